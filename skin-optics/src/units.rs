@@ -1,0 +1,33 @@
+//! Wavelength, the one validated unit type of the optics crate (nm).
+
+use crate::error::{OpticsError, check_range};
+
+/// A wavelength in nanometres, guaranteed to lie inside the tabulated range [250, 1000] nm
+/// of the hemoglobin data, so every chromophore function is defined for it.
+#[derive(Debug, Clone, Copy, PartialEq, PartialOrd)]
+pub struct Wavelength(f64);
+
+impl Wavelength {
+    /// Shortest supported wavelength, nm (start of Prahl's hemoglobin table).
+    pub const MIN_NM: f64 = 250.0;
+    /// Longest supported wavelength, nm (end of Prahl's hemoglobin table).
+    pub const MAX_NM: f64 = 1000.0;
+
+    /// A wavelength from nanometres; outside [250, 1000] nm is an error, not an extrapolation.
+    pub fn new(nm: f64) -> Result<Self, OpticsError> {
+        check_range(
+            "wavelength (nm)",
+            nm,
+            Self::MIN_NM,
+            Self::MAX_NM,
+            "[250, 1000] nm",
+        )
+        .map(Self)
+    }
+
+    /// The wavelength in nanometres.
+    #[must_use]
+    pub fn nm(self) -> f64 {
+        self.0
+    }
+}

@@ -1,0 +1,2 @@
+//! `skin-validate`: Monte Carlo reference runs and diffusion-versus-exact charts.
+fn main() {}
