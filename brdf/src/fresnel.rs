@@ -1,0 +1,113 @@
+//! Exact unpolarised Fresnel reflectance of a smooth dielectric interface, and its angular moments.
+//!
+//! The only home of dielectric Fresnel in the workspace ([TS67] uses it inside the microfacet lobe;
+//! `multipole` uses it for the observable reflectance and the BSSRDF's directional term).
+//! Written once in f64; the per-ray f32 code casts.
+
+/// Unpolarised Fresnel reflectance for light arriving with `cos_theta_i` (cosine to the normal on the
+/// incident side, clamped to [0, 1]) at an interface of relative index `eta` = n_transmitted / n_incident.
+/// Returns 1 under total internal reflection (possible when `eta` < 1).
+#[must_use]
+pub fn dielectric_reflectance(cos_theta_i: f64, eta: f64) -> f64 {
+    let c = cos_theta_i.clamp(0.0, 1.0);
+    let sin2_t = (1.0 - c * c) / (eta * eta);
+    if sin2_t >= 1.0 {
+        return 1.0;
+    }
+    let ct = (1.0 - sin2_t).sqrt();
+    let r_par = (eta * c - ct) / (eta * c + ct);
+    let r_perp = (c - eta * ct) / (c + eta * ct);
+    0.5 * (r_par * r_par + r_perp * r_perp)
+}
+
+/// Fresnel reflectance at normal incidence, ((η − 1)/(η + 1))² (0.0278 for η = 1.4).
+#[must_use]
+pub fn normal_incidence_reflectance(eta: f64) -> f64 {
+    let r = (eta - 1.0) / (eta + 1.0);
+    r * r
+}
+
+/// The n-th Fresnel moment ∫₀¹ F_r(μ, η) μⁿ dμ (μ = cos θ on the incident side, η = n_t / n_i).
+///
+/// 2·moment(1, η) is the hemispherical (cosine-weighted) reflectance for diffuse light; with η = 1.4
+/// it is the external one, ≈ 0.078, so the BSSRDF's S_ω normalisation is c = 1 − 2·moment(1, 1.4)
+/// (pbrt-v3 writes this as 1 − 2 F̄₁(1/η) in its own index convention). Composite Simpson,
+/// split at the critical angle where F_r has a kink; accurate to about 1e-6 (the square-root kink at the critical angle limits Simpson).
+#[must_use]
+pub fn fresnel_moment(n: i32, eta: f64) -> f64 {
+    let f = |mu: f64| dielectric_reflectance(mu, eta) * mu.powi(n);
+    // Below the critical cosine everything is reflected (eta < 1); integrate each smooth piece.
+    let mu_c = if eta < 1.0 {
+        (1.0 - eta * eta).sqrt()
+    } else {
+        0.0
+    };
+    simpson(f, 0.0, mu_c, 512) + simpson(f, mu_c, 1.0, 4096)
+}
+
+fn simpson(f: impl Fn(f64) -> f64, a: f64, b: f64, n: usize) -> f64 {
+    if b <= a {
+        return 0.0;
+    }
+    let h = (b - a) / n as f64;
+    let mut s = f(a) + f(b);
+    for i in 1..n {
+        let x = a + h * i as f64;
+        s += if i % 2 == 1 { 4.0 } else { 2.0 } * f(x);
+    }
+    s * h / 3.0
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+
+    #[test]
+    fn normal_incidence_matches_closed_form() {
+        assert_relative_eq!(
+            dielectric_reflectance(1.0, 1.4),
+            0.027_777_777_8,
+            epsilon = 1e-9
+        );
+        assert_relative_eq!(
+            normal_incidence_reflectance(1.4),
+            0.027_777_777_8,
+            epsilon = 1e-9
+        );
+    }
+
+    #[test]
+    fn grazing_is_total_and_tir_beyond_critical_angle() {
+        assert_relative_eq!(dielectric_reflectance(0.0, 1.4), 1.0, epsilon = 1e-12);
+        // Inside skin (η = 1/1.4) the critical cosine is √(1 − 1/1.96) = 0.6999.
+        assert_eq!(dielectric_reflectance(0.69, 1.0 / 1.4), 1.0);
+        assert!(dielectric_reflectance(0.71, 1.0 / 1.4) < 1.0);
+    }
+
+    #[test]
+    fn brewster_angle_zeroes_p_polarisation() {
+        // At Brewster's angle tanθ = η the reflectance is half the s-term only: (cos-based check).
+        let theta_b = 1.4f64.atan();
+        let c = theta_b.cos();
+        let ct = (1.0 - (1.0 - c * c) / 1.96).sqrt();
+        let r_perp = (c - 1.4 * ct) / (c + 1.4 * ct);
+        assert_relative_eq!(
+            dielectric_reflectance(c, 1.4),
+            0.5 * r_perp * r_perp,
+            epsilon = 1e-12
+        );
+    }
+
+    #[test]
+    fn first_moment_gives_pbrt_normalisation() {
+        // pbrt-v3's polynomial fit FresnelMoment1(1/1.4) = 0.0392 (its fit is good to ~1e-3).
+        let m1 = fresnel_moment(1, 1.4);
+        assert!((m1 - 0.0392).abs() < 1e-3, "{m1}");
+        // Energy: internal hemispherical reflectance + transmittance relation (Stokes):
+        // 1 − 2·m1(1/η) = (1 − 2·m1(η)) · η² for diffuse light (reciprocity of the interface).
+        let inside = 1.0 - 2.0 * fresnel_moment(1, 1.0 / 1.4);
+        let outside = 1.0 - 2.0 * m1;
+        assert_relative_eq!(inside * 1.96, outside, max_relative = 1e-5);
+    }
+}

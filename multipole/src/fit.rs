@@ -1,0 +1,1 @@
+//! Fitting skin parameters to a colour or a reflectance spectrum (issue [fit]); in progress.
