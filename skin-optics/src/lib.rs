@@ -3,6 +3,7 @@
 pub mod chromophores;
 pub mod color;
 pub mod error;
+pub mod lab;
 pub mod params;
 pub mod spectrum;
 mod table;
