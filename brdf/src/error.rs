@@ -1,0 +1,74 @@
+//! Typed errors for invalid BRDF parameters.
+
+use thiserror::Error;
+
+/// A parameter outside the domain of the surface-reflection model. Every variant carries the parameter
+/// name, the offending value and the valid range.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum BrdfError {
+    /// A parameter is NaN or infinite.
+    #[error("{name} = {value} is not a finite number (valid range {range})")]
+    NonFinite {
+        /// Parameter name as the user knows it.
+        name: &'static str,
+        /// The offending value.
+        value: f64,
+        /// Human-readable valid range, e.g. `(0, 1]`.
+        range: &'static str,
+    },
+    /// A parameter lies outside its valid interval.
+    #[error("{name} = {value} outside {range}")]
+    OutOfRange {
+        /// Parameter name as the user knows it.
+        name: &'static str,
+        /// The offending value.
+        value: f64,
+        /// Human-readable valid range, e.g. `(0, 1]`.
+        range: &'static str,
+    },
+}
+
+/// Which end of an interval is open.
+#[derive(Clone, Copy)]
+pub(crate) enum Bounds {
+    /// `[min, max]`.
+    Closed,
+    /// `(min, max]`.
+    OpenBelow,
+}
+
+/// Check that `value` is finite and inside the interval; `range` is the text shown to the user.
+pub(crate) fn check_range(
+    name: &'static str,
+    value: f64,
+    min: f64,
+    max: f64,
+    bounds: Bounds,
+    range: &'static str,
+) -> Result<f64, BrdfError> {
+    if !value.is_finite() {
+        return Err(BrdfError::NonFinite { name, value, range });
+    }
+    let below = match bounds {
+        Bounds::Closed => value < min,
+        Bounds::OpenBelow => value <= min,
+    };
+    if below || value > max {
+        return Err(BrdfError::OutOfRange { name, value, range });
+    }
+    Ok(value)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn open_lower_bound_rejects_the_bound_itself() {
+        assert!(check_range("m", 0.0, 0.0, 1.0, Bounds::OpenBelow, "(0, 1]").is_err());
+        assert!(check_range("m", 1.0, 0.0, 1.0, Bounds::OpenBelow, "(0, 1]").is_ok());
+        assert!(check_range("m", f64::NAN, 0.0, 1.0, Bounds::OpenBelow, "(0, 1]").is_err());
+        let e = check_range("roughness m", 1.5, 0.0, 1.0, Bounds::OpenBelow, "(0, 1]").unwrap_err();
+        assert_eq!(e.to_string(), "roughness m = 1.5 outside (0, 1]");
+    }
+}

@@ -1,0 +1,50 @@
+//! The few float operations the shared microfacet formulas need, for `f32` (per ray) and `f64`
+//! (albedo quadrature), so each formula is written once (house rule: one home per formula).
+
+use core::ops::{Add, Div, Mul, Neg, Sub};
+
+/// A float type the microfacet formulas are generic over (`f32` or `f64`).
+pub(crate) trait Real:
+    Copy
+    + PartialOrd
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
+    + Neg<Output = Self>
+{
+    /// 0.
+    const ZERO: Self;
+    /// 1.
+    const ONE: Self;
+    /// 2.
+    const TWO: Self;
+    /// ln(1 + x), accurate for small x.
+    fn ln_1p(self) -> Self;
+    /// Smaller of two values.
+    fn min(self, other: Self) -> Self;
+}
+
+impl Real for f32 {
+    const ZERO: Self = 0.0;
+    const ONE: Self = 1.0;
+    const TWO: Self = 2.0;
+    fn ln_1p(self) -> Self {
+        f32::ln_1p(self)
+    }
+    fn min(self, other: Self) -> Self {
+        f32::min(self, other)
+    }
+}
+
+impl Real for f64 {
+    const ZERO: Self = 0.0;
+    const ONE: Self = 1.0;
+    const TWO: Self = 2.0;
+    fn ln_1p(self) -> Self {
+        f64::ln_1p(self)
+    }
+    fn min(self, other: Self) -> Self {
+        f64::min(self, other)
+    }
+}
