@@ -1,0 +1,56 @@
+//! Typed errors of the diffusion crate: every variant names the parameter, its value and its range.
+
+use skin_optics::OpticsError;
+use thiserror::Error;
+
+/// An input outside the domain of the diffusion model.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum MultipoleError {
+    /// A physical parameter (coefficient, thickness, index, radius) is NaN, infinite or out of range.
+    #[error("{name} = {value} outside {range}")]
+    OutOfRange {
+        /// Parameter name with its symbol and unit, e.g. `"σa (mm⁻¹)"`.
+        name: &'static str,
+        /// The offending value.
+        value: f64,
+        /// Human-readable valid range, e.g. `[0, 1e6]`.
+        range: &'static str,
+    },
+    /// A numerical knob (`ProfileOptions`) is out of range.
+    #[error("option {name} = {value} outside {range}")]
+    InvalidOption {
+        /// Knob name, e.g. `"radial_samples"`.
+        name: &'static str,
+        /// The offending value.
+        value: f64,
+        /// Human-readable valid range.
+        range: &'static str,
+    },
+    /// A layer stack that cannot be combined (empty, or a semi-infinite layer above another layer).
+    #[error("invalid layer stack: {0}")]
+    Stack(&'static str),
+    /// An unknown method name (valid: `multipole`).
+    #[error("unknown method '{0}' (valid: multipole)")]
+    UnknownMethod(String),
+    /// A profile table that is not finite and non-negative, or whose radii do not increase.
+    #[error("invalid profile table: {0}")]
+    Profile(&'static str),
+    /// An error from the optical coefficients (wavelength, grid).
+    #[error(transparent)]
+    Optics(#[from] OpticsError),
+}
+
+/// Check that `value` is finite and in `[min, max]`; `range` is the text shown to the user.
+pub(crate) fn check_range(
+    name: &'static str,
+    value: f64,
+    min: f64,
+    max: f64,
+    range: &'static str,
+) -> Result<f64, MultipoleError> {
+    if value.is_finite() && value >= min && value <= max {
+        Ok(value)
+    } else {
+        Err(MultipoleError::OutOfRange { name, value, range })
+    }
+}
