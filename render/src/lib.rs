@@ -2,3 +2,4 @@
 
 pub mod atomic;
 pub mod cli;
+pub mod plot;
