@@ -1,0 +1,85 @@
+//! Typed errors of the renderer: every variant names the file, key or setting and what was expected.
+
+use std::path::PathBuf;
+use thiserror::Error;
+
+/// Anything that stops a scene from loading or an image from being written.
+#[derive(Debug, Error)]
+pub enum RenderError {
+    /// The scene file is not valid TOML or does not match the schema (unknown key, wrong type).
+    #[error("scene {file}: {message}")]
+    SceneSyntax {
+        /// Scene file (or `builtin:NAME`).
+        file: String,
+        /// The parser's message, which names the key and line.
+        message: String,
+    },
+    /// A key of the scene file has a value outside what is expected.
+    #[error("scene {file}: key `{key}`: {message}")]
+    SceneValue {
+        /// Scene file (or `builtin:NAME`).
+        file: String,
+        /// Dotted key path, e.g. `meshes[1].translate_mm`.
+        key: String,
+        /// What was wrong and what is expected.
+        message: String,
+    },
+    /// A file the scene refers to (mesh, texture, environment map) cannot be read.
+    #[error("{what} file {path} cannot be read: {source}")]
+    MissingFile {
+        /// What the file is for ("mesh", "texture", "environment map", "scene").
+        what: &'static str,
+        /// The path as resolved.
+        path: PathBuf,
+        /// The underlying I/O error.
+        source: std::io::Error,
+    },
+    /// A mesh file could be read but not decoded.
+    #[error("mesh {path}: {message}")]
+    Mesh {
+        /// The mesh path.
+        path: PathBuf,
+        /// What is wrong with it.
+        message: String,
+    },
+    /// An image file (texture, environment map) could be read but not decoded.
+    #[error("image {path}: {message}")]
+    Image {
+        /// The image path.
+        path: PathBuf,
+        /// What is wrong with it.
+        message: String,
+    },
+    /// A render setting outside its valid range.
+    #[error("{name} = {value} outside {range}")]
+    Setting {
+        /// The setting as the user knows it (e.g. `--spp`).
+        name: &'static str,
+        /// The offending value.
+        value: String,
+        /// The valid range.
+        range: &'static str,
+    },
+    /// An I/O error without more context (wrapped with the path where it is known).
+    #[error(transparent)]
+    Io(#[from] std::io::Error),
+    /// Writing an output image failed.
+    #[error("cannot write {path}: {message}")]
+    Output {
+        /// The output path.
+        path: PathBuf,
+        /// What went wrong.
+        message: String,
+    },
+}
+
+impl RenderError {
+    /// Shorthand for [`RenderError::SceneValue`].
+    pub fn value(file: &str, key: impl Into<String>, message: impl Into<String>) -> Self {
+        Self::SceneValue {
+            file: file.to_string(),
+            key: key.into(),
+            message: message.into(),
+        }
+    }
+}

@@ -1,0 +1,355 @@
+//! Hero-wavelength spectral sampling: four wavelengths per path, stratified over 380–780 nm,
+//! and per-material spectral tables evaluated at them (pbrt-v4's `SampledWavelengths`, f32 per ray).
+//!
+//! Colour science is not re-derived here: the CIE matching functions come from
+//! `skin_optics::color::cie_xyz_bar` and are only re-tabulated in f32 at 1 nm for speed.
+
+use skin_optics::color::{cie_xyz_bar, cie_y_integral};
+use std::ops::{Add, AddAssign, Div, Mul, MulAssign};
+use std::sync::OnceLock;
+
+/// Wavelengths carried per path.
+pub const N_WAVELENGTHS: usize = 4;
+/// Shortest rendered wavelength, nm.
+pub const LAMBDA_MIN_NM: f32 = 380.0;
+/// Longest rendered wavelength, nm.
+pub const LAMBDA_MAX_NM: f32 = 780.0;
+
+/// A quantity (radiance, throughput, albedo) at the four sampled wavelengths of a path.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct SampledSpectrum(pub [f32; N_WAVELENGTHS]);
+
+impl SampledSpectrum {
+    /// All four values equal to `v`.
+    #[must_use]
+    pub const fn splat(v: f32) -> Self {
+        Self([v; N_WAVELENGTHS])
+    }
+    /// Zero at every wavelength.
+    #[must_use]
+    pub const fn zero() -> Self {
+        Self::splat(0.0)
+    }
+    /// Largest of the four values.
+    #[must_use]
+    pub fn max_value(&self) -> f32 {
+        self.0.iter().copied().fold(f32::NEG_INFINITY, f32::max)
+    }
+    /// Mean of the four values.
+    #[must_use]
+    pub fn average(&self) -> f32 {
+        self.0.iter().sum::<f32>() / N_WAVELENGTHS as f32
+    }
+    /// True when every value is zero.
+    #[must_use]
+    pub fn is_black(&self) -> bool {
+        self.0.iter().all(|&v| v == 0.0)
+    }
+    /// True when every value is finite.
+    #[must_use]
+    pub fn is_finite(&self) -> bool {
+        self.0.iter().all(|v| v.is_finite())
+    }
+    /// Apply `f` to each value.
+    #[must_use]
+    pub fn map(self, f: impl Fn(f32) -> f32) -> Self {
+        Self(self.0.map(f))
+    }
+}
+
+impl Add for SampledSpectrum {
+    type Output = Self;
+    fn add(self, o: Self) -> Self {
+        Self(std::array::from_fn(|i| self.0[i] + o.0[i]))
+    }
+}
+impl AddAssign for SampledSpectrum {
+    fn add_assign(&mut self, o: Self) {
+        *self = *self + o;
+    }
+}
+impl Mul for SampledSpectrum {
+    type Output = Self;
+    fn mul(self, o: Self) -> Self {
+        Self(std::array::from_fn(|i| self.0[i] * o.0[i]))
+    }
+}
+impl MulAssign for SampledSpectrum {
+    fn mul_assign(&mut self, o: Self) {
+        *self = *self * o;
+    }
+}
+impl Mul<f32> for SampledSpectrum {
+    type Output = Self;
+    fn mul(self, s: f32) -> Self {
+        self.map(|v| v * s)
+    }
+}
+impl MulAssign<f32> for SampledSpectrum {
+    fn mul_assign(&mut self, s: f32) {
+        *self = *self * s;
+    }
+}
+impl Div<f32> for SampledSpectrum {
+    type Output = Self;
+    fn div(self, s: f32) -> Self {
+        self.map(|v| v / s)
+    }
+}
+
+/// The four wavelengths of one path (nm) and their sampling densities (nm⁻¹).
+///
+/// The hero wavelength λ₀ is uniform in [380, 780] nm and the other three are rotated by a quarter
+/// of the range each, so the four are stratified ([Wilkie et al. 2014] hero wavelength sampling).
+/// A BSSRDF that samples with the hero's profile can call [`SampledWavelengths::terminate_secondary`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SampledWavelengths {
+    lambda_nm: [f32; N_WAVELENGTHS],
+    pdf: [f32; N_WAVELENGTHS],
+}
+
+impl SampledWavelengths {
+    /// Stratified sample of the visible range from `u` in [0, 1).
+    #[must_use]
+    pub fn sample_visible(u: f32) -> Self {
+        let range = LAMBDA_MAX_NM - LAMBDA_MIN_NM;
+        let lambda_nm = std::array::from_fn(|i| {
+            let mut x = u + i as f32 / N_WAVELENGTHS as f32;
+            if x >= 1.0 {
+                x -= 1.0;
+            }
+            LAMBDA_MIN_NM + x * range
+        });
+        Self {
+            lambda_nm,
+            pdf: [1.0 / range; N_WAVELENGTHS],
+        }
+    }
+
+    /// Wavelength `i`, nm (`i = 0` is the hero).
+    #[must_use]
+    pub fn nm(&self, i: usize) -> f32 {
+        self.lambda_nm[i]
+    }
+
+    /// All four wavelengths, nm.
+    #[must_use]
+    pub fn all_nm(&self) -> [f32; N_WAVELENGTHS] {
+        self.lambda_nm
+    }
+
+    /// Sampling density of each wavelength, nm⁻¹ (0 once terminated).
+    #[must_use]
+    pub fn pdf(&self) -> [f32; N_WAVELENGTHS] {
+        self.pdf
+    }
+
+    /// Keep only the hero wavelength (for wavelength-dependent sampling decisions, as pbrt-v4):
+    /// the others get pdf 0 and stop contributing, the hero's estimate is scaled to stay unbiased.
+    pub fn terminate_secondary(&mut self) {
+        if self.pdf[1] == 0.0 {
+            return;
+        }
+        for p in &mut self.pdf[1..] {
+            *p = 0.0;
+        }
+        self.pdf[0] /= N_WAVELENGTHS as f32;
+    }
+
+    /// Monte Carlo estimate of CIE XYZ from radiance `l` at these wavelengths, normalised so a
+    /// constant spectral radiance 1 has Y = 1: XYZ = ∫ L {x̄,ȳ,z̄} dλ / ∫ ȳ dλ.
+    #[must_use]
+    pub fn to_xyz(&self, l: &SampledSpectrum) -> [f32; 3] {
+        let table = cmf_table();
+        let mut xyz = [0.0f32; 3];
+        for i in 0..N_WAVELENGTHS {
+            if self.pdf[i] == 0.0 || l.0[i] == 0.0 {
+                continue;
+            }
+            let cmf = table.at(self.lambda_nm[i]);
+            let w = l.0[i] / self.pdf[i];
+            for c in 0..3 {
+                xyz[c] += cmf[c] * w;
+            }
+        }
+        let norm = 1.0 / (N_WAVELENGTHS as f32 * table.y_integral);
+        xyz.map(|v| v * norm)
+    }
+}
+
+/// CIE 1931 x̄ȳz̄ re-tabulated in f32 at 1 nm over 380–780 nm from `skin_optics::color`.
+struct CmfTable {
+    rows: Vec<[f32; 3]>,
+    y_integral: f32,
+}
+
+impl CmfTable {
+    fn at(&self, nm: f32) -> [f32; 3] {
+        let x = (nm - LAMBDA_MIN_NM).clamp(0.0, (self.rows.len() - 1) as f32);
+        let i = (x as usize).min(self.rows.len() - 2);
+        let f = x - i as f32;
+        let (a, b) = (self.rows[i], self.rows[i + 1]);
+        std::array::from_fn(|c| a[c] + f * (b[c] - a[c]))
+    }
+}
+
+fn cmf_table() -> &'static CmfTable {
+    static T: OnceLock<CmfTable> = OnceLock::new();
+    T.get_or_init(|| {
+        let n = (LAMBDA_MAX_NM - LAMBDA_MIN_NM) as usize + 1;
+        let rows = (0..n)
+            .map(|i| cie_xyz_bar(f64::from(LAMBDA_MIN_NM) + i as f64).map(|v| v as f32))
+            .collect();
+        CmfTable {
+            rows,
+            y_integral: cie_y_integral() as f32,
+        }
+    })
+}
+
+/// Relative luminance Y of a spectrum `s(λ)` (nm → value): ∫ s ȳ dλ / ∫ ȳ dλ over the CIE table.
+#[must_use]
+pub fn luminance_of(s: impl Fn(f64) -> f64) -> f64 {
+    let mut y = 0.0;
+    let mut nm = skin_optics::color::CMF_START_NM;
+    while nm <= skin_optics::color::CMF_END_NM {
+        y += s(nm) * cie_xyz_bar(nm)[1];
+        nm += 1.0;
+    }
+    y / cie_y_integral()
+}
+
+/// A spectrum tabulated on a uniform 5-nm grid over 380–780 nm in f32, built once at scene load
+/// (albedos, emission) and evaluated at the hero wavelengths by linear interpolation.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SpectrumTable {
+    values: Vec<f32>,
+}
+
+impl SpectrumTable {
+    /// Table step, nm.
+    pub const STEP_NM: f32 = 5.0;
+
+    /// Tabulate `f(λ_nm)` on the 5-nm grid.
+    #[must_use]
+    pub fn from_fn(f: impl Fn(f64) -> f64) -> Self {
+        let n = ((LAMBDA_MAX_NM - LAMBDA_MIN_NM) / Self::STEP_NM) as usize + 1;
+        let values = (0..n)
+            .map(|i| f(f64::from(LAMBDA_MIN_NM + i as f32 * Self::STEP_NM)) as f32)
+            .collect();
+        Self { values }
+    }
+
+    /// The same value at every wavelength.
+    #[must_use]
+    pub fn constant(v: f32) -> Self {
+        Self::from_fn(|_| f64::from(v))
+    }
+
+    /// Value at `nm` (clamped to the table's range).
+    #[must_use]
+    pub fn at_nm(&self, nm: f32) -> f32 {
+        let x = ((nm - LAMBDA_MIN_NM) / Self::STEP_NM).clamp(0.0, (self.values.len() - 1) as f32);
+        let i = (x as usize).min(self.values.len() - 2);
+        let f = x - i as f32;
+        self.values[i] + f * (self.values[i + 1] - self.values[i])
+    }
+
+    /// Values at the path's four wavelengths.
+    #[must_use]
+    pub fn eval(&self, wl: &SampledWavelengths) -> SampledSpectrum {
+        SampledSpectrum(wl.all_nm().map(|nm| self.at_nm(nm)))
+    }
+
+    /// Largest tabulated value.
+    #[must_use]
+    pub fn max_value(&self) -> f32 {
+        self.values.iter().copied().fold(0.0, f32::max)
+    }
+
+    /// Mean of the tabulated values.
+    #[must_use]
+    pub fn mean(&self) -> f32 {
+        self.values.iter().sum::<f32>() / self.values.len() as f32
+    }
+
+    /// Multiply every value by `s`.
+    #[must_use]
+    pub fn scaled(mut self, s: f32) -> Self {
+        for v in &mut self.values {
+            *v *= s;
+        }
+        self
+    }
+}
+
+/// Upper edges of the blue and green bands of the sRGB → spectrum box basis, nm.
+const BOX_EDGES_NM: [f32; 2] = [490.0, 580.0];
+
+/// A reflectance spectrum for a linear sRGB triple: a box basis (blue below 490 nm, green to
+/// 580 nm, red above). Greys map exactly to constant spectra; hues are approximate, which is
+/// enough for backdrops and environment maps (skin colour is always computed spectrally).
+#[must_use]
+pub fn linear_srgb_to_spectrum(rgb: [f32; 3]) -> SpectrumTable {
+    SpectrumTable::from_fn(|nm| f64::from(linear_srgb_at_nm(rgb, nm as f32)))
+}
+
+/// The box-basis spectrum of a linear sRGB triple (see [`linear_srgb_to_spectrum`]) at `nm`.
+#[must_use]
+pub fn linear_srgb_at_nm(rgb: [f32; 3], nm: f32) -> f32 {
+    if nm < BOX_EDGES_NM[0] {
+        rgb[2]
+    } else if nm < BOX_EDGES_NM[1] {
+        rgb[1]
+    } else {
+        rgb[0]
+    }
+}
+
+/// XYZ → linear sRGB (IEC 61966-2-1), through `skin_optics::color`.
+#[must_use]
+pub fn xyz_to_linear_srgb(xyz: [f32; 3]) -> [f32; 3] {
+    skin_optics::color::Xyz(xyz.map(f64::from))
+        .to_linear_srgb()
+        .0
+        .map(|v| v as f32)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn wavelengths_are_stratified_and_in_range() {
+        let wl = SampledWavelengths::sample_visible(0.9);
+        let mut nm = wl.all_nm();
+        nm.sort_by(f32::total_cmp);
+        for w in nm.windows(2) {
+            assert!((w[1] - w[0] - 100.0).abs() < 1e-3, "{nm:?}");
+        }
+        assert!(
+            nm.iter()
+                .all(|&l| (LAMBDA_MIN_NM..LAMBDA_MAX_NM).contains(&l))
+        );
+    }
+
+    #[test]
+    fn constant_radiance_has_unit_luminance() {
+        // Average the estimator over many stratified hero samples: Y → 1 for L = 1.
+        let n = 4000;
+        let mut y = 0.0f64;
+        for k in 0..n {
+            let wl = SampledWavelengths::sample_visible((k as f32 + 0.5) / n as f32);
+            y += f64::from(wl.to_xyz(&SampledSpectrum::splat(1.0))[1]);
+        }
+        y /= f64::from(n);
+        assert!((y - 1.0).abs() < 1e-3, "Y = {y}");
+    }
+
+    #[test]
+    fn spectrum_table_interpolates() {
+        let t = SpectrumTable::from_fn(|nm| nm / 100.0);
+        assert!((t.at_nm(512.5) - 5.125).abs() < 1e-5);
+        assert!((t.at_nm(100.0) - 3.8).abs() < 1e-5);
+    }
+}
