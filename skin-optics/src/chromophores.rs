@@ -132,3 +132,209 @@ impl SkinParams {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn wl(nm: f64) -> Wavelength {
+        Wavelength::new(nm).unwrap()
+    }
+
+    /// Relative difference, for the 1e-9 hand-computed checks.
+    fn rel(a: f64, b: f64) -> f64 {
+        (a - b).abs() / b.abs()
+    }
+
+    // Hand-computed from the printed formulas (double precision, independent of this code):
+    // e.g. eq. 2 at 400 nm: 6.6e10 · 400^−3.33 = 6.6e10 · e^(−3.33 · ln 400) = 142.78551898613...
+    #[test]
+    fn eumelanin_eq2_matches_hand_values() {
+        assert!(rel(eumelanin_sigma_a(wl(400.0)), 142.785_518_986_134_4) < 1e-9);
+        assert!(rel(eumelanin_sigma_a(wl(600.0)), 37.008_396_787_617_47) < 1e-9);
+    }
+
+    #[test]
+    fn pheomelanin_eq3_matches_hand_values() {
+        assert!(rel(pheomelanin_sigma_a(wl(400.0)), 126.652_287_788_074_02) < 1e-9);
+        assert!(rel(pheomelanin_sigma_a(wl(600.0)), 18.457_783_964_937_395) < 1e-9);
+    }
+
+    #[test]
+    fn baseline_eq4_matches_hand_values() {
+        // 0.0244 + 8.53 e^(−246/66.2) and 0.0244 + 8.53 e^(−546/66.2).
+        assert!(rel(baseline_sigma_a(wl(400.0)), 0.231_941_756_567_145_05) < 1e-9);
+        assert!(rel(baseline_sigma_a(wl(700.0)), 0.026_633_590_770_620_816) < 1e-9);
+    }
+
+    #[test]
+    fn reduced_scattering_eq6_matches_hand_values() {
+        assert!(rel(reduced_scattering(wl(500.0)), 7.275_987_018_393_602) < 1e-9);
+        assert!(rel(reduced_scattering(wl(700.0)), 4.404_280_371_335_495) < 1e-9);
+    }
+
+    /// docs/physics.md §1 check table (5 significant digits, so 1e-4 relative).
+    #[test]
+    fn physics_check_table() {
+        let table = [
+            (400.0, 142.79, 126.65, 0.2319, 12.539),
+            (500.0, 67.916, 43.882, 0.07022, 7.276),
+            (600.0, 37.008, 18.458, 0.03452, 5.306),
+            (700.0, 22.150, 8.875, 0.02663, 4.404),
+        ];
+        for (nm, em, pm, base, s) in table {
+            let l = wl(nm);
+            assert!(rel(eumelanin_sigma_a(l), em) < 1e-4, "em {nm}");
+            assert!(rel(pheomelanin_sigma_a(l), pm) < 1e-4, "pm {nm}");
+            assert!(rel(baseline_sigma_a(l), base) < 2e-4, "base {nm}");
+            assert!(rel(reduced_scattering(l), s) < 1e-4, "s' {nm}");
+        }
+    }
+
+    #[test]
+    fn no_melanin_gives_baseline_epidermis() {
+        let skin = SkinParams::new(0.0, 0.37, 0.05, 0.25).unwrap();
+        for nm in [250.0, 400.0, 555.5, 1000.0] {
+            assert_eq!(epidermis_sigma_a(&skin, wl(nm)), baseline_sigma_a(wl(nm)));
+        }
+    }
+
+    #[test]
+    fn no_blood_gives_baseline_dermis() {
+        let skin = SkinParams::new(0.2, 0.5, 0.0, 0.25).unwrap();
+        for nm in [250.0, 414.0, 577.0, 1000.0] {
+            assert_eq!(dermis_sigma_a(&skin, wl(nm)), baseline_sigma_a(wl(nm)));
+        }
+    }
+
+    #[test]
+    fn full_eumelanin_blend_ignores_pheomelanin() {
+        let l = wl(450.0);
+        let pure = SkinParams::new(1.0, 1.0, 0.01, 0.25).unwrap();
+        assert!(rel(epidermis_sigma_a(&pure, l), eumelanin_sigma_a(l)) < 1e-15);
+        let mixed = SkinParams::new(0.3, 1.0, 0.01, 0.25).unwrap();
+        let expect = 0.3 * eumelanin_sigma_a(l) + 0.7 * baseline_sigma_a(l);
+        assert!(rel(epidermis_sigma_a(&mixed, l), expect) < 1e-14);
+        let pheo = SkinParams::new(1.0, 0.0, 0.01, 0.25).unwrap();
+        assert!(rel(epidermis_sigma_a(&pheo, l), pheomelanin_sigma_a(l)) < 1e-15);
+    }
+
+    #[test]
+    fn dermis_eq5_mixes_oxy_and_deoxy_by_gamma() {
+        let l = wl(560.0);
+        let skin = SkinParams::new(0.01, 0.5, 0.04, 0.25).unwrap();
+        // Default γ = 0.7.
+        let expect = 0.04 * (0.7 * oxyhemoglobin_sigma_a(l) + 0.3 * deoxyhemoglobin_sigma_a(l))
+            + 0.96 * baseline_sigma_a(l);
+        assert!(rel(dermis_sigma_a(&skin, l), expect) < 1e-14);
+        let venous = skin.with_oxygenation(0.0).unwrap();
+        let expect = 0.04 * deoxyhemoglobin_sigma_a(l) + 0.96 * baseline_sigma_a(l);
+        assert!(rel(dermis_sigma_a(&venous, l), expect) < 1e-14);
+    }
+
+    #[test]
+    fn blood_check_value_oxy_414() {
+        // docs/physics.md: 280.80 mm⁻¹; ε(414) = 524 280 cm⁻¹/M gives 280.7946 with Prahl's 2.303.
+        let v = oxyhemoglobin_sigma_a(wl(414.0));
+        assert!((v - 280.80).abs() < 0.01, "{v}");
+        assert!(rel(v, 2.303 * 524_280.0 * 150.0 / 64_500.0 / 10.0) < 1e-14);
+    }
+
+    #[test]
+    fn hemoglobin_is_interpolated_linearly_between_table_rows() {
+        // Rows 414 nm (524 280, 342 596) and 416 nm (521 880, 363 848) of Prahl's table.
+        assert!(
+            rel(
+                oxyhemoglobin_molar_extinction(wl(415.0)),
+                0.5 * (524_280.0 + 521_880.0)
+            ) < 1e-14
+        );
+        assert!(
+            rel(
+                deoxyhemoglobin_molar_extinction(wl(414.5)),
+                0.75 * 342_596.0 + 0.25 * 363_848.0
+            ) < 1e-14
+        );
+        assert!(oxyhemoglobin_molar_extinction(wl(1000.0)) > 0.0);
+        assert!(oxyhemoglobin_molar_extinction(wl(250.0)) > 0.0);
+    }
+
+    /// Wavelength of the largest value of `f` on [a, b] sampled every 0.5 nm.
+    fn argmax(f: fn(Wavelength) -> f64, a: f64, b: f64) -> f64 {
+        let n = ((b - a) / 0.5) as usize;
+        (0..=n)
+            .map(|i| a + 0.5 * i as f64)
+            .max_by(|x, y| f(wl(*x)).total_cmp(&f(wl(*y))))
+            .unwrap()
+    }
+
+    #[test]
+    fn oxyhemoglobin_soret_peak_at_414nm() {
+        let peak = argmax(oxyhemoglobin_sigma_a, 350.0, 500.0);
+        assert!((peak - 414.0).abs() <= 2.0, "Soret peak at {peak} nm");
+    }
+
+    #[test]
+    fn oxyhemoglobin_q_bands_near_542_and_577nm() {
+        let alpha = argmax(oxyhemoglobin_sigma_a, 530.0, 560.0);
+        let beta = argmax(oxyhemoglobin_sigma_a, 565.0, 590.0);
+        assert!((alpha - 542.0).abs() <= 2.0, "Q band α at {alpha} nm");
+        assert!((beta - 577.0).abs() <= 2.0, "Q band β at {beta} nm");
+        // Both are true local maxima: the valley between them is lower than either.
+        let valley = oxyhemoglobin_sigma_a(wl(560.0));
+        assert!(valley < oxyhemoglobin_sigma_a(wl(alpha)));
+        assert!(valley < oxyhemoglobin_sigma_a(wl(beta)));
+    }
+
+    #[test]
+    fn deoxyhemoglobin_peak_431_to_433nm() {
+        // Prahl's table has a flat top: 552 160 cm⁻¹/M at both 432 and 434 nm. The peak is that
+        // plateau; its centre must lie in 431–433 nm.
+        let max = deoxyhemoglobin_sigma_a(wl(argmax(deoxyhemoglobin_sigma_a, 350.0, 500.0)));
+        let top: Vec<f64> = (0..=300)
+            .map(|i| 350.0 + 0.5 * f64::from(i))
+            .filter(|&nm| deoxyhemoglobin_sigma_a(wl(nm)) >= max * (1.0 - 1e-12))
+            .collect();
+        let (first, last) = (top[0], top[top.len() - 1]);
+        assert_eq!((first, last), (432.0, 434.0));
+        let centre = 0.5 * (first + last);
+        assert!(
+            (431.0..=433.0).contains(&centre),
+            "deoxy peak at {centre} nm"
+        );
+    }
+
+    #[test]
+    fn coefficients_bundle_the_layer_laws() {
+        let skin = SkinParams::preset(crate::Preset::Medium)
+            .with_dermis_scattering_scale(0.5)
+            .unwrap();
+        let l = wl(633.0);
+        let c = skin.coefficients(l);
+        assert_eq!(c.lambda, l);
+        assert_eq!(c.epidermis.sigma_a, epidermis_sigma_a(&skin, l));
+        assert_eq!(c.dermis.sigma_a, dermis_sigma_a(&skin, l));
+        assert_eq!(c.epidermis.sigma_s_prime, reduced_scattering(l));
+        assert_eq!(c.dermis.sigma_s_prime, 0.5 * reduced_scattering(l));
+    }
+
+    proptest! {
+        #[test]
+        fn all_coefficients_finite_and_positive(
+            cm in 0.0..=1.0f64, bm in 0.0..=1.0f64, ch in 0.0..=1.0f64, rho in 0.0..=1.0f64,
+            gamma in 0.0..=1.0f64, d in 1e-3..=10.0f64, eta in 1.0..=3.0f64, scale in 1e-3..=4.0f64,
+            nm in 250.0..=1000.0f64,
+        ) {
+            let skin = SkinParams::new(cm, bm, ch, rho).unwrap()
+                .with_oxygenation(gamma).unwrap()
+                .with_epidermis_thickness_mm(d).unwrap()
+                .with_eta(eta).unwrap()
+                .with_dermis_scattering_scale(scale).unwrap();
+            let c = skin.coefficients(wl(nm));
+            for v in [c.epidermis.sigma_a, c.epidermis.sigma_s_prime, c.dermis.sigma_a, c.dermis.sigma_s_prime] {
+                prop_assert!(v.is_finite() && v > 0.0, "{v} at {nm} nm");
+            }
+        }
+    }
+}

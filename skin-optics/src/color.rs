@@ -165,3 +165,101 @@ pub fn srgb_decode(c: f64) -> f64 {
         ((c + 0.055) / 1.055).powf(2.4)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::spectrum::WavelengthGrid;
+
+    fn white() -> GridSpectrum {
+        GridSpectrum::new(WavelengthGrid::visible(), vec![1.0; 31]).unwrap()
+    }
+
+    #[test]
+    fn white_reflector_has_unit_luminance() {
+        // k = 1 / Σ S ȳ Δλ makes Y exactly 1 for R ≡ 1.
+        let xyz = reflectance_to_xyz(&white());
+        assert!((xyz.0[1] - 1.0).abs() < 1e-12);
+        let half = GridSpectrum::new(WavelengthGrid::visible(), vec![0.5; 31]).unwrap();
+        assert!((reflectance_to_xyz(&half).0[1] - 0.5).abs() < 1e-12);
+    }
+
+    #[test]
+    fn white_reflector_maps_to_srgb_white() {
+        let rgb = reflectance_to_xyz(&white()).to_linear_srgb();
+        for c in rgb.0 {
+            assert!((c - 1.0).abs() < 1e-3, "{rgb:?}");
+        }
+        let srgb = rgb.to_srgb();
+        for c in srgb.0 {
+            assert!((c - 1.0).abs() < 1e-3, "{srgb:?}");
+        }
+        assert_eq!(srgb.to_hex(), "#ffffff");
+    }
+
+    #[test]
+    fn d65_white_point_chromaticity() {
+        // CIE 015: D65 with the 1931 2° observer, x = 0.3127, y = 0.3290.
+        let [x, y] = reflectance_to_xyz(&white()).chromaticity();
+        assert!((x - 0.3127).abs() < 1e-4, "x = {x}");
+        assert!((y - 0.3290).abs() < 1e-4, "y = {y}");
+    }
+
+    #[test]
+    fn tables_hold_their_anchor_values() {
+        // ȳ peaks at 1 at 555 nm; D65 is normalised to 100 at 560 nm ([CIE] 015).
+        assert!((cie_xyz_bar(555.0)[1] - 1.0).abs() < 1e-6);
+        assert!((d65(560.0) - 100.0).abs() < 1e-9);
+        assert_eq!(cie_xyz_bar(CMF_START_NM - 1.0), [0.0; 3]);
+        assert_eq!(d65(900.0), 0.0);
+        // ∫ ȳ dλ over the 1-nm table ≈ 106.857 nm.
+        assert!(
+            (cie_y_integral() - 106.857).abs() < 1e-3,
+            "{}",
+            cie_y_integral()
+        );
+    }
+
+    #[test]
+    fn srgb_transfer_curve_inverts_and_is_continuous() {
+        for i in 0..=100 {
+            let c = f64::from(i) / 100.0;
+            assert!((srgb_decode(srgb_encode(c)) - c).abs() < 1e-12);
+        }
+        // The two pieces meet at the threshold to within the standard's 4-digit constants.
+        let t: f64 = 0.003_130_8;
+        assert!((12.92 * t - (1.055 * t.powf(1.0 / 2.4) - 0.055)).abs() < 1e-6);
+        assert!((srgb_encode(1.0) - 1.0).abs() < 1e-15);
+        assert_eq!(srgb_encode(0.0), 0.0);
+    }
+
+    #[test]
+    fn srgb_matrices_are_inverse() {
+        for rgb in [[1.0, 0.0, 0.0], [0.2, 0.5, 0.9], [1.0, 1.0, 1.0]] {
+            let back = LinearSrgb(rgb).to_xyz().to_linear_srgb();
+            for (a, b) in back.0.iter().zip(rgb) {
+                // The IEC matrices are printed to 4 decimals.
+                assert!((a - b).abs() < 5e-4, "{back:?} vs {rgb:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn hex_round_trip() {
+        let s = Srgb::from_hex("#c8967d").unwrap();
+        assert_eq!(s.to_hex(), "#c8967d");
+        assert_eq!(Srgb::from_hex("c8967D").unwrap().to_hex(), "#c8967d");
+        assert!(Srgb::from_hex("#c8967").is_none());
+        assert!(Srgb::from_hex("#g8967d").is_none());
+        let back = s.to_linear().to_srgb();
+        assert_eq!(back.to_hex(), "#c8967d");
+    }
+
+    #[test]
+    fn grey_reflector_keeps_white_chromaticity() {
+        let grey = GridSpectrum::new(WavelengthGrid::visible(), vec![0.18; 31]).unwrap();
+        let [x, y] = reflectance_to_xyz(&grey).chromaticity();
+        let [xw, yw] = reflectance_to_xyz(&white()).chromaticity();
+        assert!((x - xw).abs() < 1e-12 && (y - yw).abs() < 1e-12);
+    }
+}

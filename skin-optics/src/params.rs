@@ -211,3 +211,164 @@ impl Default for SkinParams {
         Self::preset(Preset::Light)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The error's variant, parameter name and value.
+    fn parts(e: OpticsError) -> (&'static str, &'static str, f64) {
+        match e {
+            OpticsError::NonFinite { name, value, .. } => ("NonFinite", name, value),
+            OpticsError::OutOfRange { name, value, .. } => ("OutOfRange", name, value),
+            other => panic!("unexpected {other:?}"),
+        }
+    }
+
+    fn check_field(
+        name: &'static str,
+        build: impl Fn(f64) -> Result<SkinParams, OpticsError>,
+        out_of_range: &[f64],
+    ) {
+        for v in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+            let (kind, n, _) = parts(build(v).unwrap_err());
+            assert_eq!((kind, n), ("NonFinite", name), "{name} = {v}");
+        }
+        for &v in out_of_range {
+            let (kind, n, value) = parts(build(v).unwrap_err());
+            assert_eq!((kind, n, value), ("OutOfRange", name, v), "{name} = {v}");
+        }
+    }
+
+    #[test]
+    fn every_invalid_field_is_rejected_with_its_name() {
+        let bad_fraction = [-1e-12, -0.5, 1.000_001, 1.5];
+        check_field(
+            "melanin fraction C_m",
+            |v| SkinParams::new(v, 0.5, 0.01, 0.25),
+            &bad_fraction,
+        );
+        check_field(
+            "eumelanin blend β_m",
+            |v| SkinParams::new(0.1, v, 0.01, 0.25),
+            &bad_fraction,
+        );
+        check_field(
+            "hemoglobin fraction C_h",
+            |v| SkinParams::new(0.1, 0.5, v, 0.25),
+            &bad_fraction,
+        );
+        check_field(
+            "oiliness ρ_s",
+            |v| SkinParams::new(0.1, 0.5, 0.01, v),
+            &bad_fraction,
+        );
+        let skin = SkinParams::default();
+        check_field("oiliness ρ_s", |v| skin.with_oiliness(v), &bad_fraction);
+        check_field(
+            "blood oxygenation γ",
+            |v| skin.with_oxygenation(v),
+            &bad_fraction,
+        );
+        check_field(
+            "epidermis thickness (mm)",
+            |v| skin.with_epidermis_thickness_mm(v),
+            &[0.0, -0.0, -0.25, 10.5],
+        );
+        check_field(
+            "index of refraction η",
+            |v| skin.with_eta(v),
+            &[0.999, 0.0, 3.01],
+        );
+        check_field(
+            "dermis scattering scale",
+            |v| skin.with_dermis_scattering_scale(v),
+            &[0.0, -1.0, 4.5],
+        );
+    }
+
+    #[test]
+    fn error_message_names_field_value_and_range() {
+        let e = SkinParams::new(1.5, 0.5, 0.01, 0.25).unwrap_err();
+        assert_eq!(e.to_string(), "melanin fraction C_m = 1.5 outside [0, 1]");
+        let e = SkinParams::new(f64::NAN, 0.5, 0.01, 0.25).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "melanin fraction C_m = NaN is not a finite number (valid range [0, 1])"
+        );
+    }
+
+    #[test]
+    fn boundary_values_are_accepted() {
+        let s = SkinParams::new(0.0, 1.0, 0.0, 1.0).unwrap();
+        assert_eq!(
+            (
+                s.melanin(),
+                s.eumelanin_blend(),
+                s.hemoglobin(),
+                s.oiliness()
+            ),
+            (0.0, 1.0, 0.0, 1.0)
+        );
+        let s = s
+            .with_eta(1.0)
+            .unwrap()
+            .with_eta(3.0)
+            .unwrap()
+            .with_epidermis_thickness_mm(10.0)
+            .unwrap()
+            .with_oxygenation(1.0)
+            .unwrap()
+            .with_dermis_scattering_scale(4.0)
+            .unwrap();
+        assert_eq!(
+            (
+                s.eta(),
+                s.epidermis_thickness_mm(),
+                s.oxygenation(),
+                s.dermis_scattering_scale()
+            ),
+            (3.0, 10.0, 1.0, 4.0)
+        );
+    }
+
+    #[test]
+    fn defaults_are_the_seed_constants() {
+        let s = SkinParams::new(0.1, 0.5, 0.01, 0.25).unwrap();
+        assert_eq!(s.oxygenation(), 0.7);
+        assert_eq!(s.epidermis_thickness_mm(), 0.25);
+        assert_eq!(s.eta(), 1.4);
+        assert_eq!(s.dermis_scattering_scale(), 1.0);
+    }
+
+    #[test]
+    fn presets_match_physics_md() {
+        let get = |p| {
+            let s = SkinParams::preset(p);
+            (
+                s.melanin(),
+                s.eumelanin_blend(),
+                s.hemoglobin(),
+                s.oiliness(),
+            )
+        };
+        assert_eq!(get(Preset::Light), (0.002, 0.5, 0.01, 0.25));
+        assert_eq!(get(Preset::Medium), (0.05, 0.6, 0.02, 0.25));
+        assert_eq!(get(Preset::Dark), (0.30, 0.9, 0.04, 0.25));
+        assert_eq!(SkinParams::default(), SkinParams::preset(Preset::Light));
+    }
+
+    #[test]
+    fn preset_names_round_trip() {
+        for p in Preset::ALL {
+            assert_eq!(p.name().parse::<Preset>().unwrap(), p);
+            assert_eq!(p.to_string(), p.name());
+        }
+        assert_eq!("DARK".parse::<Preset>().unwrap(), Preset::Dark);
+        let e = "tan".parse::<Preset>().unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "unknown skin preset 'tan' (valid: light, medium, dark)"
+        );
+    }
+}

@@ -1,6 +1,6 @@
 //! Uniform wavelength grids and spectra tabulated on them (tabulation, not physics).
 
-use crate::error::OpticsError;
+use crate::error::{OpticsError, check_range};
 use crate::units::Wavelength;
 
 /// A uniform grid of wavelengths `start_nm + i · step_nm`, i = 0..count, all inside
@@ -13,18 +13,24 @@ pub struct WavelengthGrid {
 }
 
 impl WavelengthGrid {
+    /// Smallest accepted grid step, nm (keeps a grid over the whole range below 75 001 points).
+    pub const MIN_STEP_NM: f64 = 0.01;
+    /// Largest accepted grid step, nm (the width of the supported range).
+    pub const MAX_STEP_NM: f64 = 750.0;
+
     /// A grid from `from_nm` to `to_nm` inclusive (the last point is the largest one ≤ `to_nm`),
-    /// with step `step_nm` > 0; both ends must be valid [`Wavelength`]s.
+    /// with step `step_nm` in [0.01, 750] nm; both ends must be valid [`Wavelength`]s and
+    /// `to_nm ≥ from_nm`.
     pub fn new(from_nm: f64, to_nm: f64, step_nm: f64) -> Result<Self, OpticsError> {
-        let from = Wavelength::new(from_nm).map_err(|e| rename(e, "--from wavelength (nm)"))?;
-        let to = Wavelength::new(to_nm).map_err(|e| rename(e, "--to wavelength (nm)"))?;
-        if !step_nm.is_finite() || step_nm <= 0.0 {
-            return Err(OpticsError::OutOfRange {
-                name: "wavelength step (nm)",
-                value: step_nm,
-                range: "(0, 750] nm",
-            });
-        }
+        let from = Wavelength::new(from_nm).map_err(|e| rename(e, "grid start (nm)"))?;
+        let to = Wavelength::new(to_nm).map_err(|e| rename(e, "grid end (nm)"))?;
+        check_range(
+            "grid step (nm)",
+            step_nm,
+            Self::MIN_STEP_NM,
+            Self::MAX_STEP_NM,
+            "[0.01, 750] nm",
+        )?;
         if to.nm() < from.nm() {
             return Err(OpticsError::Grid(format!(
                 "end {to_nm} nm is below start {from_nm} nm"
@@ -153,5 +159,102 @@ impl GridSpectrum {
         let i = (x.floor() as usize).min(n - 2);
         let t = x - i as f64;
         self.values[i] * (1.0 - t) + self.values[i + 1] * t
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn visible_grid_is_400_to_700_by_10() {
+        let g = WavelengthGrid::new(400.0, 700.0, 10.0).unwrap();
+        assert_eq!(g, WavelengthGrid::visible());
+        assert_eq!(g.len(), 31);
+        assert_eq!((g.nm(0), g.nm(30)), (400.0, 700.0));
+        let nms: Vec<f64> = g.iter().map(Wavelength::nm).collect();
+        assert_eq!(nms[15], 550.0);
+    }
+
+    #[test]
+    fn grid_ends_at_largest_point_not_above_to() {
+        let g = WavelengthGrid::new(400.0, 700.0, 7.0).unwrap();
+        assert_eq!(g.len(), 43);
+        assert_eq!(g.nm(42), 694.0);
+        let one = WavelengthGrid::new(550.0, 550.0, 5.0).unwrap();
+        assert_eq!(one.len(), 1);
+        let full = WavelengthGrid::new(250.0, 1000.0, 750.0).unwrap();
+        assert_eq!((full.len(), full.nm(1)), (2, 1000.0));
+        // 0.1 nm steps: rounding must not lose the end point.
+        let fine = WavelengthGrid::new(400.0, 700.0, 0.1).unwrap();
+        assert_eq!(fine.len(), 3001);
+        assert!(fine.wavelength(3000).nm() <= 700.0 + 1e-9);
+    }
+
+    #[test]
+    fn grid_errors_name_the_bad_parameter() {
+        let kind = |r: Result<WavelengthGrid, OpticsError>| match r.unwrap_err() {
+            OpticsError::OutOfRange { name, .. } => ("OutOfRange", name),
+            OpticsError::NonFinite { name, .. } => ("NonFinite", name),
+            OpticsError::Grid(_) => ("Grid", ""),
+            OpticsError::GridMismatch => ("GridMismatch", ""),
+        };
+        assert_eq!(
+            kind(WavelengthGrid::new(100.0, 700.0, 10.0)),
+            ("OutOfRange", "grid start (nm)")
+        );
+        assert_eq!(
+            kind(WavelengthGrid::new(f64::NAN, 700.0, 10.0)),
+            ("NonFinite", "grid start (nm)")
+        );
+        assert_eq!(
+            kind(WavelengthGrid::new(400.0, 1200.0, 10.0)),
+            ("OutOfRange", "grid end (nm)")
+        );
+        assert_eq!(
+            kind(WavelengthGrid::new(400.0, 700.0, 0.0)),
+            ("OutOfRange", "grid step (nm)")
+        );
+        assert_eq!(
+            kind(WavelengthGrid::new(400.0, 700.0, -10.0)),
+            ("OutOfRange", "grid step (nm)")
+        );
+        assert_eq!(
+            kind(WavelengthGrid::new(400.0, 700.0, 1e-6)),
+            ("OutOfRange", "grid step (nm)")
+        );
+        assert_eq!(
+            kind(WavelengthGrid::new(400.0, 700.0, 751.0)),
+            ("OutOfRange", "grid step (nm)")
+        );
+        assert_eq!(
+            kind(WavelengthGrid::new(400.0, 700.0, f64::NAN)),
+            ("NonFinite", "grid step (nm)")
+        );
+        assert_eq!(kind(WavelengthGrid::new(700.0, 400.0, 10.0)), ("Grid", ""));
+    }
+
+    #[test]
+    fn spectrum_length_must_match_grid() {
+        let g = WavelengthGrid::visible();
+        assert!(matches!(
+            GridSpectrum::new(g, vec![0.5; 30]),
+            Err(OpticsError::Grid(_))
+        ));
+        assert!(GridSpectrum::new(g, vec![0.5; 31]).is_ok());
+    }
+
+    #[test]
+    fn spectrum_interpolates_and_holds_ends() {
+        let g = WavelengthGrid::new(400.0, 420.0, 10.0).unwrap();
+        let s = GridSpectrum::from_fn(g, |l| l.nm() / 100.0);
+        assert_eq!(s.values(), &[4.0, 4.1, 4.2]);
+        assert!((s.at_nm(405.0) - 4.05).abs() < 1e-12);
+        assert_eq!(s.at_nm(300.0), 4.0);
+        assert_eq!(s.at_nm(900.0), 4.2);
+        assert_eq!(s.grid(), &g);
+        let single =
+            GridSpectrum::new(WavelengthGrid::new(500.0, 500.0, 1.0).unwrap(), vec![0.3]).unwrap();
+        assert_eq!(single.at_nm(700.0), 0.3);
     }
 }

@@ -56,3 +56,61 @@ impl UniformTable {
         col[i] * (1.0 - t) + col[i + 1] * t
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The embedded files have the shape the code assumes (uniform grid, expected columns).
+    #[test]
+    fn embedded_tables_have_the_expected_shape() {
+        let shapes = [
+            (
+                include_str!("../data/hemoglobin_molar_extinction.csv"),
+                250.0,
+                2.0,
+                376,
+                2,
+            ),
+            (
+                include_str!("../data/cie1931_2deg_cmf.csv"),
+                360.0,
+                1.0,
+                471,
+                3,
+            ),
+            (include_str!("../data/cie_d65.csv"), 300.0, 1.0, 531, 1),
+        ];
+        for (text, start, step, rows, cols) in shapes {
+            let t = UniformTable::parse(text);
+            assert_eq!(
+                (t.start_nm, t.step_nm, t.columns.len()),
+                (start, step, cols)
+            );
+            for c in &t.columns {
+                assert_eq!(c.len(), rows);
+            }
+            // Uniform: every row's wavelength is start + i·step.
+            let nms: Vec<f64> = text
+                .lines()
+                .filter(|l| !l.starts_with('#') && !l.trim().is_empty())
+                .skip(1)
+                .map(|l| l.split(',').next().unwrap().parse().unwrap())
+                .collect();
+            for (i, nm) in nms.iter().enumerate() {
+                assert_eq!(*nm, start + step * i as f64);
+            }
+        }
+    }
+
+    #[test]
+    fn lerp_is_linear_and_zero_outside() {
+        let t = UniformTable::parse("# c\nx,a\n10,1\n20,3\n30,7\n");
+        assert_eq!(t.lerp(0, 10.0), 1.0);
+        assert_eq!(t.lerp(0, 15.0), 2.0);
+        assert_eq!(t.lerp(0, 25.0), 5.0);
+        assert_eq!(t.lerp(0, 30.0), 7.0);
+        assert_eq!(t.lerp(0, 9.9), 0.0);
+        assert_eq!(t.lerp(0, 30.1), 0.0);
+    }
+}

@@ -31,3 +31,36 @@ impl Wavelength {
         self.0
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn accepts_the_closed_table_range() {
+        assert_eq!(Wavelength::new(250.0).unwrap().nm(), 250.0);
+        assert_eq!(Wavelength::new(1000.0).unwrap().nm(), 1000.0);
+        assert_eq!(Wavelength::new(555.5).unwrap().nm(), 555.5);
+    }
+
+    #[test]
+    fn rejects_outside_and_non_finite() {
+        for nm in [249.999, 1000.001, 0.0, -500.0] {
+            assert!(
+                matches!(Wavelength::new(nm), Err(OpticsError::OutOfRange { name: "wavelength (nm)", value, .. }) if value == nm),
+                "{nm}"
+            );
+        }
+        for nm in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+            assert!(matches!(
+                Wavelength::new(nm),
+                Err(OpticsError::NonFinite {
+                    name: "wavelength (nm)",
+                    ..
+                })
+            ));
+        }
+        let msg = Wavelength::new(100.0).unwrap_err().to_string();
+        assert_eq!(msg, "wavelength (nm) = 100 outside [250, 1000] nm");
+    }
+}
