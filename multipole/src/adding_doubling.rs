@@ -1,1 +1,442 @@
-//! Adding-doubling: exact plane-parallel transport for layered slabs (issue [exact]); in progress.
+//! Adding-doubling: exact plane-parallel transport in layered slabs ([vdH80]; [Prahl95] for tissue).
+//!
+//! The radiative transfer equation for a stack of homogeneous layers, each with its own absorption σa,
+//! scattering σs (mm⁻¹), Henyey–Greenstein anisotropy g and thickness (the last may be semi-infinite),
+//! one refractive index throughout the stack and smooth Fresnel interfaces to the media above and below,
+//! solved deterministically for azimuthally symmetric light:
+//!
+//! - angles: `quadrature_points` directions per hemisphere; Radau on [0, 1] for an index-matched stack,
+//!   otherwise Gauss on [0, μc] and Radau on [μc, 1], μc the critical cosine inside, so μ = 1 (the
+//!   normally incident beam) is a node and the Fresnel kink falls between the two rules;
+//! - phase function: HG redistribution by Legendre series with the δ-M truncation (M = quadrature points);
+//! - each layer: diamond initialisation of a layer thinner than the smallest μ, then doubling (to
+//!   convergence for a semi-infinite layer); layers and interfaces combined by the adding equations with
+//!   directional operators.
+//!
+//! The knob is `quadrature_points`; the δ-M truncation and the angular discretisation are its only
+//! approximations (measured: see the tests and BENCHMARKS.md `## Exact method`).
+//!
+//! Symbols: `sigma_a` σa (mm⁻¹), `sigma_s` σs (mm⁻¹, not reduced), `g` HG anisotropy, `albedo` a = σs/σt,
+//! `tau` optical thickness σt·d, `eta` refractive index of the stack, `mu` μ = cos θ inside the stack.
+
+mod layer;
+mod matrix;
+mod quadrature;
+
+use layer::{Angles, LayerBuild, Operator};
+use matrix::Mat;
+use skin_optics::{SkinParams, Wavelength, WavelengthGrid};
+use thiserror::Error;
+
+/// Default Henyey–Greenstein anisotropy for skin layers (σs = σs'/(1 − g)); the seed gives only σs'.
+pub const DEFAULT_G: f64 = 0.9;
+
+/// Default number of quadrature directions per hemisphere (measured error against 64: BENCHMARKS.md).
+pub const DEFAULT_QUADRATURE_POINTS: usize = 16;
+
+/// Largest supported number of quadrature directions per hemisphere.
+pub const MAX_QUADRATURE_POINTS: usize = 64;
+
+/// Invalid input to the adding-doubling solver, naming the parameter, its value and its valid range.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum AddingDoublingError {
+    /// A parameter outside its valid range (or not a number).
+    #[error("{name} = {value} outside {range}")]
+    OutOfRange {
+        /// Parameter name.
+        name: &'static str,
+        /// The offending value.
+        value: f64,
+        /// Valid range, as text.
+        range: &'static str,
+    },
+    /// A stack with no layers.
+    #[error("a layered slab needs at least one layer")]
+    NoLayers,
+    /// Only the last layer of a stack may be semi-infinite.
+    #[error("layer {index} is semi-infinite but is not the last layer")]
+    InfiniteLayerNotLast {
+        /// Index of the offending layer (0 = top).
+        index: usize,
+    },
+    /// A semi-infinite layer that does not absorb has no finite answer to converge to numerically.
+    #[error("a semi-infinite layer needs sigma_a > 0 (got {sigma_a_per_mm} mm⁻¹)")]
+    SemiInfiniteWithoutAbsorption {
+        /// Its absorption coefficient, mm⁻¹.
+        sigma_a_per_mm: f64,
+    },
+    /// The adding equations met a singular matrix (a lossless loop between two layers).
+    #[error("singular matrix while {0} (a non-absorbing layer against a totally reflecting one?)")]
+    Singular(&'static str),
+}
+
+fn check(
+    name: &'static str,
+    value: f64,
+    ok: bool,
+    range: &'static str,
+) -> Result<f64, AddingDoublingError> {
+    if ok && !value.is_nan() {
+        Ok(value)
+    } else {
+        Err(AddingDoublingError::OutOfRange { name, value, range })
+    }
+}
+
+/// Solver knobs.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AddingDoublingOptions {
+    quadrature_points: usize,
+    g: f64,
+}
+
+impl AddingDoublingOptions {
+    /// `quadrature_points`: directions per hemisphere, even, in [4, 64]; `g`: the HG anisotropy used
+    /// for skin layers by [`skin_totals`] (σs = σs'/(1 − g)), in [0, 0.99].
+    pub fn new(quadrature_points: usize, g: f64) -> Result<Self, AddingDoublingError> {
+        if !(4..=MAX_QUADRATURE_POINTS).contains(&quadrature_points)
+            || !quadrature_points.is_multiple_of(2)
+        {
+            return Err(AddingDoublingError::OutOfRange {
+                name: "quadrature_points",
+                value: quadrature_points as f64,
+                range: "even numbers in [4, 64]",
+            });
+        }
+        check("g", g, (0.0..=0.99).contains(&g), "[0, 0.99]")?;
+        Ok(Self {
+            quadrature_points,
+            g,
+        })
+    }
+
+    /// Quadrature directions per hemisphere.
+    #[must_use]
+    pub fn quadrature_points(&self) -> usize {
+        self.quadrature_points
+    }
+
+    /// HG anisotropy assumed for skin layers.
+    #[must_use]
+    pub fn g(&self) -> f64 {
+        self.g
+    }
+}
+
+impl Default for AddingDoublingOptions {
+    fn default() -> Self {
+        Self {
+            quadrature_points: DEFAULT_QUADRATURE_POINTS,
+            g: DEFAULT_G,
+        }
+    }
+}
+
+/// One homogeneous layer: σa, σs (mm⁻¹), HG g, thickness (mm, may be infinite).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SlabLayer {
+    sigma_a: f64,
+    sigma_s: f64,
+    g: f64,
+    thickness_mm: f64,
+}
+
+impl SlabLayer {
+    /// A layer of absorption `sigma_a_per_mm` ≥ 0, scattering `sigma_s_per_mm` ≥ 0 (not reduced),
+    /// anisotropy `g` in (−1, 1) and thickness `thickness_mm` ≥ 0 (`f64::INFINITY` for semi-infinite).
+    pub fn new(
+        sigma_a_per_mm: f64,
+        sigma_s_per_mm: f64,
+        g: f64,
+        thickness_mm: f64,
+    ) -> Result<Self, AddingDoublingError> {
+        check(
+            "sigma_a",
+            sigma_a_per_mm,
+            sigma_a_per_mm.is_finite() && sigma_a_per_mm >= 0.0,
+            "[0, ∞) mm⁻¹",
+        )?;
+        check(
+            "sigma_s",
+            sigma_s_per_mm,
+            sigma_s_per_mm.is_finite() && sigma_s_per_mm >= 0.0,
+            "[0, ∞) mm⁻¹",
+        )?;
+        check("g", g, g > -1.0 && g < 1.0, "(−1, 1)")?;
+        check(
+            "thickness_mm",
+            thickness_mm,
+            thickness_mm >= 0.0,
+            "[0, ∞] mm",
+        )?;
+        if thickness_mm.is_infinite() && sigma_a_per_mm <= 0.0 {
+            return Err(AddingDoublingError::SemiInfiniteWithoutAbsorption { sigma_a_per_mm });
+        }
+        Ok(Self {
+            sigma_a: sigma_a_per_mm,
+            sigma_s: sigma_s_per_mm,
+            g,
+            thickness_mm,
+        })
+    }
+
+    /// A semi-infinite layer (σa must be positive).
+    pub fn semi_infinite(
+        sigma_a_per_mm: f64,
+        sigma_s_per_mm: f64,
+        g: f64,
+    ) -> Result<Self, AddingDoublingError> {
+        Self::new(sigma_a_per_mm, sigma_s_per_mm, g, f64::INFINITY)
+    }
+
+    /// Absorption coefficient σa, mm⁻¹.
+    #[must_use]
+    pub fn sigma_a(&self) -> f64 {
+        self.sigma_a
+    }
+
+    /// Scattering coefficient σs, mm⁻¹.
+    #[must_use]
+    pub fn sigma_s(&self) -> f64 {
+        self.sigma_s
+    }
+
+    /// HG anisotropy g.
+    #[must_use]
+    pub fn g(&self) -> f64 {
+        self.g
+    }
+
+    /// Thickness, mm (infinite for a semi-infinite layer).
+    #[must_use]
+    pub fn thickness_mm(&self) -> f64 {
+        self.thickness_mm
+    }
+
+    /// Single-scattering albedo a = σs/(σa + σs) (0 for an empty layer).
+    #[must_use]
+    pub fn albedo(&self) -> f64 {
+        let st = self.sigma_a + self.sigma_s;
+        if st > 0.0 { self.sigma_s / st } else { 0.0 }
+    }
+
+    /// Optical thickness τ = (σa + σs) d (dimensionless; 0 for an empty layer of any thickness).
+    #[must_use]
+    pub fn optical_thickness(&self) -> f64 {
+        let st = self.sigma_a + self.sigma_s;
+        if st == 0.0 {
+            0.0
+        } else {
+            st * self.thickness_mm
+        }
+    }
+}
+
+/// Totals for a collimated beam at normal incidence, per incident photon.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SlabTotals {
+    /// Diffuse reflectance, specular reflection of the top surface excluded (the observable).
+    pub diffuse_reflectance: f64,
+    /// Specular reflection of the top surface, F_r(0).
+    pub specular_reflectance: f64,
+    /// Total transmittance out of the bottom (scattered and unscattered; 0 for a semi-infinite stack).
+    pub transmittance: f64,
+}
+
+impl SlabTotals {
+    /// Absorbed fraction, 1 − R_diffuse − R_specular − T.
+    #[must_use]
+    pub fn absorbed(&self) -> f64 {
+        1.0 - self.diffuse_reflectance - self.specular_reflectance - self.transmittance
+    }
+}
+
+/// A stack of layers (top first) of one refractive index between two outer media.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LayeredSlab {
+    layers: Vec<SlabLayer>,
+    eta: f64,
+    n_above: f64,
+    n_below: f64,
+}
+
+impl LayeredSlab {
+    /// `layers` top first (only the last may be semi-infinite); `eta` the refractive index of every layer;
+    /// `n_above`, `n_below` those of the outer media (each in [1, 3]).
+    ///
+    /// One index for the whole stack is what skin needs (1.4 throughout) and lets every layer share one
+    /// angular grid; internal index steps are not supported.
+    pub fn new(
+        layers: Vec<SlabLayer>,
+        eta: f64,
+        n_above: f64,
+        n_below: f64,
+    ) -> Result<Self, AddingDoublingError> {
+        if layers.is_empty() {
+            return Err(AddingDoublingError::NoLayers);
+        }
+        if let Some(index) = layers[..layers.len() - 1]
+            .iter()
+            .position(|l| l.thickness_mm.is_infinite())
+        {
+            return Err(AddingDoublingError::InfiniteLayerNotLast { index });
+        }
+        check("eta", eta, (1.0..=3.0).contains(&eta), "[1, 3]")?;
+        check("n_above", n_above, (1.0..=3.0).contains(&n_above), "[1, 3]")?;
+        check("n_below", n_below, (1.0..=3.0).contains(&n_below), "[1, 3]")?;
+        Ok(Self {
+            layers,
+            eta,
+            n_above,
+            n_below,
+        })
+    }
+
+    /// The layers, top first.
+    #[must_use]
+    pub fn layers(&self) -> &[SlabLayer] {
+        &self.layers
+    }
+
+    /// Whether the last layer is semi-infinite.
+    #[must_use]
+    pub fn is_semi_infinite(&self) -> bool {
+        self.layers
+            .last()
+            .is_some_and(|l| l.thickness_mm.is_infinite())
+    }
+
+    /// The angular grid inside the stack: split at the critical cosine of the top face if any.
+    fn angles(&self, quadrature_points: usize) -> Angles {
+        let mu_c = if self.n_above < self.eta {
+            (1.0 - (self.n_above / self.eta).powi(2)).sqrt()
+        } else {
+            0.0
+        };
+        let rule = quadrature::slab_rule(quadrature_points, mu_c);
+        Angles::new(rule.nodes, rule.weights)
+    }
+
+    /// Diffuse reflectance, specular reflectance and transmittance for a normally incident beam.
+    pub fn solve(
+        &self,
+        options: &AddingDoublingOptions,
+    ) -> Result<SlabTotals, AddingDoublingError> {
+        let angles = self.angles(options.quadrature_points);
+        let n = angles.n();
+        let normal = n - 1; // μ = 1 is the last node of every rule.
+        let top = layer::interface(&angles, self.eta, self.n_above);
+        let specular = top.r_down[(normal, normal)];
+
+        // Fold from the bottom up: a semi-infinite bottom needs reflection only.
+        let mut ops = Vec::with_capacity(self.layers.len());
+        for l in &self.layers {
+            ops.push(build_layer(&angles, l)?);
+        }
+        let diffuse;
+        let transmittance;
+        if self.is_semi_infinite() {
+            let mut below = ops.pop().map(|o| o.r_down).unwrap_or_else(|| Mat::zeros(n));
+            while let Some(op) = ops.pop() {
+                below = op
+                    .reflect_over(&below)
+                    .map_err(|_| AddingDoublingError::Singular("adding layers"))?;
+            }
+            diffuse = escape_through_top(&top, &below, normal)?;
+            transmittance = 0.0;
+        } else {
+            let mut acc = layer::interface(&angles, self.eta, self.n_below);
+            while let Some(op) = ops.pop() {
+                acc = op
+                    .add(&acc)
+                    .map_err(|_| AddingDoublingError::Singular("adding layers"))?;
+            }
+            let whole = top
+                .add(&acc)
+                .map_err(|_| AddingDoublingError::Singular("adding the top surface"))?;
+            diffuse = whole.r_down.column_sum(normal) - specular;
+            transmittance = whole.t_down.column_sum(normal);
+        }
+        let totals = SlabTotals {
+            diffuse_reflectance: diffuse,
+            specular_reflectance: specular,
+            transmittance,
+        };
+        debug_assert!(totals.diffuse_reflectance.is_finite() && totals.transmittance.is_finite());
+        Ok(totals)
+    }
+}
+
+/// Diffuse flux leaving through the top surface for a unit normally incident beam, given the reflection
+/// operator `below` of everything under the surface: T₁₀ (I − R_below R₁₀)⁻¹ R_below T₀₁ e_normal,
+/// computed for that one column only.
+fn escape_through_top(
+    top: &Operator,
+    below: &Mat,
+    normal: usize,
+) -> Result<f64, AddingDoublingError> {
+    let n = below.n();
+    let entering = top.t_down[(normal, normal)];
+    let source: Vec<f64> = below.column(normal).iter().map(|v| v * entering).collect();
+    let lhs = below.mul(&top.r_up).identity_minus();
+    let up = lhs
+        .solve_vec(&source)
+        .map_err(|_| AddingDoublingError::Singular("adding the top surface"))?;
+    Ok((0..n).map(|i| top.t_up[(i, i)] * up[i]).sum())
+}
+
+fn build_layer(angles: &Angles, l: &SlabLayer) -> Result<Operator, AddingDoublingError> {
+    let built = layer::homogeneous(angles, l.albedo(), l.optical_thickness(), l.g)
+        .map_err(|_| AddingDoublingError::Singular("doubling a layer"))?;
+    match built {
+        LayerBuild::Done(op) => {
+            debug_assert!(op.r_down.is_finite() && op.t_down.is_finite());
+            Ok(op)
+        }
+        LayerBuild::NotConverged => Err(AddingDoublingError::SemiInfiniteWithoutAbsorption {
+            sigma_a_per_mm: l.sigma_a,
+        }),
+    }
+}
+
+/// The [DJ06] skin at `lambda` as a stack: epidermis of the skin's thickness over a semi-infinite
+/// dermis, index `skin.eta()` throughout, air above; σs = σs'/(1 − g) with g = `options.g()`.
+pub fn skin_stack(
+    skin: &SkinParams,
+    lambda: Wavelength,
+    options: &AddingDoublingOptions,
+) -> Result<LayeredSlab, AddingDoublingError> {
+    let c = skin.coefficients(lambda);
+    let g = options.g;
+    let epidermis = SlabLayer::new(
+        c.epidermis.sigma_a,
+        c.epidermis.sigma_s_prime / (1.0 - g),
+        g,
+        skin.epidermis_thickness_mm(),
+    )?;
+    let dermis = SlabLayer::semi_infinite(c.dermis.sigma_a, c.dermis.sigma_s_prime / (1.0 - g), g)?;
+    LayeredSlab::new(vec![epidermis, dermis], skin.eta(), 1.0, 1.0)
+}
+
+/// Exact totals of the skin at one wavelength (normal incidence, per incident photon).
+pub fn skin_totals(
+    skin: &SkinParams,
+    lambda: Wavelength,
+    options: &AddingDoublingOptions,
+) -> Result<SlabTotals, AddingDoublingError> {
+    skin_stack(skin, lambda, options)?.solve(options)
+}
+
+/// Exact totals of the skin at every wavelength of `grid`, in order, on the calling thread.
+pub fn skin_totals_spectrum(
+    skin: &SkinParams,
+    grid: &WavelengthGrid,
+    options: &AddingDoublingOptions,
+) -> Result<Vec<SlabTotals>, AddingDoublingError> {
+    grid.iter()
+        .map(|lambda| skin_totals(skin, lambda, options))
+        .collect()
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,246 @@
+//! Small dense square matrices (n ≤ 64) for adding-doubling: product, sum, and a linear solve.
+//!
+//! Hand-written rather than a linear-algebra crate: the solver needs four operations on matrices of
+//! at most 64 × 64, and keeping them here keeps the hot loop visible and dependency-free.
+
+/// A dense square matrix of f64, row-major.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Mat {
+    n: usize,
+    data: Vec<f64>,
+}
+
+/// The matrix of a linear solve had a (numerically) zero pivot.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Singular;
+
+impl Mat {
+    /// The n × n zero matrix.
+    pub(crate) fn zeros(n: usize) -> Self {
+        Self {
+            n,
+            data: vec![0.0; n * n],
+        }
+    }
+
+    /// The n × n identity.
+    pub(crate) fn identity(n: usize) -> Self {
+        Self::diagonal(&vec![1.0; n])
+    }
+
+    /// The diagonal matrix with `d` on its diagonal.
+    pub(crate) fn diagonal(d: &[f64]) -> Self {
+        let mut m = Self::zeros(d.len());
+        for (i, &v) in d.iter().enumerate() {
+            m[(i, i)] = v;
+        }
+        m
+    }
+
+    /// Build from a function of (row, column).
+    pub(crate) fn from_fn(n: usize, f: impl Fn(usize, usize) -> f64) -> Self {
+        let mut m = Self::zeros(n);
+        for i in 0..n {
+            for j in 0..n {
+                m[(i, j)] = f(i, j);
+            }
+        }
+        m
+    }
+
+    /// Order of the matrix.
+    pub(crate) fn n(&self) -> usize {
+        self.n
+    }
+
+    /// Matrix product self · rhs.
+    pub(crate) fn mul(&self, rhs: &Mat) -> Mat {
+        debug_assert_eq!(self.n, rhs.n);
+        let n = self.n;
+        let mut out = Mat::zeros(n);
+        // i-k-j order: the inner loop runs over contiguous rows of rhs and out, so it vectorises.
+        for i in 0..n {
+            let out_row = &mut out.data[i * n..(i + 1) * n];
+            for k in 0..n {
+                let a = self.data[i * n + k];
+                if a == 0.0 {
+                    continue;
+                }
+                let rhs_row = &rhs.data[k * n..(k + 1) * n];
+                for (o, &b) in out_row.iter_mut().zip(rhs_row) {
+                    *o += a * b;
+                }
+            }
+        }
+        out
+    }
+
+    /// Matrix-vector product self · v.
+    #[cfg(test)]
+    pub(crate) fn mul_vec(&self, v: &[f64]) -> Vec<f64> {
+        let n = self.n;
+        (0..n)
+            .map(|i| {
+                self.data[i * n..(i + 1) * n]
+                    .iter()
+                    .zip(v)
+                    .map(|(a, b)| a * b)
+                    .sum()
+            })
+            .collect()
+    }
+
+    /// Sum self + rhs.
+    pub(crate) fn add(&self, rhs: &Mat) -> Mat {
+        let mut out = self.clone();
+        for (o, r) in out.data.iter_mut().zip(&rhs.data) {
+            *o += r;
+        }
+        out
+    }
+
+    /// I − self.
+    pub(crate) fn identity_minus(&self) -> Mat {
+        let mut out = self.clone();
+        for v in &mut out.data {
+            *v = -*v;
+        }
+        for i in 0..self.n {
+            out[(i, i)] += 1.0;
+        }
+        out
+    }
+
+    /// Scale row i by `left[i]` and column j by `right[j]`: diag(left) · self · diag(right).
+    pub(crate) fn scale_rows_cols(&self, left: &[f64], right: &[f64]) -> Mat {
+        let n = self.n;
+        Mat::from_fn(n, |i, j| left[i] * self[(i, j)] * right[j])
+    }
+
+    /// Sum of column j.
+    pub(crate) fn column_sum(&self, j: usize) -> f64 {
+        (0..self.n).map(|i| self[(i, j)]).sum()
+    }
+
+    /// Column j as a vector.
+    pub(crate) fn column(&self, j: usize) -> Vec<f64> {
+        (0..self.n).map(|i| self[(i, j)]).collect()
+    }
+
+    /// Largest absolute entry.
+    pub(crate) fn max_abs(&self) -> f64 {
+        self.data.iter().fold(0.0, |m, v| m.max(v.abs()))
+    }
+
+    /// Whether every entry is finite.
+    pub(crate) fn is_finite(&self) -> bool {
+        self.data.iter().all(|v| v.is_finite())
+    }
+
+    /// Solve self · X = rhs for X (Gaussian elimination with partial pivoting).
+    pub(crate) fn solve(&self, rhs: &Mat) -> Result<Mat, Singular> {
+        let n = self.n;
+        let mut x = rhs.clone();
+        self.solve_in_place(n, &mut x.data)?;
+        Ok(x)
+    }
+
+    /// Solve self · x = rhs for a vector x.
+    pub(crate) fn solve_vec(&self, rhs: &[f64]) -> Result<Vec<f64>, Singular> {
+        let mut x = rhs.to_vec();
+        self.solve_in_place(1, &mut x)?;
+        Ok(x)
+    }
+
+    /// Overwrite `b` (n rows of `cols` entries, row-major) with self⁻¹ b.
+    fn solve_in_place(&self, cols: usize, b: &mut [f64]) -> Result<(), Singular> {
+        let n = self.n;
+        let mut a = self.data.clone();
+        let scale = self.max_abs().max(f64::MIN_POSITIVE);
+        for k in 0..n {
+            let (p, pivot_abs) = (k..n)
+                .map(|i| (i, a[i * n + k].abs()))
+                .fold((k, -1.0), |best, c| if c.1 > best.1 { c } else { best });
+            if pivot_abs.is_nan() || pivot_abs <= 1e-14 * scale {
+                return Err(Singular);
+            }
+            if p != k {
+                for j in 0..n {
+                    a.swap(k * n + j, p * n + j);
+                }
+                for j in 0..cols {
+                    b.swap(k * cols + j, p * cols + j);
+                }
+            }
+            let inv = 1.0 / a[k * n + k];
+            for i in k + 1..n {
+                let f = a[i * n + k] * inv;
+                if f == 0.0 {
+                    continue;
+                }
+                for j in k + 1..n {
+                    a[i * n + j] -= f * a[k * n + j];
+                }
+                for j in 0..cols {
+                    b[i * cols + j] -= f * b[k * cols + j];
+                }
+            }
+        }
+        for k in (0..n).rev() {
+            let inv = 1.0 / a[k * n + k];
+            for j in 0..cols {
+                let mut s = b[k * cols + j];
+                for m in k + 1..n {
+                    s -= a[k * n + m] * b[m * cols + j];
+                }
+                b[k * cols + j] = s * inv;
+            }
+        }
+        Ok(())
+    }
+}
+
+impl std::ops::Index<(usize, usize)> for Mat {
+    type Output = f64;
+    fn index(&self, (i, j): (usize, usize)) -> &f64 {
+        &self.data[i * self.n + j]
+    }
+}
+
+impl std::ops::IndexMut<(usize, usize)> for Mat {
+    fn index_mut(&mut self, (i, j): (usize, usize)) -> &mut f64 {
+        &mut self.data[i * self.n + j]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn solve_inverts_a_product() {
+        let a = Mat::from_fn(5, |i, j| {
+            1.0 / (1.0 + i as f64 + j as f64) + if i == j { 2.0 } else { 0.0 }
+        });
+        let x = Mat::from_fn(5, |i, j| (i as f64 - 2.0 * j as f64).sin());
+        let b = a.mul(&x);
+        let x2 = a.solve(&b).expect("well conditioned");
+        for i in 0..5 {
+            for j in 0..5 {
+                assert!((x[(i, j)] - x2[(i, j)]).abs() < 1e-12);
+            }
+        }
+        let v = x.column(1);
+        let bv = a.mul_vec(&v);
+        let v2 = a.solve_vec(&bv).expect("well conditioned");
+        for (p, q) in v.iter().zip(&v2) {
+            assert!((p - q).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn singular_is_reported() {
+        let a = Mat::from_fn(3, |i, _| i as f64);
+        assert_eq!(a.solve(&Mat::identity(3)), Err(Singular));
+    }
+}
