@@ -134,9 +134,13 @@ pub(crate) fn lookup(table: &[f32], cos_theta: f32) -> f32 {
     } else {
         2.0 * p2 - p1
     };
-    p1 + 0.5
-        * t
-        * (p2 - p0 + t * (2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3 + t * (3.0 * (p1 - p2) + p3 - p0)))
+    let value = p1
+        + 0.5
+            * t
+            * (p2 - p0
+                + t * (2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3 + t * (3.0 * (p1 - p2) + p3 - p0)));
+    // The cubic may overshoot by rounding where the albedo is ~0 (η = 1) or ~1: keep it physical.
+    value.clamp(0.0, 1.0)
 }
 
 #[cfg(test)]

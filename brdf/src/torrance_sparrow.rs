@@ -103,7 +103,8 @@ impl TorranceSparrow {
     /// horizon. Wavelength independent. Symmetric in its arguments.
     ///
     /// The lobe is unbounded in the grazing mirror configuration (f ∝ 1/cos²θ); values beyond
-    /// `f32::MAX` saturate there instead of becoming infinite.
+    /// `f32::MAX` saturate there instead of becoming infinite, and when 4 cosθo cosθi underflows f32
+    /// (both directions within ~1e-19 of the horizon) the result is 0. Never NaN or infinite.
     #[must_use]
     pub fn eval(&self, wo: Vec3, wi: Vec3) -> f32 {
         let (cos_o, cos_i) = (wo.z, wi.z);
@@ -118,8 +119,12 @@ impl TorranceSparrow {
         let d = beckmann::distribution(h, self.roughness_m);
         let g = v_cavity::g(h.z, cos_o, cos_i, o_h);
         let f = dielectric_reflectance(f64::from(o_h), f64::from(self.eta)) as f32;
-        let value = self.oiliness_rho_s * d * g * f / (4.0 * cos_o * cos_i);
-        value.min(f32::MAX)
+        let denominator = 4.0 * cos_o * cos_i;
+        if denominator < f32::MIN_POSITIVE {
+            // Both directions within ~1e-19 of the horizon: a measure-zero set where 0/0 could arise.
+            return 0.0;
+        }
+        (self.oiliness_rho_s * d * g * f / denominator).min(f32::MAX)
     }
 
     /// Density in sr⁻¹ with which [`Self::sample`] returns ωi for outgoing ωo: D(h) cosθh / (4 ωo·h)
