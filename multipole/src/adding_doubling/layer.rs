@@ -187,10 +187,11 @@ fn double(r: &Mat, t: &Mat) -> Result<(Mat, Mat), Singular> {
     Ok((r2, t2))
 }
 
-/// Stop doubling a semi-infinite layer once transmission is this small (flux fraction) …
-const SEMI_INFINITE_T: f64 = 1e-7;
+/// Stop doubling a semi-infinite layer once transmission is this small (flux fraction) … (what is
+/// still missing from R is of order T², here ≤ 1e-10)
+const SEMI_INFINITE_T: f64 = 1e-5;
 /// … and reflection changed by less than this in the last doubling.
-const SEMI_INFINITE_DR: f64 = 1e-13;
+const SEMI_INFINITE_DR: f64 = 1e-11;
 /// Enough doublings for any absorbing layer (2^200 starting thicknesses).
 const MAX_DOUBLINGS: usize = 200;
 

@@ -165,39 +165,53 @@ impl Mat {
                 return Err(Singular);
             }
             if p != k {
-                for j in 0..n {
-                    a.swap(k * n + j, p * n + j);
-                }
-                for j in 0..cols {
-                    b.swap(k * cols + j, p * cols + j);
-                }
+                swap_rows(&mut a, n, k, p);
+                swap_rows(b, cols, k, p);
             }
             let inv = 1.0 / a[k * n + k];
-            for i in k + 1..n {
-                let f = a[i * n + k] * inv;
+            // Row slices let the eliminations below vectorise (no aliasing, no bounds checks).
+            let (a_top, a_rest) = a.split_at_mut((k + 1) * n);
+            let a_k = &a_top[k * n + k + 1..(k + 1) * n];
+            let (b_top, b_rest) = b.split_at_mut((k + 1) * cols);
+            let b_k = &b_top[k * cols..];
+            for (a_i, b_i) in a_rest
+                .chunks_exact_mut(n)
+                .zip(b_rest.chunks_exact_mut(cols))
+            {
+                let f = a_i[k] * inv;
                 if f == 0.0 {
                     continue;
                 }
-                for j in k + 1..n {
-                    a[i * n + j] -= f * a[k * n + j];
-                }
-                for j in 0..cols {
-                    b[i * cols + j] -= f * b[k * cols + j];
-                }
+                axpy(&mut a_i[k + 1..], -f, a_k);
+                axpy(b_i, -f, b_k);
             }
         }
         for k in (0..n).rev() {
             let inv = 1.0 / a[k * n + k];
-            for j in 0..cols {
-                let mut s = b[k * cols + j];
-                for m in k + 1..n {
-                    s -= a[k * n + m] * b[m * cols + j];
-                }
-                b[k * cols + j] = s * inv;
+            let (b_top, b_rest) = b.split_at_mut((k + 1) * cols);
+            let b_k = &mut b_top[k * cols..];
+            for (m, b_m) in (k + 1..n).zip(b_rest.chunks_exact(cols)) {
+                axpy(b_k, -a[k * n + m], b_m);
+            }
+            for v in b_k.iter_mut() {
+                *v *= inv;
             }
         }
         Ok(())
     }
+}
+
+/// y ← y + α x.
+fn axpy(y: &mut [f64], alpha: f64, x: &[f64]) {
+    for (y, x) in y.iter_mut().zip(x) {
+        *y += alpha * x;
+    }
+}
+
+fn swap_rows(m: &mut [f64], cols: usize, i: usize, j: usize) {
+    let (lo, hi) = (i.min(j), i.max(j));
+    let (top, bottom) = m.split_at_mut(hi * cols);
+    top[lo * cols..(lo + 1) * cols].swap_with_slice(&mut bottom[..cols]);
 }
 
 impl std::ops::Index<(usize, usize)> for Mat {
