@@ -5,9 +5,12 @@ use crate::boundary::observable_reflectance;
 use crate::dipole::Dipole;
 use crate::error::MultipoleError;
 use crate::medium::Medium;
+use crate::profile::Profile;
 use crate::slab::{Poles, Slab};
+use crate::spatial::{ProfileOptions, reference_reflectance, stack_profile};
 use crate::stack::{Layer, Stack};
-use skin_optics::{SkinParams, Wavelength};
+use rayon::prelude::*;
+use skin_optics::{SkinParams, Wavelength, WavelengthGrid};
 use std::fmt;
 use std::str::FromStr;
 
@@ -76,10 +79,115 @@ pub fn diffuse_reflectance(
     ))
 }
 
+/// The radial profile R(r) of `skin` at `lambda` (per unit flux entering; mm⁻²) with the knobs `opts`.
+pub fn profile(
+    skin: &SkinParams,
+    lambda: Wavelength,
+    method: Method,
+    opts: &ProfileOptions,
+) -> Result<Profile, MultipoleError> {
+    match method {
+        Method::Multipole => stack_profile(&stack(skin, lambda)?, opts),
+    }
+}
+
+/// One profile per wavelength of a grid, computed in parallel (rayon) across wavelengths.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SpectralProfiles {
+    grid: WavelengthGrid,
+    profiles: Vec<Profile>,
+}
+
+impl SpectralProfiles {
+    /// Profiles of `skin` at every wavelength of `grid`.
+    pub fn new(
+        skin: &SkinParams,
+        grid: &WavelengthGrid,
+        method: Method,
+        opts: &ProfileOptions,
+    ) -> Result<Self, MultipoleError> {
+        opts.validate()?;
+        let lambdas: Vec<Wavelength> = grid.iter().collect();
+        let profiles = lambdas
+            .par_iter()
+            .map(|&l| profile(skin, l, method, opts))
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(Self {
+            grid: grid.clone(),
+            profiles,
+        })
+    }
+
+    /// The wavelength grid.
+    #[must_use]
+    pub fn grid(&self) -> &WavelengthGrid {
+        &self.grid
+    }
+
+    /// The profiles, one per grid wavelength in order.
+    #[must_use]
+    pub fn profiles(&self) -> &[Profile] {
+        &self.profiles
+    }
+
+    /// The profile at grid index `i` (panics if `i` ≥ grid length, like slice indexing).
+    #[must_use]
+    pub fn profile(&self, i: usize) -> &Profile {
+        &self.profiles[i]
+    }
+}
+
+/// Error of one knob setting against the converged reference, for the time-versus-error chart.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct KnobError {
+    /// max over r of |2πr² (R − R_ref)| / R_tot,ref: the error of the energy per ln r, relative to the
+    /// total (scale free; evaluated with `Profile::eval` at 400 log-spaced radii in [1e-3, r_max]).
+    pub max_energy_density_error: f64,
+    /// |R_tot − R_tot,ref| / R_tot,ref (poles only: the total comes from q = 0).
+    pub total_relative_error: f64,
+    /// |r₉₉ − r₉₉,ref| / r₉₉,ref.
+    pub r99_relative_error: f64,
+}
+
+/// Measure the error of `opts` for `skin` at `lambda` against a converged reference
+/// (`Poles::Exact`, direct quadrature with `libm::j0`, see `spatial::reference_reflectance`).
+pub fn profile_error(
+    skin: &SkinParams,
+    lambda: Wavelength,
+    method: Method,
+    opts: &ProfileOptions,
+) -> Result<KnobError, MultipoleError> {
+    let Method::Multipole = method;
+    let st = stack(skin, lambda)?;
+    let test = stack_profile(&st, opts)?;
+    let reference = stack_profile(&st, &ProfileOptions::reference())?;
+    let r_hi = test.r_max_mm().min(reference.r_max_mm());
+    let n = 400;
+    let radii: Vec<f64> = (0..n)
+        .map(|i| {
+            crate::spatial::R_MIN_MM
+                * (r_hi / crate::spatial::R_MIN_MM).powf(i as f64 / (n - 1) as f64)
+        })
+        .collect();
+    let exact = reference_reflectance(&st, Poles::Exact, &radii);
+    let total_ref = reference.total();
+    let max_err = radii
+        .iter()
+        .zip(&exact)
+        .map(|(&r, &e)| 2.0 * std::f64::consts::PI * r * r * (test.eval(r) - e).abs() / total_ref)
+        .fold(0.0, f64::max);
+    Ok(KnobError {
+        max_energy_density_error: max_err,
+        total_relative_error: (test.total() - total_ref).abs() / total_ref,
+        r99_relative_error: (test.radius_99_mm() - reference.radius_99_mm()).abs()
+            / reference.radius_99_mm(),
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use skin_optics::Preset;
+    use skin_optics::{Preset, WavelengthGrid};
 
     #[test]
     fn method_parses_and_prints() {
@@ -107,5 +215,68 @@ mod tests {
                 last = r;
             }
         }
+    }
+
+    #[test]
+    fn every_preset_profile_is_finite_non_negative_and_holds_its_energy() {
+        let opts = ProfileOptions::default();
+        for p in [Preset::Light, Preset::Medium, Preset::Dark] {
+            let skin = SkinParams::preset(p);
+            let set =
+                SpectralProfiles::new(&skin, &WavelengthGrid::visible(), Method::Multipole, &opts)
+                    .unwrap();
+            assert_eq!(set.profiles().len(), 31);
+            for (i, prof) in set.profiles().iter().enumerate() {
+                assert!(
+                    prof.reflectance_per_mm2()
+                        .iter()
+                        .all(|v| v.is_finite() && *v >= 0.0)
+                );
+                assert_eq!(
+                    prof.clamped_samples(),
+                    0,
+                    "{p:?} at {} nm",
+                    set.grid().nm(i)
+                );
+                assert!(prof.total() > 0.0 && prof.total() < 1.0);
+                let held = prof.table_integral() / prof.total();
+                assert!(
+                    (held - 0.999).abs() < 1e-3,
+                    "{p:?} {} nm holds {held}",
+                    set.grid().nm(i)
+                );
+                assert!(prof.radius_99_mm() < prof.r_max_mm());
+            }
+        }
+    }
+
+    #[test]
+    fn knob_error_shrinks_with_resolution() {
+        let skin = SkinParams::preset(Preset::Light);
+        let lambda = Wavelength::new(650.0).unwrap();
+        let coarse = ProfileOptions {
+            radial_samples: 32,
+            transform_nodes: 2,
+            transform_radii: 12,
+            ..Default::default()
+        };
+        let e_coarse = profile_error(&skin, lambda, Method::Multipole, &coarse).unwrap();
+        let e_default =
+            profile_error(&skin, lambda, Method::Multipole, &ProfileOptions::default()).unwrap();
+        assert!(e_default.max_energy_density_error < 1e-3, "{e_default:?}");
+        assert!(
+            e_coarse.max_energy_density_error > 3.0 * e_default.max_energy_density_error,
+            "{e_coarse:?}"
+        );
+        let few = ProfileOptions {
+            poles: Poles::Count(0),
+            ..Default::default()
+        };
+        assert!(
+            profile_error(&skin, lambda, Method::Multipole, &few)
+                .unwrap()
+                .total_relative_error
+                > 1e-4
+        );
     }
 }

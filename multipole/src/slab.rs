@@ -9,17 +9,25 @@
 //! # Thin slabs
 //! The multipole puts its real source at z0 = ℓ = 1/σt'. When d < ℓ that source lies outside the slab
 //! and R or T turn negative (physics.md §4). This crate's documented behaviour:
-//! * the real source is clamped into the slab, z0 = min(ℓ, d) (on the far face it transmits half its
-//!   light as a delta at r = 0, the limit of the pole kernel as its depth reaches the face);
-//! * the diffuse response is blended with an unscattered pass-through: a fraction
-//!   w = min(1, σs' d) (the reduced scattering optical depth, ≈ the probability to scatter at all)
-//!   is diffused, the rest is transmitted as a delta at r = 0 attenuated by e^(−σa d), with no reflection.
+//! * a fraction w = min(1, σs' d) (the reduced scattering optical depth, ≈ the probability to scatter
+//!   at all) is diffused; the rest is transmitted as a delta at r = 0 attenuated by e^(−σa d), with no
+//!   reflection;
+//! * the diffused part keeps its real source strictly inside the slab: z0 = ℓ w² (≤ w d α' < d). The
+//!   square makes z0 continuous with the plain multipole's ℓ at w = 1 while it shrinks with d.
+//!   (A source *on* the far face, z0 = min(ℓ, d), was tried first: it transmits half its light as a
+//!   delta but makes the diffuse T(r) negative when lit from the matched side.)
 //!
 //! Slabs with σs' d ≥ 1 (which implies d ≥ ℓ) are untouched, so the published check values hold and the
-//! skin's epidermis (σs' d ≥ 1.1 over 400–700 nm) is modelled by the plain multipole. With the clamp,
-//! every image of the real source lies inside the extrapolated slab, so R and T are non-negative, and
+//! skin's epidermis (σs' d ≥ 1.1 over 400–700 nm) is modelled by the plain multipole. With the source
+//! inside, R(r) and T(r) are non-negative (tested from 0.05 to 1 mean free paths), and
 //! for σa = 0 the blend conserves energy exactly (R̂(0) + T̂(0) = 1); a zero-thickness slab is the
-//! identity (R = 0, T = δ). Public code blends toward a transmitted delta below two mean free paths;
+//! identity (R = 0, T = δ).
+//!
+//! A limit shared by every multipole, thin or not: when the top extrapolation distance exceeds
+//! d + z_bd, the slab's own R(r) has a small negative lobe far from the source (the lowest diffusion
+//! mode peaks above the lit face). The bare epidermis at 700 nm is such a slab. Stacked over a dermis
+//! the sum stays positive; `Profile` never carries a negative value (clamped to 0 and counted).
+//! Public code blends toward a transmitted delta below two mean free paths;
 //! this crate blends only where the multipole itself is not valid.
 
 use crate::boundary::a_coefficient;
@@ -113,6 +121,7 @@ impl Slab {
         let z_b0 = medium.extrapolation_mm(a_top);
         let z_bd = medium.extrapolation_mm(a_bottom);
         let d = thickness_mm;
+        let weight = (medium.sigma_s_prime() * d).min(1.0);
         Ok(Self {
             medium,
             thickness_mm: d,
@@ -121,8 +130,8 @@ impl Slab {
             z_b0,
             z_bd,
             period: 2.0 * (d + z_b0 + z_bd),
-            z0: medium.mean_free_path_mm().min(d),
-            weight: (medium.sigma_s_prime() * d).min(1.0),
+            z0: medium.mean_free_path_mm() * weight * weight,
+            weight,
         })
     }
 
@@ -157,7 +166,7 @@ impl Slab {
         (self.a_top, self.a_bottom)
     }
 
-    /// Depth of the real source z0 = min(ℓ, d), mm (clamped into the slab; see the module doc).
+    /// Depth of the real source z0 = ℓ w², mm (= ℓ unless the slab is thin; see the module doc).
     #[must_use]
     pub fn source_depth_mm(&self) -> f64 {
         self.z0
@@ -180,7 +189,7 @@ impl Slab {
     }
 
     /// Weight of the delta at r = 0 in the transmittance, dimensionless: the unscattered pass-through
-    /// (1 − w) e^(−σa d), plus w α'/2 when the real source sits on the far face (d < ℓ).
+    /// (1 − w) e^(−σa d), plus w α'/2 in the edge case of a source on the far face (σa = 0, σs' d = 1).
     #[must_use]
     pub fn transmitted_delta(&self) -> f64 {
         let on_face = if self.z0 >= self.thickness_mm {
@@ -292,6 +301,44 @@ impl Slab {
                 (half * r, half * t + pass)
             }
         }
+    }
+
+    /// Both directions at once, (R̂↓, T̂↓, R̂↑, T̂↑) at `q` (rad/mm), plus the head transform
+    /// ([`Slab::head_transform`]): the hot path of `stack`. With `Poles::Exact` every term is a product
+    /// of five exponentials e^(−x s), x ∈ {z0, 2z_b0, 2z_bd, d, d − z0}, shared by both directions.
+    #[must_use]
+    pub fn transform_both(&self, q: f64, poles: Poles) -> ([f64; 4], f64) {
+        let st = self.medium.sigma_tr();
+        let s = (st * st + q * q).sqrt();
+        if poles != Poles::Exact || self.period * s < 1.0 {
+            // Few poles, or small L s where 1 − e^(−Ls) would cancel: the general path.
+            let (rd, td) = self.transform(q, poles);
+            let (ru, tu) = self.flipped().transform(q, poles);
+            return ([rd, td, ru, tu], self.head_transform(q));
+        }
+        let d = self.thickness_mm;
+        let a = (-self.z0 * s).exp();
+        let b = (-2.0 * self.z_b0 * s).exp();
+        let c = (-2.0 * self.z_bd * s).exp();
+        let e = (-d * s).exp();
+        let g = (-(d - self.z0) * s).exp();
+        let el = e * e * b * c;
+        let inv = 1.0 / (1.0 - el);
+        let half = 0.5 * self.prefactor();
+        let pass = (1.0 - self.weight) * (-self.medium.sigma_a() * d).exp();
+        // One direction with extrapolation factors (b, c) = (top, bottom); see `transform` for the terms.
+        let dir = |b: f64, c: f64| -> (f64, f64) {
+            let series_x1 = (g * e * b * c - el * a) * inv;
+            let series_x2 = (g * e * c - el * a * b) * inv;
+            let r = a + a * b - series_x1 - series_x2;
+            let series_y1 = (e * a * b * c - el * g) * inv;
+            let series_y2 = (g * c - el * e * a * b) * inv;
+            let t = g - e * a * b - series_y1 + series_y2;
+            (half * r, half * t + pass)
+        };
+        let (rd, td) = dir(b, c);
+        let (ru, tu) = dir(c, b);
+        ([rd, td, ru, tu], half * (a + a * b))
     }
 
     /// Total reflectance R̂(0), dimensionless.

@@ -84,6 +84,37 @@ impl Layer {
         }
     }
 
+    /// Response and head transform at `q` together (shares the exponentials of a slab).
+    #[must_use]
+    pub fn response_and_head(&self, q: f64, poles: Poles) -> (Response, f64) {
+        match self {
+            Layer::Slab(s) => {
+                let ([r_down, t_down, r_up, t_up], head) = s.transform_both(q, poles);
+                (
+                    Response {
+                        r_down,
+                        t_down,
+                        r_up,
+                        t_up,
+                    },
+                    head,
+                )
+            }
+            Layer::SemiInfinite(d) => {
+                let r = d.transform(q);
+                (
+                    Response {
+                        r_down: r,
+                        t_down: 0.0,
+                        r_up: r,
+                        t_up: 0.0,
+                    },
+                    r,
+                )
+            }
+        }
+    }
+
     /// The slowest-decaying part of R̂↓ (the first source pair), whose inverse transform is closed form:
     /// (value at q, value in space at r) are [`Layer::head_transform`] and [`Layer::head_reflectance_mm2`].
     #[must_use]
@@ -158,6 +189,17 @@ impl Stack {
         self.layers
             .iter()
             .fold(Response::IDENTITY, |acc, l| acc.over(&l.response(q, poles)))
+    }
+
+    /// R̂↓(q) − head̂(q): the stack's reflectance spectrum without the top layer's first source pair,
+    /// the part `spatial` inverts numerically. Dimensionless.
+    #[must_use]
+    pub fn remainder_transform(&self, q: f64, poles: Poles) -> f64 {
+        let (first, head) = self.layers[0].response_and_head(q, poles);
+        let r = self.layers[1..]
+            .iter()
+            .fold(first, |acc, l| acc.over(&l.response(q, poles)));
+        r.r_down - head
     }
 
     /// R̂↓(q) of the stack, dimensionless.
@@ -249,5 +291,49 @@ mod tests {
     fn rejects_semi_infinite_above() {
         assert!(Stack::new(vec![dermis_like(0.1), epidermis_like(0.1, 0.1)]).is_err());
         assert!(Stack::new(vec![]).is_err());
+    }
+
+    mod properties {
+        use super::*;
+        use proptest::prelude::*;
+
+        /// A two-layer skin-like stack: slab σa in [0, 50], σs' in [0.5, 30] mm⁻¹, d in [0, 2] mm, η_top
+        /// in [1, 1.6], over a dipole with σa in [0, 20], σs' in [0.5, 30] mm⁻¹.
+        fn parts() -> impl Strategy<Value = (f64, f64, f64, f64, f64, f64)> {
+            (
+                0.0..50.0f64,
+                0.5..30.0f64,
+                0.0..2.0f64,
+                1.0..1.6f64,
+                0.0..20.0f64,
+                0.5..30.0f64,
+            )
+        }
+
+        fn build(sa1: f64, ss1: f64, d: f64, eta: f64, sa2: f64, ss2: f64) -> Stack {
+            let top = Slab::new(Medium::new(sa1, ss1).unwrap(), d, eta, 1.0).unwrap();
+            let bottom = Dipole::with_a(Medium::new(sa2, ss2).unwrap(), 1.0);
+            Stack::new(vec![Layer::Slab(top), Layer::SemiInfinite(bottom)]).unwrap()
+        }
+
+        proptest! {
+            #![proptest_config(ProptestConfig::with_cases(300))]
+            #[test]
+            fn stack_total_reflectance_in_unit_interval((sa1, ss1, d, eta, sa2, ss2) in parts()) {
+                let r = build(sa1, ss1, d, eta, sa2, ss2).total_reflectance(Poles::Exact);
+                prop_assert!(r.is_finite() && r >= 0.0 && r <= 1.0, "R = {}", r);
+            }
+
+            #[test]
+            fn total_reflectance_falls_as_either_absorption_rises(
+                (sa1, ss1, d, eta, sa2, ss2) in parts(), bump in 0.01..5.0f64
+            ) {
+                let r = build(sa1, ss1, d, eta, sa2, ss2).total_reflectance(Poles::Exact);
+                let r_top = build(sa1 + bump, ss1, d, eta, sa2, ss2).total_reflectance(Poles::Exact);
+                let r_bottom = build(sa1, ss1, d, eta, sa2 + bump, ss2).total_reflectance(Poles::Exact);
+                prop_assert!(r_top <= r + 1e-12, "top σa {} → {}: {} → {}", sa1, sa1 + bump, r, r_top);
+                prop_assert!(r_bottom <= r + 1e-12, "bottom σa {} → {}: {} → {}", sa2, sa2 + bump, r, r_bottom);
+            }
+        }
     }
 }
