@@ -29,9 +29,12 @@ pub enum MultipoleError {
     /// A layer stack that cannot be combined (empty, or a semi-infinite layer above another layer).
     #[error("invalid layer stack: {0}")]
     Stack(&'static str),
-    /// An unknown method name (valid: `multipole`).
-    #[error("unknown method '{0}' (valid: multipole)")]
+    /// An unknown method name (valid: `exact`, `multipole`).
+    #[error("unknown method '{0}' (valid: exact, multipole)")]
     UnknownMethod(String),
+    /// Invalid input to the exact (adding-doubling) transport solver.
+    #[error(transparent)]
+    Exact(#[from] crate::adding_doubling::AddingDoublingError),
     /// A profile table that is not finite and non-negative, or whose radii do not increase.
     #[error("invalid profile table: {0}")]
     Profile(&'static str),

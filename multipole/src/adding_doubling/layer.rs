@@ -188,10 +188,10 @@ fn double(r: &Mat, t: &Mat) -> Result<(Mat, Mat), Singular> {
 }
 
 /// Stop doubling a semi-infinite layer once transmission is this small (flux fraction) … (what is
-/// still missing from R is of order T², here ≤ 1e-10)
-const SEMI_INFINITE_T: f64 = 1e-5;
+/// still missing from R is of order T² R/(1 − R²), here ≲ 1e-7)
+const SEMI_INFINITE_T: f64 = 1e-4;
 /// … and reflection changed by less than this in the last doubling.
-const SEMI_INFINITE_DR: f64 = 1e-11;
+const SEMI_INFINITE_DR: f64 = 1e-8;
 /// Enough doublings for any absorbing layer (2^200 starting thicknesses).
 const MAX_DOUBLINGS: usize = 200;
 
