@@ -104,8 +104,16 @@ pub fn profile(
             // Diffusion's shape, exact energy: the simplest robust choice (issue [exact] lists better ones).
             let shape = stack_profile(&stack(skin, lambda)?, opts)?;
             let total = total_reflectance(skin, lambda, Method::Exact)?;
-            let scale = if shape.total() > 0.0 { total / shape.total() } else { 0.0 };
-            let values = shape.reflectance_per_mm2().iter().map(|v| v * scale).collect();
+            let scale = if shape.total() > 0.0 {
+                total / shape.total()
+            } else {
+                0.0
+            };
+            let values = shape
+                .reflectance_per_mm2()
+                .iter()
+                .map(|v| v * scale)
+                .collect();
             Profile::from_table(shape.radii_mm().to_vec(), values, total)
         }
         Method::Multipole => stack_profile(&stack(skin, lambda)?, opts),
@@ -221,7 +229,13 @@ mod tests {
         let total = total_reflectance(&light, lambda, Method::Exact).unwrap();
         let p = profile(&light, lambda, Method::Exact, &ProfileOptions::default()).unwrap();
         assert!((p.total() - total).abs() < 1e-12);
-        let m = profile(&light, lambda, Method::Multipole, &ProfileOptions::default()).unwrap();
+        let m = profile(
+            &light,
+            lambda,
+            Method::Multipole,
+            &ProfileOptions::default(),
+        )
+        .unwrap();
         let ratio = p.eval(0.5) / m.eval(0.5);
         assert!((ratio - total / m.total()).abs() < 1e-9, "same shape");
         // Diffusion overestimates dark skin: the exact total is far below it.
