@@ -22,13 +22,13 @@ const MAX_EXPONENT: f32 = 100.0;
 #[must_use]
 pub fn distribution(h: Vec3, m: f32) -> f32 {
     let cos2 = h.z * h.z;
-    if !(h.z > 0.0) || cos2 == 0.0 {
+    if h.z.is_nan() || h.z <= 0.0 || cos2 == 0.0 {
         return 0.0;
     }
     let tan2 = (h.x * h.x + h.y * h.y) / cos2;
     let m2 = m * m;
     let exponent = tan2 / m2;
-    if !(exponent <= MAX_EXPONENT) {
+    if exponent.is_nan() || exponent > MAX_EXPONENT {
         return 0.0;
     }
     (-exponent).exp() / (PI * m2 * cos2 * cos2)

@@ -28,6 +28,37 @@ pub enum BrdfError {
     },
 }
 
+/// Validate a Beckmann roughness (RMS slope) m: finite and in (0, 1].
+pub fn check_roughness(roughness_m: f32) -> Result<f32, BrdfError> {
+    check_range(
+        "roughness m",
+        f64::from(roughness_m),
+        0.0,
+        1.0,
+        Bounds::OpenBelow,
+        "(0, 1]",
+    )
+    .map(|_| roughness_m)
+}
+
+/// Validate an oiliness ρ_s (linear scale of the lobe): finite and in [0, 1].
+pub fn check_oiliness(oiliness_rho_s: f32) -> Result<f32, BrdfError> {
+    check_range(
+        "oiliness ρ_s",
+        f64::from(oiliness_rho_s),
+        0.0,
+        1.0,
+        Bounds::Closed,
+        "[0, 1]",
+    )
+    .map(|_| oiliness_rho_s)
+}
+
+/// Validate a relative refractive index η: finite and in [1, 3].
+pub fn check_eta(eta: f32) -> Result<f32, BrdfError> {
+    check_range("eta η", f64::from(eta), 1.0, 3.0, Bounds::Closed, "[1, 3]").map(|_| eta)
+}
+
 /// Which end of an interval is open.
 #[derive(Clone, Copy)]
 pub(crate) enum Bounds {

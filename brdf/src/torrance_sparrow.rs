@@ -8,7 +8,7 @@
 
 use crate::albedo;
 use crate::beckmann;
-use crate::error::{Bounds, BrdfError, check_range};
+use crate::error::{Bounds, BrdfError, check_eta, check_oiliness, check_range, check_roughness};
 use crate::fresnel::dielectric_reflectance;
 use crate::v_cavity;
 use glam::Vec3;
@@ -56,28 +56,14 @@ impl TorranceSparrow {
     /// Lobe with Beckmann RMS slope `roughness_m` in (0, 1], oiliness `oiliness_rho_s` in [0, 1] and
     /// relative refractive index `eta` in [1, 3]; NaN and infinities are rejected.
     pub fn new(roughness_m: f32, oiliness_rho_s: f32, eta: f32) -> Result<Self, BrdfError> {
-        let m = check_range(
-            "roughness m",
-            f64::from(roughness_m),
-            0.0,
-            1.0,
-            Bounds::OpenBelow,
-            "(0, 1]",
-        )?;
-        check_range(
-            "oiliness ρ_s",
-            f64::from(oiliness_rho_s),
-            0.0,
-            1.0,
-            Bounds::Closed,
-            "[0, 1]",
-        )?;
-        let eta64 = check_range("eta η", f64::from(eta), 1.0, 3.0, Bounds::Closed, "[1, 3]")?;
+        let roughness_m = check_roughness(roughness_m)?;
+        let oiliness_rho_s = check_oiliness(oiliness_rho_s)?;
+        let eta = check_eta(eta)?;
         Ok(TorranceSparrow {
             roughness_m,
             oiliness_rho_s,
             eta,
-            unit_albedo: albedo::albedo_table(m, eta64),
+            unit_albedo: albedo::albedo_table(f64::from(roughness_m), f64::from(eta)),
         })
     }
 
@@ -151,20 +137,20 @@ impl TorranceSparrow {
     /// because G ≤ G₁(ωo).
     #[must_use]
     pub fn sample(&self, wo: Vec3, u: [f32; 2]) -> Option<Sample> {
-        if !(wo.z > 0.0) {
+        if wo.z.is_nan() || wo.z <= 0.0 {
             return None;
         }
         let h = beckmann::sample_half_vector(u, self.roughness_m);
         let o_h = wo.dot(h);
-        if !(o_h > 0.0) {
+        if o_h.is_nan() || o_h <= 0.0 {
             return None;
         }
         let wi = (2.0 * o_h * h - wo).normalize();
-        if !(wi.z > 0.0) {
+        if wi.z.is_nan() || wi.z <= 0.0 {
             return None;
         }
         let pdf = self.pdf(wo, wi);
-        if !(pdf > 0.0) {
+        if pdf.is_nan() || pdf <= 0.0 {
             return None;
         }
         Some(Sample {

@@ -11,10 +11,11 @@ use crate::real::Real;
 /// One-direction V-cavity term G₁(v, h) = min(1, 2 cosθh cosθv / (v·h)), dimensionless; 0 when h
 /// faces away from v (`v_dot_h` ≤ 0).
 pub(crate) fn g1<T: Real>(cos_theta_h: T, cos_theta_v: T, v_dot_h: T) -> T {
-    if !(v_dot_h > T::ZERO) {
-        return T::ZERO;
+    if v_dot_h > T::ZERO {
+        (T::TWO * cos_theta_h * cos_theta_v / v_dot_h).min(T::ONE)
+    } else {
+        T::ZERO
     }
-    (T::TWO * cos_theta_h * cos_theta_v / v_dot_h).min(T::ONE)
 }
 
 /// Bidirectional V-cavity term G(ωo, ωi) = min(1, G₁(ωo), G₁(ωi)), dimensionless, for the half-vector

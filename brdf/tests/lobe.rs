@@ -38,8 +38,8 @@ proptest! {
     #[test]
     fn reciprocity(
         k in 0usize..5,
-        co in 0.0f32..1.0, po in 0.0f32..6.283,
-        ci in 0.0f32..1.0, pi in 0.0f32..6.283,
+        co in 0.0f32..1.0, po in 0.0f32..std::f32::consts::TAU,
+        ci in 0.0f32..1.0, pi in 0.0f32..std::f32::consts::TAU,
     ) {
         let ts = &lobes()[k];
         let (wo, wi) = (dir(co, po), dir(ci, pi));
@@ -55,7 +55,7 @@ proptest! {
     /// Sampling returns what eval and pdf say, for any outgoing direction.
     #[test]
     fn sample_consistent_with_eval_and_pdf(
-        k in 0usize..4, co in 0.0f32..1.0, po in 0.0f32..6.283, u0 in 0.0f32..1.0, u1 in 0.0f32..1.0,
+        k in 0usize..4, co in 0.0f32..1.0, po in 0.0f32..std::f32::consts::TAU, u0 in 0.0f32..1.0, u1 in 0.0f32..1.0,
     ) {
         let ts = &lobes()[k];
         let wo = dir(co, po);
