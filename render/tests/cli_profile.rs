@@ -1,0 +1,141 @@
+//! `skin profile` end to end: CSV shape and values, flag validation, the plot file.
+
+use std::process::Command;
+
+fn skin(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_skin"))
+        .arg("profile")
+        .args(args)
+        .output()
+        .expect("run skin")
+}
+
+#[test]
+fn prints_csv_with_the_requested_samples() {
+    let out = skin(&[
+        "--melanin",
+        "0.002",
+        "--eumelanin",
+        "0.5",
+        "--hemoglobin",
+        "0.01",
+        "--lambda",
+        "550",
+        "--samples",
+        "64",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8(out.stdout).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some("r_mm,reflectance_per_mm2"));
+    let rows: Vec<(f64, f64)> = lines
+        .map(|l| {
+            let (a, b) = l.split_once(',').unwrap();
+            (a.parse().unwrap(), b.parse().unwrap())
+        })
+        .collect();
+    assert_eq!(rows.len(), 64);
+    assert!((rows[0].0 - 0.001).abs() < 1e-9);
+    assert!(rows.windows(2).all(|w| w[1].0 > w[0].0));
+    assert!(rows.iter().all(|(_, v)| v.is_finite() && *v >= 0.0));
+    // Same numbers as the library (the light preset is the Figure 1 set).
+    let p = multipole::skin::profile(
+        &skin_optics::SkinParams::preset(skin_optics::Preset::Light),
+        skin_optics::Wavelength::new(550.0).unwrap(),
+        multipole::Method::Multipole,
+        &multipole::ProfileOptions {
+            radial_samples: 64,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    for ((r, v), (pr, pv)) in rows
+        .iter()
+        .zip(p.radii_mm().iter().zip(p.reflectance_per_mm2()))
+    {
+        assert!((r - pr).abs() <= 1e-6 * pr && (v - pv).abs() <= 1e-6 * pv.max(1e-300));
+    }
+    assert!(String::from_utf8_lossy(&out.stderr).contains("R_d = "));
+}
+
+#[test]
+fn explicit_r_max_and_preset() {
+    let out = skin(&[
+        "--preset",
+        "dark",
+        "--lambda",
+        "650",
+        "--r-max",
+        "2",
+        "--samples",
+        "10",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8(out.stdout).unwrap();
+    let last = text.lines().last().unwrap();
+    let r: f64 = last.split_once(',').unwrap().0.parse().unwrap();
+    assert!((r - 2.0).abs() < 1e-6);
+}
+
+#[test]
+fn bad_values_name_the_flag_and_range() {
+    for (args, flag, range) in [
+        (vec!["--lambda", "100"], "--lambda", "[250, 1000]"),
+        (
+            vec!["--lambda", "500", "--samples", "1"],
+            "--samples",
+            "[2, 1000000]",
+        ),
+        (
+            vec!["--lambda", "500", "--r-max", "-3"],
+            "--r-max",
+            "[0.002, 10000]",
+        ),
+        (
+            vec!["--lambda", "500", "--melanin", "1.5"],
+            "--melanin",
+            "[0, 1]",
+        ),
+        (
+            vec!["--lambda", "500", "--method", "mcml"],
+            "--method",
+            "multipole",
+        ),
+    ] {
+        let out = skin(&args);
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(flag) && err.contains(range), "{args:?}: {err}");
+    }
+}
+
+#[test]
+fn plot_writes_a_png() {
+    let dir = std::env::temp_dir().join(format!("skin-profile-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let png = dir.join("profile.png");
+    let out = skin(&[
+        "--lambda",
+        "550",
+        "--samples",
+        "32",
+        "--plot",
+        png.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let bytes = std::fs::read(&png).unwrap();
+    assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n");
+    std::fs::remove_dir_all(&dir).ok();
+}
