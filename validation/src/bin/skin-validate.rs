@@ -1,2 +1,172 @@
-//! `skin-validate`: Monte Carlo reference runs and diffusion-versus-exact charts.
-fn main() {}
+//! `skin-validate`: Monte Carlo reference runs (`mc`) and the diffusion-versus-exact comparison charts.
+
+use anyhow::Context;
+use clap::{Args, Parser, Subcommand};
+use indicatif::{ProgressBar, ProgressStyle};
+use render::cli::args::SkinArgs;
+use skin_optics::Wavelength;
+use std::path::PathBuf;
+use std::time::Instant;
+use validation::montecarlo::{self, LayerStack, McOptions, McResult};
+
+/// Monte Carlo ground truth for layered skin, and charts of where diffusion fails.
+///
+/// Without a subcommand: run the comparison (multipole versus Monte Carlo) and write PNG charts,
+/// the CSV behind each and a markdown summary into --out.
+#[derive(Parser, Debug)]
+#[command(name = "skin-validate", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+    /// Fewer wavelengths, grid points and photons: the whole comparison in under two minutes.
+    #[arg(long)]
+    quick: bool,
+    /// Output folder for the comparison's charts, CSV and summary.
+    #[arg(long, value_name = "DIR", default_value = "out/validation")]
+    out: PathBuf,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// One Monte Carlo run for a skin at one wavelength; prints one CSV line with its header.
+    Mc(McArgs),
+}
+
+/// Parse a wavelength in nm, [250, 1000].
+fn parse_lambda(s: &str) -> Result<f64, String> {
+    let v: f64 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("'{s}' is not a number (valid range [250, 1000] nm)"))?;
+    Wavelength::new(v)
+        .map(|w| w.nm())
+        .map_err(|e| e.to_string())
+}
+
+/// Parse a Henyey–Greenstein anisotropy, [-0.999, 0.999].
+fn parse_g(s: &str) -> Result<f64, String> {
+    let v: f64 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("'{s}' is not a number (valid range [-0.999, 0.999])"))?;
+    if v.is_finite() && (-0.999..=0.999).contains(&v) {
+        Ok(v)
+    } else {
+        Err(format!("{v} outside [-0.999, 0.999]"))
+    }
+}
+
+/// Parse a photon count, [1, 1e12] (accepts `1e6`).
+fn parse_photons(s: &str) -> Result<u64, String> {
+    let v: f64 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("'{s}' is not a number (valid range [1, 1e12])"))?;
+    if v.is_finite() && (1.0..=1e12).contains(&v) && v.fract() == 0.0 {
+        Ok(v as u64)
+    } else {
+        Err(format!("{v} outside [1, 1e12] (a whole number)"))
+    }
+}
+
+#[derive(Args, Debug)]
+struct McArgs {
+    #[command(flatten)]
+    skin: SkinArgs,
+    /// Wavelength in nm, [250, 1000].
+    #[arg(long, value_name = "NM", value_parser = parse_lambda, default_value = "550")]
+    lambda: f64,
+    /// Photon histories (the accuracy knob: the standard error falls as 1/√N).
+    #[arg(long, value_name = "N", value_parser = parse_photons, default_value = "1000000")]
+    photons: u64,
+    /// Henyey–Greenstein anisotropy g; σs = σs' / (1 − g).
+    #[arg(long, value_name = "G", value_parser = parse_g, default_value = "0.9")]
+    g: f64,
+    /// Generator seed: the same seed gives the same result on any number of threads.
+    #[arg(long, value_name = "S", default_value_t = 1)]
+    seed: u64,
+    /// Independent batches for the standard errors, [2, 1e6].
+    #[arg(long, value_name = "B", default_value_t = 32, value_parser = clap::value_parser!(u32).range(2..=1_000_000))]
+    batches: u32,
+    /// Worker threads (default: all cores).
+    #[arg(long, value_name = "T", value_parser = clap::value_parser!(u32).range(1..=1024))]
+    threads: Option<u32>,
+    /// Also write the radial profile R_d(r) as CSV (r_mm,reflectance_per_mm2,stderr).
+    #[arg(long, value_name = "FILE.csv")]
+    profile: Option<PathBuf>,
+}
+
+fn main() {
+    let cli = Cli::parse();
+    let result = match &cli.command {
+        Some(Command::Mc(args)) => run_mc(args),
+        None => validation::compare::run_comparison(cli.quick, &cli.out),
+    };
+    if let Err(e) = result {
+        eprintln!("skin-validate: {e:#}");
+        std::process::exit(1);
+    }
+}
+
+/// Progress bar on stderr for `total` photons.
+fn photon_bar(total: u64) -> ProgressBar {
+    let bar = ProgressBar::new(total);
+    if let Ok(style) = ProgressStyle::with_template(
+        "{elapsed_precise} [{bar:30}] {human_pos}/{human_len} photons ({per_sec}, eta {eta})",
+    ) {
+        bar.set_style(style.progress_chars("=> "));
+    }
+    bar
+}
+
+fn run_mc(args: &McArgs) -> anyhow::Result<()> {
+    let skin = args.skin.to_params()?;
+    let lambda = Wavelength::new(args.lambda)?;
+    let stack = LayerStack::skin(&skin, lambda, args.g)?;
+    let opts = McOptions::new(args.photons, args.batches, args.seed)?;
+    let bar = photon_bar(opts.total_photons());
+    let start = Instant::now();
+    let trace = || montecarlo::run_with_progress(&stack, &opts, |n| bar.inc(n));
+    let result = match args.threads {
+        Some(t) => rayon::ThreadPoolBuilder::new()
+            .num_threads(t as usize)
+            .build()
+            .context("building the thread pool")?
+            .install(trace),
+        None => trace(),
+    };
+    let seconds = start.elapsed().as_secs_f64();
+    bar.finish_and_clear();
+    println!(
+        "diffuse_reflectance,diffuse_reflectance_stderr,specular_reflectance,transmittance,absorbed,photons,seconds"
+    );
+    println!(
+        "{:.6},{:.6},{:.6},{:.6},{:.6},{},{:.3}",
+        result.diffuse_reflectance.mean,
+        result.diffuse_reflectance.stderr,
+        result.specular_reflectance,
+        result.transmittance.mean,
+        result.absorbed.mean,
+        result.photons,
+        seconds
+    );
+    if let Some(path) = &args.profile {
+        write_profile(path, &result)?;
+    }
+    Ok(())
+}
+
+fn write_profile(path: &std::path::Path, result: &McResult) -> anyhow::Result<()> {
+    let p = &result.radial;
+    let mut csv = String::from("r_mm,reflectance_per_mm2,stderr\n");
+    for i in 0..p.grid.bins() {
+        csv.push_str(&format!(
+            "{:.6},{:.6e},{:.3e}\n",
+            p.grid.r_mid_mm(i),
+            p.reflectance_per_mm2[i],
+            p.stderr[i]
+        ));
+    }
+    render::atomic::write_bytes(path, csv.as_bytes())
+        .with_context(|| format!("writing the profile {}", path.display()))
+}

@@ -1,0 +1,244 @@
+//! What one batch of photons scores, and how independent batches become means with standard errors.
+
+use crate::error::{ValidationError, check_range};
+
+/// A uniform radial grid for R_d(r): `bins` annuli of width `dr_mm` from r = 0.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RadialGrid {
+    dr_mm: f64,
+    bins: usize,
+}
+
+impl Default for RadialGrid {
+    /// 0.01 mm × 1000 bins: resolves the epidermal peak and reaches 10 mm (the dermal tail of red light).
+    fn default() -> Self {
+        Self {
+            dr_mm: 0.01,
+            bins: 1000,
+        }
+    }
+}
+
+impl RadialGrid {
+    /// A grid of `bins` in [1, 1e6] annuli, each `dr_mm` in (0, 100] mm wide.
+    pub fn new(dr_mm: f64, bins: usize) -> Result<Self, ValidationError> {
+        if !(dr_mm > 0.0 && dr_mm <= 100.0) {
+            return Err(ValidationError::OutOfRange {
+                name: "radial bin width (mm)",
+                value: dr_mm,
+                range: "(0, 100] mm",
+            });
+        }
+        check_range("radial bins", bins as f64, 1.0, 1.0e6, "[1, 1e6]")?;
+        Ok(Self { dr_mm, bins })
+    }
+    /// Bin width, mm.
+    #[must_use]
+    pub fn dr_mm(&self) -> f64 {
+        self.dr_mm
+    }
+    /// Number of annuli.
+    #[must_use]
+    pub fn bins(&self) -> usize {
+        self.bins
+    }
+    /// Outer radius of the grid, mm.
+    #[must_use]
+    pub fn r_max_mm(&self) -> f64 {
+        self.dr_mm * self.bins as f64
+    }
+    /// Mid radius of annulus `i`, mm.
+    #[must_use]
+    pub fn r_mid_mm(&self, i: usize) -> f64 {
+        (i as f64 + 0.5) * self.dr_mm
+    }
+    /// Area of annulus `i`, π((i+1)² − i²) dr², mm².
+    #[must_use]
+    pub fn annulus_area_mm2(&self, i: usize) -> f64 {
+        std::f64::consts::PI * (2.0 * i as f64 + 1.0) * self.dr_mm * self.dr_mm
+    }
+}
+
+/// Raw weight sums of one batch (all per batch, not yet divided by its photon count).
+#[derive(Debug, Clone)]
+pub(crate) struct BatchTally {
+    pub photons: u64,
+    pub diffuse_reflectance: f64,
+    pub transmittance: f64,
+    /// Weight deposited by implicit capture, per layer.
+    pub absorbed_by_layer: Vec<f64>,
+    /// Weight removed by roulette deaths minus weight added to survivors (zero in expectation).
+    pub roulette_balance: f64,
+    /// Escaping weight per annulus.
+    pub radial: Vec<f64>,
+    /// Escaping weight beyond the grid's outer radius.
+    pub beyond_grid: f64,
+    /// Scattering events, for speed figures (events per second).
+    pub interactions: u64,
+}
+
+impl BatchTally {
+    pub fn new(layers: usize, bins: usize) -> Self {
+        Self {
+            photons: 0,
+            diffuse_reflectance: 0.0,
+            transmittance: 0.0,
+            absorbed_by_layer: vec![0.0; layers],
+            roulette_balance: 0.0,
+            radial: vec![0.0; bins],
+            beyond_grid: 0.0,
+            interactions: 0,
+        }
+    }
+
+    fn absorbed(&self) -> f64 {
+        self.absorbed_by_layer.iter().sum::<f64>() + self.roulette_balance
+    }
+}
+
+/// A Monte Carlo estimate: mean and its standard error from the spread of independent batches.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Estimate {
+    /// Mean over all photons.
+    pub mean: f64,
+    /// Standard error of the mean, sd(batch means) / √batches.
+    pub stderr: f64,
+}
+
+impl Estimate {
+    /// Mean and standard error of equally sized batch values, combined in order (deterministic).
+    pub(crate) fn from_batches(values: impl Iterator<Item = f64> + Clone) -> Self {
+        let (mut n, mut sum) = (0usize, 0.0);
+        for v in values.clone() {
+            n += 1;
+            sum += v;
+        }
+        let mean = sum / n as f64;
+        let ss: f64 = values.map(|v| (v - mean) * (v - mean)).sum();
+        let stderr = if n > 1 {
+            (ss / ((n - 1) as f64 * n as f64)).sqrt()
+        } else {
+            f64::NAN
+        };
+        Self { mean, stderr }
+    }
+
+    /// Number of standard errors between this estimate and `reference` (an exact value).
+    #[must_use]
+    pub fn z_score(&self, reference: f64) -> f64 {
+        (self.mean - reference) / self.stderr
+    }
+}
+
+/// R_d(r) on a radial grid, mm⁻², per incident photon, with standard errors.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RadialProfile {
+    /// The grid.
+    pub grid: RadialGrid,
+    /// Diffuse reflectance per unit area per incident photon in each annulus, mm⁻².
+    pub reflectance_per_mm2: Vec<f64>,
+    /// Standard error of each value, mm⁻².
+    pub stderr: Vec<f64>,
+    /// Fraction of incident photons that escaped beyond the grid (not in the annuli).
+    pub beyond_grid: f64,
+}
+
+/// The result of one Monte Carlo run; every fraction is per incident photon.
+#[derive(Debug, Clone, PartialEq)]
+pub struct McResult {
+    /// Photons launched.
+    pub photons: u64,
+    /// Independent batches the standard errors come from.
+    pub batches: u32,
+    /// Diffuse reflectance (everything leaving the top except the entry specular).
+    pub diffuse_reflectance: Estimate,
+    /// Specular reflectance at entry, F_r(0) of the top interface (exact, no variance).
+    pub specular_reflectance: f64,
+    /// Total transmittance out of the bottom (0 for a semi-infinite stack).
+    pub transmittance: Estimate,
+    /// Absorbed fraction including the Russian-roulette weight balance, so that
+    /// R_d + R_spec + T + A = 1 to rounding for every run.
+    pub absorbed: Estimate,
+    /// Weight deposited by absorption in each layer (excludes the roulette balance).
+    pub absorbed_by_layer: Vec<f64>,
+    /// Weight removed by roulette deaths minus weight added to survivors; zero in expectation.
+    pub roulette_balance: f64,
+    /// Radial diffuse reflectance.
+    pub radial: RadialProfile,
+    /// Scattering events per photon (mean history length, for speed figures).
+    pub interactions_per_photon: f64,
+}
+
+impl McResult {
+    /// R_d + R_spec + T + A: 1 up to floating-point rounding.
+    #[must_use]
+    pub fn energy_total(&self) -> f64 {
+        self.diffuse_reflectance.mean
+            + self.specular_reflectance
+            + self.transmittance.mean
+            + self.absorbed.mean
+    }
+
+    /// Combine equally sized batch tallies, in batch order (bitwise independent of thread count).
+    pub(crate) fn from_batches(tallies: &[BatchTally], specular: f64, grid: RadialGrid) -> Self {
+        let per = |f: fn(&BatchTally) -> f64| {
+            Estimate::from_batches(tallies.iter().map(move |t| f(t) / t.photons as f64))
+        };
+        let photons: u64 = tallies.iter().map(|t| t.photons).sum();
+        let np = photons as f64;
+        let layers = tallies.first().map_or(0, |t| t.absorbed_by_layer.len());
+        let absorbed_by_layer = (0..layers)
+            .map(|l| tallies.iter().map(|t| t.absorbed_by_layer[l]).sum::<f64>() / np)
+            .collect();
+        let mut reflectance_per_mm2 = Vec::with_capacity(grid.bins());
+        let mut stderr = Vec::with_capacity(grid.bins());
+        for i in 0..grid.bins() {
+            let area = grid.annulus_area_mm2(i);
+            let e = Estimate::from_batches(
+                tallies
+                    .iter()
+                    .map(move |t| t.radial[i] / (t.photons as f64 * area)),
+            );
+            reflectance_per_mm2.push(e.mean);
+            stderr.push(e.stderr);
+        }
+        Self {
+            photons,
+            batches: tallies.len() as u32,
+            diffuse_reflectance: per(|t| t.diffuse_reflectance),
+            specular_reflectance: specular,
+            transmittance: per(|t| t.transmittance),
+            absorbed: per(BatchTally::absorbed),
+            absorbed_by_layer,
+            roulette_balance: tallies.iter().map(|t| t.roulette_balance).sum::<f64>() / np,
+            radial: RadialProfile {
+                grid,
+                reflectance_per_mm2,
+                stderr,
+                beyond_grid: tallies.iter().map(|t| t.beyond_grid).sum::<f64>() / np,
+            },
+            interactions_per_photon: tallies.iter().map(|t| t.interactions as f64).sum::<f64>()
+                / np,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn estimate_of_known_values() {
+        let e = Estimate::from_batches([1.0, 2.0, 3.0, 4.0].into_iter());
+        assert!((e.mean - 2.5).abs() < 1e-15);
+        // sd = sqrt(5/3), stderr = sd / 2
+        assert!((e.stderr - (5.0f64 / 3.0).sqrt() / 2.0).abs() < 1e-15);
+    }
+
+    #[test]
+    fn annuli_tile_the_disc() {
+        let g = RadialGrid::new(0.1, 10).unwrap();
+        let total: f64 = (0..10).map(|i| g.annulus_area_mm2(i)).sum();
+        assert!((total - std::f64::consts::PI * 1.0).abs() < 1e-12);
+    }
+}

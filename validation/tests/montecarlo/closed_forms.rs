@@ -1,0 +1,94 @@
+//! Cases with exact answers: clear slabs, Fresnel multiple reflection, no-absorption slabs.
+
+use super::photons;
+use brdf::fresnel::normal_incidence_reflectance;
+use validation::montecarlo::{Layer, LayerStack, McOptions, run};
+
+#[test]
+fn absorbing_clear_slab_transmits_beer_lambert() {
+    // σs = 0, matched indices: the beam goes straight, T = e^(−σa d) (binomial noise).
+    let (sigma_a, d) = (1.0, 0.7);
+    let stack = LayerStack::new(
+        vec![Layer::slab(sigma_a, 0.0, 0.0, 1.0, d).unwrap()],
+        1.0,
+        1.0,
+    )
+    .unwrap();
+    let r = run(&stack, &McOptions::new(photons(200_000), 20, 7).unwrap());
+    let exact = (-sigma_a * d).exp();
+    let z = r.transmittance.z_score(exact);
+    assert!(
+        z.abs() < 4.0,
+        "T {:?} vs e^-σd {exact}: z = {z}",
+        r.transmittance
+    );
+    assert_eq!(r.diffuse_reflectance.mean, 0.0);
+    assert!((r.energy_total() - 1.0).abs() < 1e-12);
+}
+
+#[test]
+fn glass_slab_reflects_two_r_over_one_plus_r() {
+    // A clear, non-absorbing slab of index 1.5 in air: incoherent multiple reflection gives
+    // R = 2 R₁ / (1 + R₁) at normal incidence, R₁ = F_r(0).
+    let stack = LayerStack::new(
+        vec![Layer::slab(0.0, 0.0, 0.0, 1.5, 1.0).unwrap()],
+        1.0,
+        1.0,
+    )
+    .unwrap();
+    let r = run(&stack, &McOptions::new(photons(200_000), 20, 3).unwrap());
+    let r1 = normal_incidence_reflectance(1.5);
+    let exact_r = 2.0 * r1 / (1.0 + r1);
+    assert!((r.specular_reflectance - r1).abs() < 1e-15);
+    let z = r.diffuse_reflectance.z_score(exact_r - r1);
+    assert!(
+        z.abs() < 4.0,
+        "R_d {:?} vs {}: z = {z}",
+        r.diffuse_reflectance,
+        exact_r - r1
+    );
+    assert!((r.transmittance.mean + r.diffuse_reflectance.mean + r1 - 1.0).abs() < 1e-12);
+}
+
+#[test]
+fn non_absorbing_matched_slab_loses_no_energy() {
+    // No absorption and matched indices: every photon leaves by the top or the bottom, with its
+    // full weight (roulette never fires because the weight never falls).
+    let stack = LayerStack::new(
+        vec![
+            Layer::slab(0.0, 5.0, 0.8, 1.0, 0.5).unwrap(),
+            Layer::slab(0.0, 20.0, 0.0, 1.0, 1.0).unwrap(),
+        ],
+        1.0,
+        1.0,
+    )
+    .unwrap();
+    let r = run(&stack, &McOptions::new(photons(20_000), 8, 11).unwrap());
+    assert_eq!(r.specular_reflectance, 0.0);
+    assert_eq!(r.roulette_balance, 0.0);
+    assert_eq!(r.absorbed.mean, 0.0);
+    let sum = r.diffuse_reflectance.mean + r.transmittance.mean;
+    assert!((sum - 1.0).abs() < 1e-12, "R_d + T = {sum}");
+    // The radial tally holds all of R_d.
+    let radial: f64 = (0..r.radial.grid.bins())
+        .map(|i| r.radial.reflectance_per_mm2[i] * r.radial.grid.annulus_area_mm2(i))
+        .sum::<f64>()
+        + r.radial.beyond_grid;
+    assert!(
+        (radial - r.diffuse_reflectance.mean).abs() < 1e-9,
+        "{radial}"
+    );
+}
+
+#[test]
+fn non_absorbing_mismatched_slab_loses_no_energy() {
+    let stack = LayerStack::new(
+        vec![Layer::slab(0.0, 10.0, 0.9, 1.4, 1.0).unwrap()],
+        1.0,
+        1.33,
+    )
+    .unwrap();
+    let r = run(&stack, &McOptions::new(photons(20_000), 8, 5).unwrap());
+    let sum = r.specular_reflectance + r.diffuse_reflectance.mean + r.transmittance.mean;
+    assert!((sum - 1.0).abs() < 1e-12, "R_spec + R_d + T = {sum}");
+}
