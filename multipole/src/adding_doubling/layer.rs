@@ -179,12 +179,46 @@ fn diamond(
     Ok((r.scale_rows_cols(c, &c_inv), t.scale_rows_cols(c, &c_inv)))
 }
 
-/// Doubling a homogeneous layer: R₂ = R + T R (I − R R)⁻¹ T, T₂ = T (I − R R)⁻¹ T.
+/// Doubling a homogeneous layer: R₂ = R + T R (I − R R)⁻¹ T, T₂ = T (I − R R)⁻¹ T (flux form).
+#[cfg(test)]
 fn double(r: &Mat, t: &Mat) -> Result<(Mat, Mat), Singular> {
     let x = r.mul(r).identity_minus().solve(t)?;
     let t2 = t.mul(&x);
     let r2 = r.add(&t.mul(&r.mul(&x)));
     Ok((r2, t2))
+}
+
+/// The same doubling in the symmetric basis X̂ = C^−½ X̃ C^½ (C = diag(2μw)), where reciprocity makes
+/// a homogeneous layer's R̂ and T̂ symmetric: with I − R̂² = L Lᵀ (Cholesky; R̂ has spectral radius < 1),
+/// F = L⁻¹ T̂ and H = L⁻¹ R̂ T̂, T̂₂ = Fᵀ F and R̂₂ = R̂ + Hᵀ F, both symmetric: about 3.7 n³
+/// multiply-adds per doubling instead of 5.3 n³ with a general solve.
+fn double_symmetric(r: &Mat, t: &Mat) -> Result<(Mat, Mat), Singular> {
+    let l = r.symmetric_square().identity_minus().cholesky()?;
+    let f = l.forward_substitute(t);
+    let h = l.forward_substitute(&r.mul(t));
+    let t2 = f.transpose_mul_symmetric(&f);
+    let r2 = r.add(&h.transpose_mul_symmetric(&f));
+    Ok((r2, t2))
+}
+
+/// Flux-form operator → symmetric basis (`s` = √(2μw)).
+fn to_symmetric(x: &Mat, s: &[f64]) -> Mat {
+    let s_inv: Vec<f64> = s.iter().map(|v| 1.0 / v).collect();
+    x.scale_rows_cols(&s_inv, s).symmetrised()
+}
+
+/// Symmetric basis → flux form.
+fn from_symmetric(x: &Mat, s: &[f64]) -> Mat {
+    let s_inv: Vec<f64> = s.iter().map(|v| 1.0 / v).collect();
+    x.scale_rows_cols(s, &s_inv)
+}
+
+/// Largest entry of a symmetric-basis operator once mapped back to flux form.
+fn flux_max_abs(x: &Mat, s: &[f64]) -> f64 {
+    let n = x.n();
+    (0..n)
+        .flat_map(|i| (0..n).map(move |j| (i, j)))
+        .fold(0.0f64, |m, (i, j)| m.max((x[(i, j)] * s[i] / s[j]).abs()))
 }
 
 /// Stop doubling a semi-infinite layer once transmission is this small (flux fraction) … (what is
@@ -227,6 +261,7 @@ pub(crate) fn homogeneous(
     }
     let (a, tau) = delta_m(albedo, tau, g, n);
     let (h_plus, h_minus) = redistribution(angles, g);
+    let s: Vec<f64> = angles.two_mu_w.iter().map(|c| c.sqrt()).collect();
     // Wiscombe's advice as [Prahl95] uses it: start at a thickness no larger than the smallest μ.
     let mu_min = angles.mu[0];
     if tau.is_finite() {
@@ -236,22 +271,27 @@ pub(crate) fn homogeneous(
             dtau *= 0.5;
             doublings += 1;
         }
-        let (mut r, mut t) = diamond(angles, &h_plus, &h_minus, a, dtau)?;
+        let (r, t) = diamond(angles, &h_plus, &h_minus, a, dtau)?;
+        let (mut r, mut t) = (to_symmetric(&r, &s), to_symmetric(&t, &s));
         for _ in 0..doublings {
-            (r, t) = double(&r, &t)?;
+            (r, t) = double_symmetric(&r, &t)?;
         }
+        let (r, t) = (from_symmetric(&r, &s), from_symmetric(&t, &s));
         return Ok(LayerBuild::Done(Operator::symmetric(r, t)));
     }
-    let (mut r, mut t) = diamond(angles, &h_plus, &h_minus, a, 0.5 * mu_min)?;
+    let (r, t) = diamond(angles, &h_plus, &h_minus, a, 0.5 * mu_min)?;
+    let (mut r, mut t) = (to_symmetric(&r, &s), to_symmetric(&t, &s));
     for _ in 0..MAX_DOUBLINGS {
-        let (r2, t2) = double(&r, &t)?;
-        let change = (0..n)
-            .flat_map(|i| (0..n).map(move |j| (i, j)))
-            .fold(0.0f64, |m, (i, j)| m.max((r2[(i, j)] - r[(i, j)]).abs()));
+        let (r2, t2) = double_symmetric(&r, &t)?;
+        let change = flux_max_abs(
+            &r2.add(&r.scale_rows_cols(&vec![-1.0; n], &vec![1.0; n])),
+            &s,
+        );
         r = r2;
         t = t2;
-        if t.max_abs() < SEMI_INFINITE_T && change < SEMI_INFINITE_DR {
+        if flux_max_abs(&t, &s) < SEMI_INFINITE_T && change < SEMI_INFINITE_DR {
             // Nothing comes out of the bottom: the layer is optically infinite.
+            let r = from_symmetric(&r, &s);
             return Ok(LayerBuild::Done(Operator::symmetric(r, Mat::zeros(n))));
         }
     }
@@ -294,6 +334,31 @@ mod tests {
                 for i in 0..n {
                     assert!((hp[(i, j)] - hp[(j, i)]).abs() < 1e-12);
                 }
+            }
+        }
+    }
+
+    #[test]
+    fn symmetric_doubling_matches_general_doubling() {
+        let mu_c = (1.0f64 - 1.0 / 1.96).sqrt();
+        let ang = angles(12, mu_c);
+        let (hp, hm) = redistribution(&ang, 0.9);
+        let (r, t) = diamond(&ang, &hp, &hm, 0.95, 0.004).expect("thin layer");
+        let s: Vec<f64> = ang.two_mu_w.iter().map(|c| c.sqrt()).collect();
+        // Reciprocity: the diamond layer is symmetric in the symmetric basis before symmetrising.
+        let r_hat = r.scale_rows_cols(&s.iter().map(|v| 1.0 / v).collect::<Vec<_>>(), &s);
+        assert!((0..12).all(|i| (0..12).all(|j| (r_hat[(i, j)] - r_hat[(j, i)]).abs() < 1e-13)));
+        let (mut rg, mut tg) = (r.clone(), t.clone());
+        let (mut rs, mut ts) = (to_symmetric(&r, &s), to_symmetric(&t, &s));
+        for _ in 0..12 {
+            (rg, tg) = double(&rg, &tg).expect("absorbing");
+            (rs, ts) = double_symmetric(&rs, &ts).expect("absorbing");
+        }
+        let (rs, ts) = (from_symmetric(&rs, &s), from_symmetric(&ts, &s));
+        for i in 0..12 {
+            for j in 0..12 {
+                assert!((rs[(i, j)] - rg[(i, j)]).abs() < 1e-12, "R {i} {j}");
+                assert!((ts[(i, j)] - tg[(i, j)]).abs() < 1e-12, "T {i} {j}");
             }
         }
     }

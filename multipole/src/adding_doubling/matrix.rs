@@ -214,6 +214,104 @@ fn swap_rows(m: &mut [f64], cols: usize, i: usize, j: usize) {
     top[lo * cols..(lo + 1) * cols].swap_with_slice(&mut bottom[..cols]);
 }
 
+impl Mat {
+    /// self · self for a symmetric self (the result is symmetric: upper triangle by row dot products,
+    /// mirrored).
+    pub(crate) fn symmetric_square(&self) -> Mat {
+        let n = self.n;
+        let mut out = Mat::zeros(n);
+        for i in 0..n {
+            let row_i = &self.data[i * n..(i + 1) * n];
+            for j in i..n {
+                let v = dot(row_i, &self.data[j * n..(j + 1) * n]);
+                out.data[i * n + j] = v;
+                out.data[j * n + i] = v;
+            }
+        }
+        out
+    }
+
+    /// Cholesky factor L (lower triangular, self = L Lᵀ) of a symmetric positive definite matrix.
+    pub(crate) fn cholesky(&self) -> Result<Mat, Singular> {
+        let n = self.n;
+        let mut l = Mat::zeros(n);
+        for i in 0..n {
+            for j in 0..=i {
+                let s = self.data[i * n + j]
+                    - dot(&l.data[i * n..i * n + j], &l.data[j * n..j * n + j]);
+                if i == j {
+                    if s.is_nan() || s <= 1e-300 {
+                        return Err(Singular);
+                    }
+                    l.data[i * n + i] = s.sqrt();
+                } else {
+                    l.data[i * n + j] = s / l.data[j * n + j];
+                }
+            }
+        }
+        Ok(l)
+    }
+
+    /// L⁻¹ B for lower-triangular self = L (forward substitution on whole rows of B).
+    pub(crate) fn forward_substitute(&self, b: &Mat) -> Mat {
+        let n = self.n;
+        let mut x = b.clone();
+        for i in 0..n {
+            let (done, rest) = x.data.split_at_mut(i * n);
+            let x_i = &mut rest[..n];
+            for (k, x_k) in done.chunks_exact(n).enumerate() {
+                axpy(x_i, -self.data[i * n + k], x_k);
+            }
+            let inv = 1.0 / self.data[i * n + i];
+            for v in x_i.iter_mut() {
+                *v *= inv;
+            }
+        }
+        x
+    }
+
+    /// selfᵀ · b when the result is known to be symmetric: upper triangle accumulated row by row,
+    /// mirrored (half the work of a full product).
+    pub(crate) fn transpose_mul_symmetric(&self, b: &Mat) -> Mat {
+        let n = self.n;
+        let mut out = Mat::zeros(n);
+        for k in 0..n {
+            let b_k = &b.data[k * n..(k + 1) * n];
+            for i in 0..n {
+                let a = self.data[k * n + i];
+                axpy(&mut out.data[i * n + i..(i + 1) * n], a, &b_k[i..]);
+            }
+        }
+        for i in 0..n {
+            for j in 0..i {
+                out.data[i * n + j] = out.data[j * n + i];
+            }
+        }
+        out
+    }
+
+    /// (self + selfᵀ)/2: removes rounding asymmetry from a matrix that is symmetric in exact arithmetic.
+    pub(crate) fn symmetrised(&self) -> Mat {
+        Mat::from_fn(self.n, |i, j| 0.5 * (self[(i, j)] + self[(j, i)]))
+    }
+}
+
+/// Σ a_k b_k with four partial sums, so the loop vectorises without reassociating a single sum.
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let mut acc = [0.0; 4];
+    let chunks = a.len() / 4;
+    for c in 0..chunks {
+        for l in 0..4 {
+            acc[l] += a[4 * c + l] * b[4 * c + l];
+        }
+    }
+    let mut s = (acc[0] + acc[1]) + (acc[2] + acc[3]);
+    for k in 4 * chunks..a.len() {
+        s += a[k] * b[k];
+    }
+    s
+}
+
 impl std::ops::Index<(usize, usize)> for Mat {
     type Output = f64;
     fn index(&self, (i, j): (usize, usize)) -> &f64 {
@@ -249,6 +347,36 @@ mod tests {
         let v2 = a.solve_vec(&bv).expect("well conditioned");
         for (p, q) in v.iter().zip(&v2) {
             assert!((p - q).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn symmetric_kernels_match_general_products() {
+        let n = 7;
+        let r = Mat::from_fn(n, |i, j| {
+            0.05 / (1.0 + (i as f64 - j as f64).abs()) + 0.01 * (i + j) as f64 / n as f64
+        });
+        let t = Mat::from_fn(n, |i, j| {
+            if i == j {
+                0.6
+            } else {
+                0.02 * ((i * j) as f64).cos().abs()
+            }
+        })
+        .symmetrised();
+        let sq = r.symmetric_square();
+        let sq_ref = r.mul(&r);
+        let a = sq.identity_minus();
+        let l = a.cholesky().expect("SPD");
+        let f = l.forward_substitute(&t);
+        // Fᵀ F = T (I − R²)⁻¹ T.
+        let tt = f.transpose_mul_symmetric(&f);
+        let tt_ref = t.mul(&a.solve(&t).expect("regular"));
+        for i in 0..n {
+            for j in 0..n {
+                assert!((sq[(i, j)] - sq_ref[(i, j)]).abs() < 1e-15);
+                assert!((tt[(i, j)] - tt_ref[(i, j)]).abs() < 1e-14);
+            }
         }
     }
 

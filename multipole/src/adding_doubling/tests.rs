@@ -367,3 +367,57 @@ fn print_convergence_table() {
         );
     }
 }
+
+#[test]
+#[ignore = "prints the dark-skin quadrature convergence for BENCHMARKS.md"]
+fn print_dark_convergence_table() {
+    let skin = SkinParams::new(0.5, 0.9, 0.07, 0.25).expect("valid skin");
+    println!("| points | 400 nm | 450 nm | 550 nm | 650 nm | 700 nm |");
+    for n in [8, 16, 24, 32, 48, 64] {
+        let row: Vec<String> = [400.0, 450.0, 550.0, 650.0, 700.0]
+            .iter()
+            .map(|&nm| {
+                let r = skin_totals(&skin, Wavelength::new(nm).expect("nm"), &opts(n))
+                    .expect("solves")
+                    .diffuse_reflectance;
+                format!("{r:.5}")
+            })
+            .collect();
+        println!("| {n} | {} |", row.join(" | "));
+    }
+}
+
+#[test]
+#[ignore = "prints multipole against exact totals for BENCHMARKS.md"]
+fn print_multipole_against_exact() {
+    use crate::skin::{Method, diffuse_reflectance};
+    println!(
+        "| skin (C_m, β_m, C_h) | exact 450 / 550 / 650 nm | multipole / exact − 1, 400–700 nm |"
+    );
+    for (c_m, beta_m, c_h) in [
+        (0.002, 0.5, 0.01),
+        (0.05, 0.7, 0.02),
+        (0.25, 0.9, 0.04),
+        (0.5, 0.9, 0.07),
+    ] {
+        let skin = SkinParams::new(c_m, beta_m, c_h, 0.25).expect("valid skin");
+        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        let mut shown = Vec::new();
+        for nm in (400..=700).step_by(10) {
+            let lambda = Wavelength::new(f64::from(nm)).expect("visible");
+            let e = diffuse_reflectance(&skin, lambda, Method::Exact).expect("solves");
+            let m = diffuse_reflectance(&skin, lambda, Method::Multipole).expect("solves");
+            lo = lo.min(m / e - 1.0);
+            hi = hi.max(m / e - 1.0);
+            if nm % 100 == 50 {
+                shown.push(format!("{e:.4}"));
+            }
+        }
+        println!(
+            "| {c_m}, {beta_m}, {c_h} | {} | {:+.1}% to {:+.1}% |",
+            shown.join(" / "),
+            100.0 * lo,
+            100.0 * hi
+        );
+    }
+}
