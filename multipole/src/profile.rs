@@ -34,7 +34,9 @@ impl Profile {
             ));
         }
         if radii_mm[0] <= 0.0
-            || radii_mm.windows(2).any(|w| !(w[1] > w[0]))
+            || radii_mm
+                .windows(2)
+                .any(|w| w[1].partial_cmp(&w[0]) != Some(std::cmp::Ordering::Greater))
             || radii_mm.iter().any(|r| !r.is_finite())
         {
             return Err(MultipoleError::Profile(
@@ -168,7 +170,7 @@ impl Profile {
     #[must_use]
     pub fn pdf_radius(&self, r_mm: f64) -> f64 {
         let norm = self.table_integral();
-        if !(r_mm >= 0.0) || r_mm > self.r_max_mm() || norm <= 0.0 {
+        if r_mm.is_nan() || r_mm < 0.0 || r_mm > self.r_max_mm() || norm <= 0.0 {
             return 0.0;
         }
         let i = self.radii_mm.partition_point(|&r| r < r_mm);
@@ -187,7 +189,7 @@ impl Profile {
     #[must_use]
     pub fn eval(&self, r_mm: f64) -> f64 {
         let (rs, vs) = (&self.radii_mm, &self.reflectance_per_mm2);
-        if !(r_mm >= 0.0) || r_mm > self.r_max_mm() {
+        if r_mm.is_nan() || r_mm < 0.0 || r_mm > self.r_max_mm() {
             return 0.0;
         }
         if r_mm <= rs[0] {

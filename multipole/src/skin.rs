@@ -142,7 +142,7 @@ impl SpectralProfiles {
             .map(|&l| profile(skin, l, method, opts))
             .collect::<Result<Vec<_>, _>>()?;
         Ok(Self {
-            grid: grid.clone(),
+            grid: *grid,
             profiles,
         })
     }

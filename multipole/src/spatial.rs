@@ -29,11 +29,11 @@ pub struct ProfileOptions {
     pub r_max_mm: Option<f64>,
     /// Energy fraction defining the outer radius when `r_max_mm` is `None` (default 0.999).
     pub energy_fraction: f64,
-    /// Gauss–Legendre nodes per 2π/ρ panel of the inverse transform (default 6; 1–64).
+    /// Gauss–Legendre nodes per 2π/ρ panel of the inverse transform (default 5; 1–64).
     pub transform_nodes: usize,
     /// Radii at which the inverse transform is evaluated before interpolation (default 48; 2–4096).
     pub transform_radii: usize,
-    /// Spectrum cutoff: stop at Q where |F(Q)| Q² < tolerance × peak (default 1e-8; [1e-16, 0.1]).
+    /// Spectrum cutoff: stop at Q where |F(Q)| Q² < tolerance × peak (default 1e-5; [1e-16, 0.1]).
     pub transform_tolerance: f64,
 }
 
@@ -44,9 +44,9 @@ impl Default for ProfileOptions {
             radial_samples: 256,
             r_max_mm: None,
             energy_fraction: 0.999,
-            transform_nodes: 6,
+            transform_nodes: 5,
             transform_radii: 48,
-            transform_tolerance: 1e-8,
+            transform_tolerance: 1e-5,
         }
     }
 }

@@ -321,7 +321,7 @@ mod tests {
             #[test]
             fn stack_total_reflectance_in_unit_interval((sa1, ss1, d, eta, sa2, ss2) in parts()) {
                 let r = build(sa1, ss1, d, eta, sa2, ss2).total_reflectance(Poles::Exact);
-                prop_assert!(r.is_finite() && r >= 0.0 && r <= 1.0, "R = {}", r);
+                prop_assert!(r.is_finite() && (0.0..=1.0).contains(&r), "R = {}", r);
             }
 
             #[test]

@@ -1,0 +1,115 @@
+//! Time versus error of every profile knob, against the converged reference (`skin::profile_error`).
+//!
+//! `cargo run --release -p multipole --example knob_errors [OUT.csv]` (default `out/multipole_knobs.csv`).
+//! Columns: preset, lambda_nm, knob, value, time_us (median of 7 single-threaded runs),
+//! max_energy_density_error, total_relative_error, r99_relative_error. One knob varies at a time,
+//! the others stay at their defaults.
+
+use multipole::skin::{Method, profile, profile_error};
+use multipole::{Poles, ProfileOptions};
+use skin_optics::{Preset, SkinParams, Wavelength};
+use std::io::Write;
+use std::time::Instant;
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let out = std::env::args()
+        .nth(1)
+        .unwrap_or_else(|| "out/multipole_knobs.csv".into());
+    let d = ProfileOptions::default();
+    let mut settings: Vec<(&str, String, ProfileOptions)> = Vec::new();
+    for n in [0usize, 1, 2, 5, 10, 20, 50] {
+        settings.push((
+            "poles",
+            n.to_string(),
+            ProfileOptions {
+                poles: Poles::Count(n),
+                ..d
+            },
+        ));
+    }
+    settings.push(("poles", "exact".into(), d));
+    for n in [16usize, 32, 64, 128, 256, 512, 1024] {
+        settings.push((
+            "radial_samples",
+            n.to_string(),
+            ProfileOptions {
+                radial_samples: n,
+                ..d
+            },
+        ));
+    }
+    for n in [2usize, 3, 4, 5, 6, 8, 12] {
+        settings.push((
+            "transform_nodes",
+            n.to_string(),
+            ProfileOptions {
+                transform_nodes: n,
+                ..d
+            },
+        ));
+    }
+    for n in [8usize, 12, 16, 24, 32, 48, 64, 96, 128] {
+        settings.push((
+            "transform_radii",
+            n.to_string(),
+            ProfileOptions {
+                transform_radii: n,
+                ..d
+            },
+        ));
+    }
+    for t in [1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-10, 1e-12] {
+        settings.push((
+            "transform_tolerance",
+            format!("{t:e}"),
+            ProfileOptions {
+                transform_tolerance: t,
+                ..d
+            },
+        ));
+    }
+    let mut csv = String::from(
+        "preset,lambda_nm,knob,value,time_us,max_energy_density_error,total_relative_error,r99_relative_error\n",
+    );
+    let total = 3 * 2 * settings.len();
+    let mut done = 0;
+    for preset in [Preset::Light, Preset::Medium, Preset::Dark] {
+        let skin = SkinParams::preset(preset);
+        for nm in [450.0, 650.0] {
+            let lambda = Wavelength::new(nm)?;
+            for (knob, value, opts) in &settings {
+                let mut times: Vec<f64> = (0..7)
+                    .map(|_| {
+                        let t = Instant::now();
+                        let p = profile(&skin, lambda, Method::Multipole, opts);
+                        std::hint::black_box(p).ok();
+                        t.elapsed().as_secs_f64() * 1e6
+                    })
+                    .collect();
+                times.sort_by(f64::total_cmp);
+                let e = profile_error(&skin, lambda, Method::Multipole, opts)?;
+                csv.push_str(&format!(
+                    "{},{nm},{knob},{value},{:.1},{:.3e},{:.3e},{:.3e}\n",
+                    preset.name(),
+                    times[3],
+                    e.max_energy_density_error,
+                    e.total_relative_error,
+                    e.r99_relative_error
+                ));
+                done += 1;
+                eprint!("\r{done}/{total}");
+            }
+        }
+    }
+    eprintln!();
+    // Write to a temporary name and rename, so a crash leaves no half file.
+    let path = std::path::Path::new(&out);
+    if let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir)?;
+    }
+    let tmp = path.with_extension("csv.tmp");
+    std::fs::File::create(&tmp)?.write_all(csv.as_bytes())?;
+    std::fs::rename(&tmp, path)?;
+    eprintln!("wrote {}", path.display());
+    Ok(())
+}
