@@ -166,45 +166,69 @@ pub fn frequency_cutoff(
     q_limit
 }
 
-/// Shape-preserving cubic interpolation (Fritsch–Carlson PCHIP) of (xs, ys) at `x`; xs increasing.
-/// Constant extrapolation outside [xs₀, xs_last].
-#[must_use]
-pub fn pchip(xs: &[f64], ys: &[f64], x: f64) -> f64 {
-    let n = xs.len();
-    if n == 0 {
-        return 0.0;
+/// Shape-preserving cubic interpolant (Fritsch–Carlson PCHIP) through (xs, ys), xs increasing;
+/// slopes are computed once, so each evaluation is a binary search and one cubic.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Pchip {
+    xs: Vec<f64>,
+    ys: Vec<f64>,
+    slopes: Vec<f64>,
+}
+
+impl Pchip {
+    /// Interpolant through the nodes (xs strictly increasing, same length as ys).
+    #[must_use]
+    pub fn new(xs: Vec<f64>, ys: Vec<f64>) -> Self {
+        let n = xs.len().min(ys.len());
+        let delta: Vec<f64> = (0..n.saturating_sub(1))
+            .map(|k| (ys[k + 1] - ys[k]) / (xs[k + 1] - xs[k]))
+            .collect();
+        let slopes = (0..n)
+            .map(|k| {
+                if n < 2 {
+                    0.0
+                } else if k == 0 {
+                    delta[0]
+                } else if k == n - 1 {
+                    delta[n - 2]
+                } else {
+                    let (d0, d1) = (delta[k - 1], delta[k]);
+                    if d0 * d1 <= 0.0 {
+                        0.0
+                    } else {
+                        let (h0, h1) = (xs[k] - xs[k - 1], xs[k + 1] - xs[k]);
+                        let (w1, w2) = (2.0 * h1 + h0, h1 + 2.0 * h0);
+                        (w1 + w2) / (w1 / d0 + w2 / d1)
+                    }
+                }
+            })
+            .collect();
+        Self { xs, ys, slopes }
     }
-    if x <= xs[0] || n == 1 {
-        return ys[0];
-    }
-    if x >= xs[n - 1] {
-        return ys[n - 1];
-    }
-    let i = xs.partition_point(|&v| v <= x) - 1;
-    let h = xs[i + 1] - xs[i];
-    let delta = |k: usize| (ys[k + 1] - ys[k]) / (xs[k + 1] - xs[k]);
-    let slope = |k: usize| -> f64 {
-        if k == 0 {
-            return delta(0);
-        }
-        if k == n - 1 {
-            return delta(n - 2);
-        }
-        let (d0, d1) = (delta(k - 1), delta(k));
-        if d0 * d1 <= 0.0 {
+
+    /// Value at `x`; constant extrapolation outside [xs₀, xs_last].
+    #[must_use]
+    pub fn eval(&self, x: f64) -> f64 {
+        let (xs, ys) = (&self.xs, &self.ys);
+        let n = xs.len();
+        if n == 0 {
             return 0.0;
         }
-        let (h0, h1) = (xs[k] - xs[k - 1], xs[k + 1] - xs[k]);
-        let (w1, w2) = (2.0 * h1 + h0, h1 + 2.0 * h0);
-        (w1 + w2) / (w1 / d0 + w2 / d1)
-    };
-    let (m0, m1) = (slope(i), slope(i + 1));
-    let t = (x - xs[i]) / h;
-    let (t2, t3) = (t * t, t * t * t);
-    (2.0 * t3 - 3.0 * t2 + 1.0) * ys[i]
-        + (t3 - 2.0 * t2 + t) * h * m0
-        + (-2.0 * t3 + 3.0 * t2) * ys[i + 1]
-        + (t3 - t2) * h * m1
+        if x <= xs[0] || n == 1 {
+            return ys[0];
+        }
+        if x >= xs[n - 1] {
+            return ys[n - 1];
+        }
+        let i = xs.partition_point(|&v| v <= x) - 1;
+        let h = xs[i + 1] - xs[i];
+        let t = (x - xs[i]) / h;
+        let (t2, t3) = (t * t, t * t * t);
+        (2.0 * t3 - 3.0 * t2 + 1.0) * ys[i]
+            + (t3 - 2.0 * t2 + t) * h * self.slopes[i]
+            + (-2.0 * t3 + 3.0 * t2) * ys[i + 1]
+            + (t3 - t2) * h * self.slopes[i + 1]
+    }
 }
 
 #[cfg(test)]
@@ -242,12 +266,11 @@ mod tests {
 
     #[test]
     fn pchip_reproduces_nodes_and_is_monotone() {
-        let xs = [0.0, 1.0, 2.0, 4.0];
-        let ys = [1.0, 0.5, 0.2, 0.0];
-        assert_eq!(pchip(&xs, &ys, 2.0), 0.2);
+        let p = Pchip::new(vec![0.0, 1.0, 2.0, 4.0], vec![1.0, 0.5, 0.2, 0.0]);
+        assert_eq!(p.eval(2.0), 0.2);
         let mut last = f64::INFINITY;
         for i in 0..=400 {
-            let v = pchip(&xs, &ys, i as f64 * 0.01);
+            let v = p.eval(i as f64 * 0.01);
             assert!(v <= last + 1e-15);
             last = v;
         }

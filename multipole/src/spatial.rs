@@ -8,7 +8,7 @@
 
 use crate::dipole::Dipole;
 use crate::error::{MultipoleError, check_range};
-use crate::hankel::{HankelTable, frequency_cutoff, pchip};
+use crate::hankel::{HankelTable, Pchip, frequency_cutoff};
 use crate::medium::pole_energy_within;
 use crate::profile::Profile;
 use crate::slab::Poles;
@@ -122,7 +122,7 @@ impl ProfileOptions {
 /// The remainder of a stack's profile, inverted on coarse radii.
 struct Remainder {
     radii: Vec<f64>,
-    values: Vec<f64>,
+    interpolant: Pchip,
     /// Cumulative ∫₀^{r_j} 2πr remainder dr (trapezoid) at each coarse radius.
     cumulative: Vec<f64>,
 }
@@ -149,14 +149,14 @@ impl Remainder {
             cumulative.push(acc);
         }
         Self {
+            interpolant: Pchip::new(radii.clone(), values),
             radii,
-            values,
             cumulative,
         }
     }
 
     fn eval(&self, r: f64) -> f64 {
-        pchip(&self.radii, &self.values, r)
+        self.interpolant.eval(r)
     }
 
     fn cumulative(&self, r: f64) -> f64 {
