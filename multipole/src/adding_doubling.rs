@@ -267,7 +267,9 @@ impl LayeredSlab {
     /// `n_above`, `n_below` those of the outer media (each in [1, 3]).
     ///
     /// One index for the whole stack is what skin needs (1.4 throughout) and lets every layer share one
-    /// angular grid; internal index steps are not supported.
+    /// angular grid; internal index steps are not supported. The grid is split at the critical angle of
+    /// the top face only: with `n_below` ≠ `n_above` the bottom face's kink falls inside a quadrature
+    /// interval and converges more slowly in `quadrature_points`.
     pub fn new(
         layers: Vec<SlabLayer>,
         eta: f64,
