@@ -1,1 +1,0 @@
-//! Fitting skin parameters to a colour or a reflectance spectrum (issue [fit]); in progress.

@@ -1,0 +1,279 @@
+//! Fit to a colour: the skin's D65 colour from its model spectrum, and the ΔE00 search.
+
+use super::{
+    BetaRange, EXACT_DE, FitError, FitOptions, beta_sweep, global_minimum, infeasibility,
+    prior_penalty2, search_to_params, with_chromophores,
+};
+use crate::Method;
+use crate::skin::diffuse_reflectance;
+use skin_optics::color::{Xyz, reflectance_to_xyz};
+use skin_optics::lab::{Lab, delta_e_2000};
+use skin_optics::{GridSpectrum, SkinParams, WavelengthGrid};
+use std::cell::RefCell;
+
+/// The forward model from skin to colour: diffuse reflectance on a 400–700 nm grid, then CIE XYZ
+/// under D65 and CIELAB.
+///
+/// [`reflectance_to_xyz`] is linear in the reflectance (linear interpolation of the grid values,
+/// held constant beyond its ends), so XYZ = Σᵢ Rᵢ Wᵢ with Wᵢ the XYZ of the i-th grid "hat"
+/// spectrum. The Wᵢ are computed once, by calling [`reflectance_to_xyz`] on those hats, which
+/// turns the 1-nm colour integral of every candidate into a 3 × n dot product.
+#[derive(Debug, Clone)]
+pub struct ColourModel {
+    grid: WavelengthGrid,
+    weights: Vec<[f64; 3]>,
+    method: Method,
+    base: SkinParams,
+}
+
+impl ColourModel {
+    /// A model over 400–700 nm every `step_nm` (in (0, 100]), for skins built on `base` (which supplies
+    /// everything but C_m, β_m, C_h), with the diffusion `method`.
+    pub fn new(step_nm: f64, method: Method, base: SkinParams) -> Result<Self, FitError> {
+        if !(step_nm > 0.0 && step_nm <= 100.0) {
+            return Err(FitError::Option {
+                name: "step_nm",
+                value: step_nm,
+                range: "(0, 100] nm",
+            });
+        }
+        let grid = WavelengthGrid::new(super::MIN_NM, super::MAX_NM, step_nm)?;
+        let weights = (0..grid.len())
+            .map(|i| {
+                let mut hat = vec![0.0; grid.len()];
+                hat[i] = 1.0;
+                GridSpectrum::new(grid, hat).map(|s| reflectance_to_xyz(&s).0)
+            })
+            .collect::<Result<_, _>>()?;
+        Ok(Self {
+            grid,
+            weights,
+            method,
+            base,
+        })
+    }
+
+    /// The wavelength grid of the model spectrum.
+    #[must_use]
+    pub fn grid(&self) -> &WavelengthGrid {
+        &self.grid
+    }
+
+    /// The skin with fractions C_m, β_m, C_h and the base's other constants.
+    pub fn skin(
+        &self,
+        melanin: f64,
+        eumelanin_blend: f64,
+        hemoglobin: f64,
+    ) -> Result<SkinParams, FitError> {
+        Ok(with_chromophores(
+            &self.base,
+            [melanin, eumelanin_blend, hemoglobin],
+        )?)
+    }
+
+    /// Diffuse reflectance (the observable) of `skin` on the grid.
+    pub fn spectrum(&self, skin: &SkinParams) -> Result<GridSpectrum, FitError> {
+        let values = self
+            .grid
+            .iter()
+            .map(|l| diffuse_reflectance(skin, l, self.method))
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(GridSpectrum::new(self.grid, values)?)
+    }
+
+    /// CIE XYZ of `skin` under D65 (equal to [`reflectance_to_xyz`] of [`ColourModel::spectrum`]).
+    pub fn xyz(&self, skin: &SkinParams) -> Result<Xyz, FitError> {
+        let mut xyz = [0.0; 3];
+        for (l, w) in self.grid.iter().zip(&self.weights) {
+            let r = diffuse_reflectance(skin, l, self.method)?;
+            for c in 0..3 {
+                xyz[c] += r * w[c];
+            }
+        }
+        Ok(Xyz(xyz))
+    }
+
+    /// CIELAB of `skin` under D65.
+    pub fn lab(&self, skin: &SkinParams) -> Result<Lab, FitError> {
+        self.xyz(skin).map(Lab::from_xyz)
+    }
+}
+
+/// Result of [`fit_colour`]: the nearest skin to the target colour and how near it is.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ColourFit {
+    /// The fitted skin (C_m, β_m, C_h fitted; the rest from [`FitOptions::base`]).
+    pub skin: SkinParams,
+    /// The target colour.
+    pub target: Lab,
+    /// The fitted skin's colour under D65.
+    pub lab: Lab,
+    /// The fitted skin's CIE XYZ under D65.
+    pub xyz: Xyz,
+    /// CIEDE2000 between the fitted and the target colour.
+    pub delta_e: f64,
+    /// False when `delta_e` exceeds [`FitOptions::gamut_threshold_de`]: no skin has this colour.
+    pub in_gamut: bool,
+    /// The β_m values the colour allows (within [`FitOptions::beta_tolerance_de`]), if swept.
+    pub beta_range: Option<BetaRange>,
+    /// Forward-model colour evaluations spent.
+    pub evaluations: usize,
+}
+
+/// Fit C_m, β_m, C_h so the skin's D65 colour matches `target` in CIEDE2000 (see the module doc for
+/// the search, the β_m prior and the gamut test).
+pub fn fit_colour(target: Lab, opts: &FitOptions) -> Result<ColourFit, FitError> {
+    opts.validate()?;
+    if ![target.l, target.a, target.b].iter().all(|v| v.is_finite()) {
+        return Err(FitError::Option {
+            name: "target L*",
+            value: f64::NAN,
+            range: "finite CIELAB",
+        });
+    }
+    let model = ColourModel::new(opts.step_nm, opts.method, opts.base)?;
+    let failure: RefCell<Option<FitError>> = RefCell::new(None);
+    // ΔE00 of the skin with parameters p = (C_m, β_m, C_h), or +∞ (remembering why) if the model failed.
+    let delta_e = |p: &[f64; 3]| -> f64 {
+        match model.skin(p[0], p[1], p[2]).and_then(|s| model.lab(&s)) {
+            Ok(lab) => delta_e_2000(lab, target),
+            Err(e) => {
+                failure.borrow_mut().get_or_insert(e);
+                f64::INFINITY
+            }
+        }
+    };
+    let (w, prior) = (opts.prior_weight_de, opts.beta_prior);
+    let mut objective = |x: &[f64; 3]| {
+        let p = search_to_params(x, prior);
+        delta_e(&p).powi(2) + prior_penalty2(p, w, opts) + (10.0 * infeasibility(x)).powi(2)
+    };
+    let exact = |x: &[f64; 3]| delta_e(&search_to_params(x, prior)) < EXACT_DE;
+    let (x, _, mut evaluations) = global_minimum(&mut objective, exact, opts);
+    let p = search_to_params(&x, prior);
+    let best_de = delta_e(&p);
+    let (beta_range, sweep_evals) = beta_sweep(
+        &mut |p| delta_e(p),
+        p,
+        best_de,
+        opts.beta_tolerance_de,
+        opts,
+    );
+    evaluations += sweep_evals + 1;
+    if let Some(e) = failure.into_inner() {
+        return Err(e);
+    }
+    let skin = model.skin(p[0], p[1], p[2])?;
+    let xyz = model.xyz(&skin)?;
+    let lab = Lab::from_xyz(xyz);
+    Ok(ColourFit {
+        skin,
+        target,
+        lab,
+        xyz,
+        delta_e: best_de,
+        in_gamut: best_de <= opts.gamut_threshold_de,
+        beta_range,
+        evaluations,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Uniform deviates in [0, 1) from a seeded SplitMix64 (no RNG crate in this crate's dev-dependencies).
+    struct SplitMix(u64);
+    impl SplitMix {
+        fn uniform(&mut self) -> f64 {
+            self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+            let mut z = self.0;
+            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+            ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+        }
+        fn range(&mut self, lo: f64, hi: f64) -> f64 {
+            lo + (hi - lo) * self.uniform()
+        }
+    }
+
+    #[test]
+    fn cached_weights_reproduce_the_colour_integral() {
+        let model = ColourModel::new(10.0, Method::Multipole, SkinParams::default()).unwrap();
+        let skin = SkinParams::default();
+        let direct = reflectance_to_xyz(&model.spectrum(&skin).unwrap()).0;
+        let cached = model.xyz(&skin).unwrap().0;
+        for (a, b) in direct.iter().zip(cached) {
+            assert!((a - b).abs() < 1e-13, "{direct:?} vs {cached:?}");
+        }
+    }
+
+    /// Issue 8: 200 random valid skins, colour → fit → colour within ΔE00 0.5.
+    #[test]
+    fn round_trip_of_200_random_skins() {
+        let opts = FitOptions {
+            beta_scan: 0,
+            ..FitOptions::default()
+        };
+        let model = ColourModel::new(opts.step_nm, opts.method, opts.base).unwrap();
+        let mut rng = SplitMix(8);
+        let mut worst: f64 = 0.0;
+        let cases = if cfg!(debug_assertions) { 20 } else { 200 };
+        for _ in 0..cases {
+            let p = [
+                rng.range(0.0, 0.5),
+                rng.range(0.0, 1.0),
+                rng.range(0.001, 0.1),
+            ];
+            let target = model.lab(&model.skin(p[0], p[1], p[2]).unwrap()).unwrap();
+            let fit = fit_colour(target, &opts).unwrap();
+            assert!(
+                fit.delta_e < 0.5,
+                "{p:?}: ΔE00 {} ({:?})",
+                fit.delta_e,
+                fit.skin
+            );
+            assert!(fit.in_gamut);
+            worst = worst.max(fit.delta_e);
+        }
+        eprintln!("round trip: worst ΔE00 over {cases} skins = {worst:.2e}");
+    }
+
+    #[test]
+    fn pure_green_is_out_of_gamut_with_a_nearest_skin() {
+        let green = Lab::from_srgb(skin_optics::color::Srgb([0.0, 1.0, 0.0]));
+        let fit = fit_colour(green, &FitOptions::default()).unwrap();
+        assert!(!fit.in_gamut && fit.delta_e > 3.0, "ΔE00 {}", fit.delta_e);
+        assert!(
+            fit.lab.a > 0.0,
+            "nearest skin is still reddish: {}",
+            fit.lab
+        );
+    }
+
+    #[test]
+    fn light_skin_colour_allows_every_beta_and_dark_skin_pins_it() {
+        // At C_m = 0.002 (the light preset) β_m moves the colour by under one ΔE00: the fit still
+        // reproduces the colour, and reports that every β_m is allowed. At C_m = 0.3 it is pinned.
+        let opts = FitOptions::default();
+        let model = ColourModel::new(opts.step_nm, opts.method, opts.base).unwrap();
+        let light = model.lab(&model.skin(0.002, 0.1, 0.01).unwrap()).unwrap();
+        let fit = fit_colour(light, &opts).unwrap();
+        let range = fit.beta_range.unwrap();
+        assert!(fit.delta_e < 0.01, "{}", fit.delta_e);
+        assert!(range.min == 0.0 && range.max == 1.0, "{range:?}");
+        let dark = model.lab(&model.skin(0.3, 0.2, 0.04).unwrap()).unwrap();
+        let fit = fit_colour(dark, &opts).unwrap();
+        let range = fit.beta_range.unwrap();
+        assert!(
+            (fit.skin.eumelanin_blend() - 0.2).abs() < 0.01,
+            "{:?}",
+            fit.skin
+        );
+        assert!(
+            range.min >= 0.1 - 1e-12 && range.max <= 0.3 + 1e-12,
+            "{range:?}"
+        );
+    }
+}

@@ -1,0 +1,84 @@
+//! Typed errors of the fit: bad measured data (with its line), bad options, or a failing forward model.
+//!
+//! Kept beside the fit rather than in the crate's `error.rs` (owned by the diffusion work) so the fit's
+//! data-format errors stay out of the physics error type; the forward model's errors are wrapped as-is.
+
+use crate::error::MultipoleError;
+use skin_optics::OpticsError;
+use thiserror::Error;
+
+/// Why a fit could not run. Data errors name the line of the CSV (1-based) and the valid range.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum FitError {
+    /// The CSV has no header line (every data line must follow `lambda_nm,reflectance[,weight]`).
+    #[error(
+        "line {line}: expected the header `lambda_nm,reflectance` or `lambda_nm,reflectance,weight`, found `{found}`"
+    )]
+    Header {
+        /// Line number, 1-based.
+        line: usize,
+        /// The text found instead.
+        found: String,
+    },
+    /// A data line with the wrong number of comma-separated fields.
+    #[error("line {line}: {found} fields, expected {expected} (as the header)")]
+    FieldCount {
+        /// Line number, 1-based.
+        line: usize,
+        /// Fields found.
+        found: usize,
+        /// Fields the header announced.
+        expected: usize,
+    },
+    /// A field that is not a finite number.
+    #[error("line {line}: {column} `{text}` is not a finite number")]
+    Number {
+        /// Line number, 1-based.
+        line: usize,
+        /// Column name.
+        column: &'static str,
+        /// The text that failed to parse.
+        text: String,
+    },
+    /// A value outside its valid range (wavelength, reflectance or weight).
+    #[error("line {line}: {column} = {value} outside {range}")]
+    Value {
+        /// Line number, 1-based.
+        line: usize,
+        /// Column name.
+        column: &'static str,
+        /// The offending value.
+        value: f64,
+        /// Valid range, e.g. `[0, 1]`.
+        range: &'static str,
+    },
+    /// Wavelengths that do not strictly increase.
+    #[error("line {line}: wavelength {lambda_nm} nm does not increase (previous {previous_nm} nm)")]
+    NotIncreasing {
+        /// Line number, 1-based.
+        line: usize,
+        /// The offending wavelength, nm.
+        lambda_nm: f64,
+        /// The wavelength on the previous data line, nm.
+        previous_nm: f64,
+    },
+    /// Too few data points to determine the fitted parameters, or all weights zero.
+    #[error("{0}")]
+    NotEnoughData(String),
+    /// A fit option outside its range.
+    #[error("fit option {name} = {value} outside {range}")]
+    Option {
+        /// Option name, e.g. `"step_nm"`.
+        name: &'static str,
+        /// The offending value.
+        value: f64,
+        /// Valid range.
+        range: &'static str,
+    },
+    /// The forward model (diffuse reflectance) failed for a candidate skin.
+    #[error("forward model: {0}")]
+    Model(#[from] MultipoleError),
+    /// Invalid optical input (wavelength, skin parameters).
+    #[error(transparent)]
+    Optics(#[from] OpticsError),
+}
