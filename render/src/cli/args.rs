@@ -22,16 +22,16 @@ pub struct SkinArgs {
     #[arg(long, value_name = "NAME")]
     pub preset: Option<Preset>,
     /// Melanin volume fraction C_m of the epidermis, [0, 1] (physical: 0-0.5).
-    #[arg(long, value_name = "C_M", value_parser = parse_fraction)]
+    #[arg(long, value_name = "C_M", value_parser = parse_fraction, allow_negative_numbers = true)]
     pub melanin: Option<f64>,
     /// Eumelanin share β_m of the melanin, [0, 1] (the rest is pheomelanin).
-    #[arg(long, value_name = "BETA_M", value_parser = parse_fraction)]
+    #[arg(long, value_name = "BETA_M", value_parser = parse_fraction, allow_negative_numbers = true)]
     pub eumelanin: Option<f64>,
     /// Hemoglobin (blood) volume fraction C_h of the dermis, [0, 1] (physical: 0.001-0.1).
-    #[arg(long, value_name = "C_H", value_parser = parse_fraction)]
+    #[arg(long, value_name = "C_H", value_parser = parse_fraction, allow_negative_numbers = true)]
     pub hemoglobin: Option<f64>,
     /// Oiliness ρ_s, the scale of the surface reflection lobe, [0, 1].
-    #[arg(long, value_name = "RHO_S", value_parser = parse_fraction)]
+    #[arg(long, value_name = "RHO_S", value_parser = parse_fraction, allow_negative_numbers = true)]
     pub oil: Option<f64>,
 }
 

@@ -56,9 +56,9 @@ pub struct SpectrumArgs {
     /// Wavelength step, nm, [0.01, 750].
     #[arg(long, value_name = "NM", default_value_t = 10.0, value_parser = parse_step_nm, allow_negative_numbers = true)]
     pub step: f64,
-    /// Diffuse reflectance model: multipole (the paper's diffusion, [DJ05]) or exact
-    /// (adding-doubling transport).
-    #[arg(long, value_name = "NAME", default_value_t = Method::Multipole)]
+    /// Diffuse reflectance model: exact (adding-doubling transport, the default: right for every
+    /// skin tone) or multipole (the paper's diffusion, [DJ05]; too bright for dark skin).
+    #[arg(long, value_name = "NAME", default_value_t = Method::default())]
     pub method: Method,
     /// Also draw the absorption spectra (log axis, 1 nm resolution) and the reflectance to this PNG.
     #[arg(long, value_name = "FILE.png")]
