@@ -1,7 +1,7 @@
 #![doc = include_str!("../README.md")]
 
+pub mod compare;
 pub mod error;
 pub mod montecarlo;
 
 pub use error::ValidationError;
-pub mod compare;

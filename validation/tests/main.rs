@@ -4,3 +4,4 @@
 //! tolerance is stated in standard errors, so the tests stay meaningful at either count.
 
 mod montecarlo;
+mod properties;

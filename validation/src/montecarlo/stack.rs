@@ -46,14 +46,14 @@ impl Layer {
         )?;
         check_range("anisotropy g", g, -0.999, 0.999, "[-0.999, 0.999]")?;
         check_range("layer index n", n, 1.0, 3.0, "[1, 3]")?;
-        if let Some(d) = thickness_mm {
-            if !(d > 0.0 && d <= MAX_THICKNESS_MM) {
-                return Err(ValidationError::OutOfRange {
-                    name: "layer thickness (mm)",
-                    value: d,
-                    range: "(0, 1000] mm",
-                });
-            }
+        if let Some(d) = thickness_mm
+            && (d.is_nan() || d <= 0.0 || d > MAX_THICKNESS_MM)
+        {
+            return Err(ValidationError::OutOfRange {
+                name: "layer thickness (mm)",
+                value: d,
+                range: "(0, 1000] mm",
+            });
         }
         Ok(Self {
             sigma_a,
@@ -84,7 +84,7 @@ impl Layer {
         g: f64,
         n: f64,
     ) -> Result<Self, ValidationError> {
-        if !(sigma_a > 0.0) {
+        if sigma_a.is_nan() || sigma_a <= 0.0 {
             return Err(ValidationError::OutOfRange {
                 name: "absorption σa of a semi-infinite layer (mm⁻¹)",
                 value: sigma_a,

@@ -22,7 +22,7 @@ impl Default for RadialGrid {
 impl RadialGrid {
     /// A grid of `bins` in [1, 1e6] annuli, each `dr_mm` in (0, 100] mm wide.
     pub fn new(dr_mm: f64, bins: usize) -> Result<Self, ValidationError> {
-        if !(dr_mm > 0.0 && dr_mm <= 100.0) {
+        if dr_mm.is_nan() || dr_mm <= 0.0 || dr_mm > 100.0 {
             return Err(ValidationError::OutOfRange {
                 name: "radial bin width (mm)",
                 value: dr_mm,

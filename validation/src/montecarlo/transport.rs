@@ -9,6 +9,7 @@ use super::stack::LayerStack;
 use super::tally::{BatchTally, RadialGrid};
 use brdf::fresnel::dielectric_reflectance;
 use rand::RngCore;
+use rand_distr::{Distribution, Exp1};
 
 /// Russian roulette starts below this weight ([WJZ95] §3.7: 1e-4).
 pub const ROULETTE_THRESHOLD: f64 = 1.0e-4;
@@ -141,8 +142,9 @@ pub(crate) fn trace_batch(
                 f64::INFINITY
             } else {
                 if s_left == 0.0 {
-                    // ξ in (0, 1] keeps the logarithm finite.
-                    s_left = -(1.0 - uniform(rng)).ln();
+                    // Exponential optical depth, −ln ξ in distribution ([WJZ95] eq 3.8), drawn by
+                    // the ziggurat method: exact, and about twice as fast as the logarithm.
+                    s_left = Exp1.sample(rng);
                 }
                 s_left * slab.inv_mu_t
             };
@@ -225,12 +227,27 @@ pub(crate) fn trace_batch(
     tally.photons += photons;
 }
 
+/// Uniform azimuth as (cos φ, sin φ) without trigonometry: a point uniform in the unit disc, squared
+/// as a complex number, has a uniform angle 2θ; its cosine and sine are (x² − y², 2xy) / r².
+#[inline(always)]
+fn sample_azimuth(rng: &mut impl RngCore) -> (f64, f64) {
+    loop {
+        let x = 2.0 * uniform(rng) - 1.0;
+        let y = 2.0 * uniform(rng) - 1.0;
+        let r2 = x * x + y * y;
+        if r2 <= 1.0 && r2 > 1.0e-300 {
+            let inv = 1.0 / r2;
+            return ((x * x - y * y) * inv, 2.0 * x * y * inv);
+        }
+    }
+}
+
 /// New direction after a Henyey–Greenstein scattering ([WJZ95] eqs 3.15–3.20).
 #[inline(always)]
 fn scatter(p: &mut Photon, g: f64, rng: &mut impl RngCore) {
     let cos_t = sample_hg_cos(g, uniform(rng));
     let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
-    let (sin_p, cos_p) = (2.0 * std::f64::consts::PI * uniform(rng)).sin_cos();
+    let (cos_p, sin_p) = sample_azimuth(rng);
     if p.uz.abs() > COS_ZERO {
         p.ux = sin_t * cos_p;
         p.uy = sin_t * sin_p;
@@ -252,6 +269,23 @@ mod tests {
     use super::*;
     use rand::SeedableRng;
     use rand_xoshiro::Xoshiro256StarStar;
+
+    #[test]
+    fn azimuth_is_uniform_on_the_circle() {
+        let mut rng = Xoshiro256StarStar::seed_from_u64(2);
+        let n = 100_000;
+        let mut hist = [0u32; 8];
+        for _ in 0..n {
+            let (c, s) = sample_azimuth(&mut rng);
+            assert!((c * c + s * s - 1.0).abs() < 1e-12);
+            let phi = s.atan2(c) + std::f64::consts::PI;
+            hist[((phi / (2.0 * std::f64::consts::PI) * 8.0) as usize).min(7)] += 1;
+        }
+        // Each octant expects n/8 = 12500 ± 105 (binomial): 5σ ≈ 520.
+        for h in hist {
+            assert!((f64::from(h) - 12_500.0).abs() < 520.0, "{hist:?}");
+        }
+    }
 
     #[test]
     fn hg_sample_mean_cosine_is_g() {

@@ -92,3 +92,24 @@ fn non_absorbing_mismatched_slab_loses_no_energy() {
     let sum = r.specular_reflectance + r.diffuse_reflectance.mean + r.transmittance.mean;
     assert!((sum - 1.0).abs() < 1e-12, "R_spec + R_d + T = {sum}");
 }
+
+#[test]
+fn van_de_hulst_slab() {
+    // Albedo 0.9, g 0.75, optical thickness 2, matched indices: van de Hulst's tables give
+    // R = 0.09739, T = 0.66096 ([WJZ95] Table 2 uses this case to check MCML).
+    let stack = LayerStack::new(
+        vec![Layer::slab(1.0, 9.0, 0.75, 1.0, 0.2).unwrap()],
+        1.0,
+        1.0,
+    )
+    .unwrap();
+    let r = run(&stack, &McOptions::new(photons(200_000), 20, 21).unwrap());
+    let zr = r.diffuse_reflectance.z_score(0.09739);
+    let zt = r.transmittance.z_score(0.66096);
+    assert!(
+        zr.abs() < 4.0 && zt.abs() < 4.0,
+        "R {:?} (z {zr}), T {:?} (z {zt})",
+        r.diffuse_reflectance,
+        r.transmittance
+    );
+}

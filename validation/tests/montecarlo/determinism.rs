@@ -50,10 +50,10 @@ fn independent_streams_agree_on_a_two_layer_case() {
         DEFAULT_SKIN_G,
     )
     .unwrap();
-    let a = run(&stack, &McOptions::new(photons(150_000), 20, 1).unwrap());
+    let a = run(&stack, &McOptions::new(photons(80_000), 20, 1).unwrap());
     let b = run(
         &stack,
-        &McOptions::new(photons(150_000), 20, 0x9e37_79b9_7f4a_7c15).unwrap(),
+        &McOptions::new(photons(80_000), 20, 0x9e37_79b9_7f4a_7c15).unwrap(),
     );
     let (ra, rb) = (a.diffuse_reflectance, b.diffuse_reflectance);
     let sigma = ra.stderr.hypot(rb.stderr);

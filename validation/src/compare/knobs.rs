@@ -1,0 +1,153 @@
+//! Study 4: speed against accuracy for every approximation knob, light preset at 550 nm.
+//!
+//! Multipole profile knobs (poles, radial samples, transform nodes per panel): time of one
+//! `multipole::skin::profile` call (best of 3) against `multipole::skin::profile_error`'s maximum
+//! energy-density error relative to the converged reference. MC photon count: run time against the
+//! relative error of the total against adding-doubling (`Method::Exact`, independent exact transport).
+
+use super::{Settings, Summary, progress, timed_mc, write_csv};
+use crate::montecarlo::{DEFAULT_SKIN_G, LayerStack, McOptions};
+use multipole::{Method, Poles, ProfileOptions};
+use render::plot::{LineChart, Panel, Series, SeriesStyle, save_png};
+use skin_optics::{Preset, SkinParams, Wavelength};
+use std::path::Path;
+use std::time::Instant;
+
+/// (knob name, setting label, options) for every multipole setting measured.
+fn multipole_settings() -> Vec<(&'static str, String, ProfileOptions)> {
+    let base = ProfileOptions::default();
+    let mut v = Vec::new();
+    for n in [0usize, 1, 2, 3, 5, 10] {
+        v.push((
+            "poles",
+            format!("{n}"),
+            ProfileOptions {
+                poles: Poles::Count(n),
+                ..base
+            },
+        ));
+    }
+    v.push(("poles", "exact".into(), base));
+    for s in [16usize, 32, 64, 128, 256, 512, 1024] {
+        v.push((
+            "radial samples",
+            format!("{s}"),
+            ProfileOptions {
+                radial_samples: s,
+                ..base
+            },
+        ));
+    }
+    for k in [1usize, 2, 3, 5, 8, 16] {
+        v.push((
+            "transform nodes",
+            format!("{k}"),
+            ProfileOptions {
+                transform_nodes: k,
+                ..base
+            },
+        ));
+    }
+    v
+}
+
+/// Write `knobs.csv` and `knobs.png`; add the cheapest setting under 1% error per knob to `summary`.
+pub fn run(settings: &Settings, out: &Path, summary: &mut Summary) -> anyhow::Result<()> {
+    let skin = SkinParams::preset(Preset::Light);
+    let lambda = Wavelength::new(550.0)?;
+    let knobs = multipole_settings();
+    let mut photon_counts = Vec::new();
+    let mut n = 1000u64;
+    while n <= settings.knob_max_photons {
+        photon_counts.push(n);
+        n *= 3;
+    }
+    let bar = progress((knobs.len() + photon_counts.len()) as u64, "knob settings");
+    let mut rows = Vec::new();
+    let mut series: Vec<(&str, Vec<(f64, f64)>)> = Vec::new();
+    for (knob, label, opts) in &knobs {
+        let mut best = f64::INFINITY;
+        for _ in 0..3 {
+            let t = Instant::now();
+            let p = multipole::skin::profile(&skin, lambda, Method::Multipole, opts)?;
+            best = best.min(t.elapsed().as_secs_f64());
+            std::hint::black_box(p);
+        }
+        let e = multipole::skin::profile_error(&skin, lambda, Method::Multipole, opts)?;
+        let err = e.max_energy_density_error;
+        rows.push(format!("multipole {knob},{label},{best:.6e},{err:.4e}"));
+        match series.iter_mut().find(|(k, _)| k == knob) {
+            Some((_, pts)) => pts.push((best, err)),
+            None => series.push((knob, vec![(best, err)])),
+        }
+        bar.inc(1);
+    }
+    let exact = multipole::skin::diffuse_reflectance(&skin, lambda, Method::Exact)?;
+    let stack = LayerStack::skin(&skin, lambda, DEFAULT_SKIN_G)?;
+    let mut mc_pts = Vec::new();
+    for &n in &photon_counts {
+        let (r, s) = timed_mc(&stack, &McOptions::new(n, 16, settings.seed)?);
+        let err = (r.diffuse_reflectance.mean - exact).abs() / exact;
+        rows.push(format!("monte carlo photons,{n},{s:.6e},{err:.4e}"));
+        mc_pts.push((s, err));
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+    for (knob, pts) in &series {
+        let cheapest = rows
+            .iter()
+            .filter(|r| r.starts_with(&format!("multipole {knob},")))
+            .filter_map(|r| {
+                let f: Vec<&str> = r.split(',').collect();
+                let (t, e): (f64, f64) = (f[2].parse().ok()?, f[3].parse().ok()?);
+                (e < 0.01).then_some((t, f[1].to_string(), e))
+            })
+            .min_by(|a, b| a.0.total_cmp(&b.0));
+        let worst = pts.iter().map(|p| p.1).fold(0.0, f64::max);
+        summary.push(
+            "4 knobs",
+            &format!("multipole {knob}"),
+            format!("{:.2}% (worst setting)", 100.0 * worst),
+            cheapest.map_or("no setting under 1%".into(), |(t, l, e)| {
+                format!(
+                    "cheapest under 1%: {l} ({:.2} ms, {:.2}%)",
+                    1e3 * t,
+                    100.0 * e
+                )
+            }),
+        );
+    }
+    if let Some((s, e)) = mc_pts.last() {
+        summary.push(
+            "4 knobs",
+            "MC photons (total vs adding-doubling)",
+            format!("{:.2}%", 100.0 * e),
+            format!(
+                "{} photons, {s:.2} s",
+                photon_counts.last().copied().unwrap_or(0)
+            ),
+        );
+    }
+    let mut chart = LineChart::new(
+        "Speed vs accuracy, light preset 550 nm",
+        "time per evaluation (s)",
+        "relative error (profile: max energy density; MC: total)",
+    )
+    .log_x()
+    .log_y();
+    for (knob, pts) in series {
+        chart = chart.with_series(
+            Series::line(format!("multipole {knob}"), pts).with_style(SeriesStyle::LinePoints),
+        );
+    }
+    chart = chart.with_series(
+        Series::line("Monte Carlo photons", mc_pts).with_style(SeriesStyle::LinePoints),
+    );
+    write_csv(
+        &out.join("knobs.csv"),
+        "knob,setting,seconds,relative_error",
+        &rows,
+    )?;
+    save_png(&out.join("knobs.png"), &[Panel::Line(chart)], 1000, 700)?;
+    Ok(())
+}
