@@ -1,0 +1,34 @@
+//! Assets and scenes compiled into the binary, so `skin render` needs no files.
+//!
+//! Head scan: Lee Perry-Smith / Infinite Realities, CC BY 3.0 (`assets/LeePerrySmith_License.txt`).
+
+/// Prefix that names a built-in asset or scene instead of a file.
+pub const PREFIX: &str = "builtin:";
+
+/// The default scene: the head three times (light, medium, dark skin), key, fill and rim lights.
+pub const THREE_HEADS: &str = include_str!("../assets/scenes/three_heads.toml");
+/// A close-up of one ear lit from behind (for transmitted light through thin skin).
+pub const EAR: &str = include_str!("../assets/scenes/ear.toml");
+
+/// Built-in scene names, the first is the default.
+pub const SCENES: [&str; 2] = ["three-heads", "ear"];
+
+/// The text of a built-in scene by name.
+#[must_use]
+pub fn scene(name: &str) -> Option<&'static str> {
+    match name {
+        "three-heads" => Some(THREE_HEADS),
+        "ear" => Some(EAR),
+        _ => None,
+    }
+}
+
+/// The bytes of a built-in asset by file name.
+#[must_use]
+pub fn asset(name: &str) -> Option<&'static [u8]> {
+    match name {
+        "LeePerrySmith.glb" => Some(include_bytes!("../assets/LeePerrySmith.glb")),
+        "Map-COL.jpg" => Some(include_bytes!("../assets/Map-COL.jpg")),
+        _ => None,
+    }
+}

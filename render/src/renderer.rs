@@ -1,0 +1,214 @@
+//! The render loop: passes of one sample per pixel, each split into tiles rendered in parallel with
+//! rayon, until the sample count or the time limit is reached (stopping at the last finished pass).
+//!
+//! Every pixel sample has its own RNG seeded from (seed, pixel, sample index), and passes are added
+//! to the film in order, so the image for a given seed and sample count does not depend on the
+//! number of threads or on the tile schedule.
+
+use crate::error::RenderError;
+use crate::film::Film;
+use crate::integrator::{PathSettings, radiance};
+use crate::scene::Scene;
+use crate::spectrum::SampledWavelengths;
+use glam::Vec2;
+use indicatif::{ProgressBar, ProgressStyle};
+use rand::{Rng, SeedableRng};
+use rand_xoshiro::Xoshiro256PlusPlus;
+use rayon::prelude::*;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::{Duration, Instant};
+
+/// Tile edge, pixels.
+pub const TILE: usize = 16;
+
+/// What to render and how long.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RenderSettings {
+    /// Image width, pixels.
+    pub width: usize,
+    /// Image height, pixels.
+    pub height: usize,
+    /// Samples (paths) per pixel.
+    pub spp: u32,
+    /// Wall-clock budget: no pass is started that would end past it (None = no limit; at least
+    /// one pass is always rendered).
+    pub time_limit: Option<Duration>,
+    /// Seed of every random number.
+    pub seed: u64,
+    /// Worker threads (None = rayon's default, all cores).
+    pub threads: Option<usize>,
+    /// Path tracer knobs.
+    pub path: PathSettings,
+    /// Show a progress bar on stderr.
+    pub progress: bool,
+}
+
+impl Default for RenderSettings {
+    fn default() -> Self {
+        Self {
+            width: 512,
+            height: 512,
+            spp: 64,
+            time_limit: None,
+            seed: 1,
+            threads: None,
+            path: PathSettings::default(),
+            progress: false,
+        }
+    }
+}
+
+/// How the render went.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RenderStats {
+    /// Samples per pixel actually rendered.
+    pub spp: u32,
+    /// Wall-clock time of the passes.
+    pub elapsed: Duration,
+    /// Rays traced (closest-hit and shadow).
+    pub rays: u64,
+}
+
+impl RenderStats {
+    /// Rays per second.
+    #[must_use]
+    pub fn rays_per_second(&self) -> f64 {
+        self.rays as f64 / self.elapsed.as_secs_f64().max(1e-9)
+    }
+
+    /// Seconds per sample per pixel (wall-clock time of one full-image pass).
+    #[must_use]
+    pub fn seconds_per_spp(&self) -> f64 {
+        self.elapsed.as_secs_f64() / f64::from(self.spp.max(1))
+    }
+}
+
+/// Seed of pixel `pixel`'s sample `sample`: a SplitMix64-style mix, decorrelated per sample.
+fn sample_seed(seed: u64, pixel: u64, sample: u32) -> u64 {
+    let mut z = seed ^ pixel.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ (u64::from(sample) << 40);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+/// Render `scene` into a new film.
+pub fn render(
+    scene: &Scene,
+    settings: &RenderSettings,
+) -> Result<(Film, RenderStats), RenderError> {
+    let setting = |name, value: String, range| RenderError::Setting { name, value, range };
+    if settings.width == 0 || settings.width > 16384 {
+        return Err(setting("--width", settings.width.to_string(), "[1, 16384]"));
+    }
+    if settings.height == 0 || settings.height > 16384 {
+        return Err(setting(
+            "--height",
+            settings.height.to_string(),
+            "[1, 16384]",
+        ));
+    }
+    if settings.spp == 0 {
+        return Err(setting("--spp", "0".into(), "[1, 2^32)"));
+    }
+    if settings.threads == Some(0) {
+        return Err(setting("--threads", "0".into(), "[1, 1024]"));
+    }
+    let mut builder = rayon::ThreadPoolBuilder::new();
+    if let Some(t) = settings.threads {
+        builder = builder.num_threads(t);
+    }
+    let pool = builder
+        .build()
+        .map_err(|e| setting("--threads", e.to_string(), "[1, 1024]"))?;
+    pool.install(|| render_passes(scene, settings))
+}
+
+fn render_passes(scene: &Scene, s: &RenderSettings) -> Result<(Film, RenderStats), RenderError> {
+    let (w, h) = (s.width, s.height);
+    let mut film = Film::new(w, h);
+    let tiles: Vec<(usize, usize)> = (0..h.div_ceil(TILE))
+        .flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| (tx * TILE, ty * TILE)))
+        .collect();
+    let bar = if s.progress {
+        let b = ProgressBar::new(u64::from(s.spp) * (w * h) as u64);
+        b.set_style(
+            ProgressStyle::with_template(
+                "{elapsed_precise} [{bar:30}] {percent:>3}% {msg} ETA {eta}",
+            )
+            .unwrap_or_else(|_| ProgressStyle::default_bar())
+            .progress_chars("=> "),
+        );
+        b
+    } else {
+        ProgressBar::hidden()
+    };
+    let rays = AtomicU64::new(0);
+    let start = Instant::now();
+    let aspect = w as f32 / h as f32;
+    let mut pass = vec![[0.0f32; 3]; w * h];
+    let mut last = Duration::ZERO;
+    for sample in 0..s.spp {
+        let results: Vec<((usize, usize), Vec<[f32; 3]>)> = tiles
+            .par_iter()
+            .map(|&(x0, y0)| {
+                let mut tile_rays = 0u64;
+                let mut out = Vec::with_capacity(TILE * TILE);
+                for y in y0..(y0 + TILE).min(h) {
+                    for x in x0..(x0 + TILE).min(w) {
+                        let pixel = (y * w + x) as u64;
+                        let mut rng =
+                            Xoshiro256PlusPlus::seed_from_u64(sample_seed(s.seed, pixel, sample));
+                        let wl = SampledWavelengths::sample_visible(rng.random());
+                        let film_pos = Vec2::new(
+                            (x as f32 + rng.random::<f32>()) / w as f32,
+                            (y as f32 + rng.random::<f32>()) / h as f32,
+                        );
+                        let lens = Vec2::new(rng.random(), rng.random());
+                        let (o, d) = scene.camera.generate_ray(film_pos, aspect, lens);
+                        let l = radiance(scene, &s.path, o, d, &wl, &mut rng, &mut tile_rays);
+                        // A non-finite sample would poison the pixel: drop it (counted as black).
+                        out.push(if l.is_finite() {
+                            wl.to_xyz(&l)
+                        } else {
+                            [0.0; 3]
+                        });
+                    }
+                }
+                rays.fetch_add(tile_rays, Ordering::Relaxed);
+                bar.inc(out.len() as u64);
+                ((x0, y0), out)
+            })
+            .collect();
+        for ((x0, y0), out) in results {
+            let tw = (x0 + TILE).min(w) - x0;
+            for (i, v) in out.into_iter().enumerate() {
+                pass[(y0 + i / tw) * w + x0 + i % tw] = v;
+            }
+        }
+        film.add_pass(&pass);
+        let elapsed = start.elapsed();
+        bar.set_message(format!(
+            "{}/{} spp, {:.2} Mrays/s",
+            sample + 1,
+            s.spp,
+            rays.load(Ordering::Relaxed) as f64 / elapsed.as_secs_f64().max(1e-9) / 1e6
+        ));
+        // Stop when the next pass would end past the limit (passes take about equally long).
+        let pass_time = elapsed.checked_sub(last).unwrap_or_default();
+        last = elapsed;
+        if let Some(limit) = s.time_limit
+            && elapsed + pass_time > limit
+            && sample + 1 < s.spp
+        {
+            bar.println(format!("time limit reached after {} spp", sample + 1));
+            break;
+        }
+    }
+    bar.finish_and_clear();
+    let stats = RenderStats {
+        spp: film.spp(),
+        elapsed: start.elapsed(),
+        rays: rays.load(Ordering::Relaxed),
+    };
+    Ok((film, stats))
+}

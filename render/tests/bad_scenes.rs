@@ -1,0 +1,128 @@
+//! Bad scene files fail with a message naming the file, the key (or path) and what was expected,
+//! and `skin render` writes no image.
+
+use clap::Parser;
+use render::cli::render::{RenderArgs, run};
+use std::path::PathBuf;
+
+#[derive(Parser)]
+struct Cli {
+    #[command(flatten)]
+    args: RenderArgs,
+}
+
+const GOOD: &str = r#"
+[camera]
+position_mm = [0, 0, 300]
+look_at_mm = [0, 0, 0]
+fov_deg = 30
+
+[materials.skin]
+type = "skin"
+preset = "light"
+
+[[meshes]]
+shape = "sphere"
+material = "skin"
+scale = 50
+translate_mm = [0, 0, 0]
+"#;
+
+fn dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("skin-bad-scene-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// Run `skin render` on `text`; return the error message and check no image was written.
+fn render_text(name: &str, text: &str) -> Result<(), String> {
+    let d = dir(name);
+    let scene = d.join("scene.toml");
+    std::fs::write(&scene, text).unwrap();
+    let out = d.join("out");
+    let cli = Cli::parse_from([
+        "render",
+        "--scene",
+        scene.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--width",
+        "8",
+        "--height",
+        "8",
+        "--spp",
+        "1",
+        "--quiet",
+    ]);
+    let r = run(&cli.args).map_err(|e| format!("{e:#}"));
+    if r.is_err() {
+        for f in [
+            "render.png",
+            "render.exr",
+            "render.png.tmp",
+            "render.exr.tmp",
+        ] {
+            assert!(!out.join(f).exists(), "{f} written for a bad scene");
+        }
+    }
+    std::fs::remove_dir_all(&d).unwrap();
+    r
+}
+
+fn assert_mentions(err: &str, parts: &[&str]) {
+    for p in parts {
+        assert!(err.contains(p), "error {err:?} does not mention {p:?}");
+    }
+}
+
+#[test]
+fn the_good_scene_renders() {
+    render_text("good", GOOD).unwrap();
+}
+
+#[test]
+fn unknown_key_is_named() {
+    let text = GOOD.replace("fov_deg = 30", "fov_deg = 30\nzoom = 2");
+    let e = render_text("unknown", &text).unwrap_err();
+    assert_mentions(&e, &["scene.toml", "zoom", "unknown field"]);
+}
+
+#[test]
+fn missing_mesh_names_its_path() {
+    let text = GOOD.replace("shape = \"sphere\"", "file = \"no_such_head.glb\"");
+    let e = render_text("missing", &text).unwrap_err();
+    assert_mentions(&e, &["mesh", "no_such_head.glb"]);
+    assert_mentions(&e, &["cannot be read"]);
+}
+
+#[test]
+fn invalid_skin_parameter_is_named() {
+    let text = GOOD.replace("preset = \"light\"", "preset = \"light\"\nmelanin = 1.5");
+    let e = render_text("skin", &text).unwrap_err();
+    assert_mentions(
+        &e,
+        &["scene.toml", "materials.skin.melanin", "1.5", "[0, 1]"],
+    );
+}
+
+#[test]
+fn non_finite_transform_is_named() {
+    let text = GOOD.replace("translate_mm = [0, 0, 0]", "translate_mm = [nan, 0, 0]");
+    let e = render_text("nan", &text).unwrap_err();
+    assert_mentions(&e, &["scene.toml", "meshes[0].translate_mm", "finite"]);
+    let text = GOOD.replace("scale = 50", "scale = inf");
+    let e = render_text("inf", &text).unwrap_err();
+    assert_mentions(&e, &["meshes[0].scale", "finite"]);
+}
+
+#[test]
+fn unknown_material_and_bad_light_are_named() {
+    let text = GOOD.replace("material = \"skin\"", "material = \"bone\"");
+    let e = render_text("material", &text).unwrap_err();
+    assert_mentions(&e, &["meshes[0].material", "bone"]);
+    let text = format!(
+        "{GOOD}\n[[lights]]\ntype = \"sphere\"\ncenter_mm = [0, 0, 200]\nradius_mm = -1\nintensity = 1\n"
+    );
+    let e = render_text("light", &text).unwrap_err();
+    assert_mentions(&e, &["lights[0].radius_mm", "> 0"]);
+}
