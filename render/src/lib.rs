@@ -11,6 +11,7 @@ pub mod camera;
 pub mod film;
 pub mod light;
 pub mod texture;
+pub mod bssrdf;
 pub mod builtin;
 pub mod geometry;
 pub mod integrator;

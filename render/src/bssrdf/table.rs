@@ -1,0 +1,405 @@
+//! Per-material radial profile tables for rendering: 2πr R(r) on one geometric radius grid per
+//! material, one row per tabulation wavelength, each with its CDF, in f32 (physics.md §8).
+//!
+//! The profiles themselves come from the owner, `multipole::SpectralProfiles` ([DJ05] multipole with
+//! frequency-domain stacking, [DJ06] two-layer skin); this module only re-tabulates them for speed
+//! and interpolates across wavelength for the hero wavelengths of a path.
+//!
+//! # Interpolation and sampling
+//! Within a row the density p(r) = 2πr R(r) is linear in r between grid radii (rising linearly
+//! from p(0) = 0 below the first radius), so the CDF is piecewise quadratic and is inverted exactly,
+//! and `eval` returns R = p / (2πr) from the same interpolant: for one wavelength, R(r) and the
+//! sampling density are exactly proportional. Between two tabulation wavelengths λ_j, λ_{j+1} with
+//! weight t the profile is the mixture (1 − t) R_j + t R_{j+1}, sampled exactly by first choosing
+//! the row with probability ∝ its weighted energy.
+//!
+//! # Energy beyond the table
+//! A row ends at the radius holding 99.9% of its energy (the multipole default); its R is scaled by
+//! R_tot / ∫table so the table integrates to the model's total R_tot (exact, from q = 0): the 0.1%
+//! tail is redistributed over the table instead of being lost.
+
+use multipole::{Method, MultipoleError, Profile, ProfileOptions, SpectralProfiles};
+use skin_optics::{SkinParams, WavelengthGrid};
+use std::f32::consts::PI;
+
+/// Smallest radius of the grid, mm (matches the multipole tables' first radius).
+pub const R_MIN_MM: f32 = 1e-3;
+
+/// Knobs of a [`ProfileTable`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct TableOptions {
+    /// First tabulation wavelength, nm.
+    pub from_nm: f64,
+    /// Last tabulation wavelength, nm.
+    pub to_nm: f64,
+    /// Wavelength step, nm (profiles are linearly interpolated between steps).
+    pub step_nm: f64,
+    /// Radii of the common geometric grid (≥ 8).
+    pub radii: usize,
+    /// Multipole knobs of each profile.
+    pub profile: ProfileOptions,
+}
+
+impl Default for TableOptions {
+    fn default() -> Self {
+        Self {
+            from_nm: 380.0,
+            to_nm: 780.0,
+            step_nm: 10.0,
+            radii: 128,
+            profile: ProfileOptions::default(),
+        }
+    }
+}
+
+/// One tabulation wavelength.
+#[derive(Debug, Clone, PartialEq)]
+struct Row {
+    /// p(r) = 2πr R(r) at the grid radii (mm⁻¹), scaled to integrate to `total`; only `len` used.
+    p: Vec<f32>,
+    /// Cumulative ∫₀^{r_i} p dr at the grid radii.
+    cdf: Vec<f32>,
+    /// Radii used: the row ends at grid index `len − 1`, its 99.9% energy radius.
+    len: usize,
+    /// ∫ p dr over the row (= the model's total diffuse reflectance R_tot).
+    total: f32,
+}
+
+/// Radial profiles of one material at the tabulation wavelengths (f32, for the renderer).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ProfileTable {
+    radii_mm: Vec<f32>,
+    from_nm: f32,
+    step_nm: f32,
+    rows: Vec<Row>,
+}
+
+/// A wavelength between two rows: lower row index and weight of the upper one.
+#[derive(Debug, Clone, Copy)]
+struct Lerp {
+    j: usize,
+    t: f32,
+}
+
+impl ProfileTable {
+    /// Compute the profiles of `skin` with `method` (in parallel across wavelengths) and tabulate them.
+    pub fn build(
+        skin: &SkinParams,
+        method: Method,
+        opts: &TableOptions,
+    ) -> Result<Self, MultipoleError> {
+        let grid = WavelengthGrid::new(opts.from_nm, opts.to_nm, opts.step_nm).map_err(|_| {
+            MultipoleError::Profile(
+                "table wavelength grid must lie in [250, 1000] nm with step ≥ 0.01 nm",
+            )
+        })?;
+        let profiles = SpectralProfiles::new(skin, &grid, method, &opts.profile)?;
+        Self::from_profiles(
+            opts.from_nm as f32,
+            opts.step_nm as f32,
+            profiles.profiles(),
+            opts.radii,
+        )
+    }
+
+    /// Tabulate `profiles` (one per wavelength, `from_nm` + i·`step_nm`) on `radii` geometric radii
+    /// from [`R_MIN_MM`] to the largest 99.9% energy radius.
+    pub fn from_profiles(
+        from_nm: f32,
+        step_nm: f32,
+        profiles: &[Profile],
+        radii: usize,
+    ) -> Result<Self, MultipoleError> {
+        if profiles.is_empty() || radii < 8 || step_nm.is_nan() || step_nm <= 0.0 {
+            return Err(MultipoleError::Profile(
+                "need ≥ 1 profile, ≥ 8 radii and a positive wavelength step",
+            ));
+        }
+        let r_out = profiles.iter().map(Profile::r_max_mm).fold(0.0, f64::max) as f32;
+        if r_out.is_nan() || r_out <= R_MIN_MM || !r_out.is_finite() {
+            return Err(MultipoleError::Profile(
+                "profile outer radius must exceed 1e-3 mm",
+            ));
+        }
+        let ratio = (r_out / R_MIN_MM).ln() / (radii - 1) as f32;
+        let mut radii_mm: Vec<f32> = (0..radii)
+            .map(|i| R_MIN_MM * (ratio * i as f32).exp())
+            .collect();
+        radii_mm[radii - 1] = r_out;
+        let rows = profiles
+            .iter()
+            .map(|pr| {
+                let r_end = pr.r_max_mm() as f32;
+                // First grid radius at or beyond this profile's own outer radius.
+                let len = (radii_mm.partition_point(|&r| r < r_end) + 1).min(radii);
+                let mut p: Vec<f32> = radii_mm[..len]
+                    .iter()
+                    .map(|&r| {
+                        (2.0 * std::f64::consts::PI * f64::from(r) * pr.eval(f64::from(r))) as f32
+                    })
+                    .collect();
+                let cdf = cumulative(&radii_mm, &p);
+                let integral = cdf[len - 1];
+                let total = pr.total() as f32;
+                if integral.is_nan() || integral <= 0.0 || !total.is_finite() {
+                    return Err(MultipoleError::Profile(
+                        "profile has no energy on the table",
+                    ));
+                }
+                let scale = total / integral;
+                p.iter_mut().for_each(|v| *v *= scale);
+                let cdf = cumulative(&radii_mm, &p);
+                Ok(Row { p, cdf, len, total })
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(Self {
+            radii_mm,
+            from_nm,
+            step_nm,
+            rows,
+        })
+    }
+
+    /// Number of tabulation wavelengths.
+    #[must_use]
+    pub fn wavelengths(&self) -> usize {
+        self.rows.len()
+    }
+
+    /// The common radius grid, mm.
+    #[must_use]
+    pub fn radii_mm(&self) -> &[f32] {
+        &self.radii_mm
+    }
+
+    fn lerp(&self, nm: f32) -> Lerp {
+        let x = ((nm - self.from_nm) / self.step_nm).clamp(0.0, (self.rows.len() - 1) as f32);
+        let j = (x as usize).min(self.rows.len().saturating_sub(2));
+        Lerp {
+            j,
+            t: if self.rows.len() == 1 {
+                0.0
+            } else {
+                x - j as f32
+            },
+        }
+    }
+
+    /// The rows and weights mixed at `nm`.
+    fn mix(&self, nm: f32) -> [(&Row, f32); 2] {
+        let l = self.lerp(nm);
+        let upper = (l.j + 1).min(self.rows.len() - 1);
+        [(&self.rows[l.j], 1.0 - l.t), (&self.rows[upper], l.t)]
+    }
+
+    /// The model's total diffuse reflectance R_tot at `nm` (per unit flux entering), dimensionless.
+    #[must_use]
+    pub fn total(&self, nm: f32) -> f32 {
+        self.mix(nm).iter().map(|(row, w)| w * row.total).sum()
+    }
+
+    /// Outer radius of the profile at `nm` (its 99.9% energy radius on the grid), mm.
+    #[must_use]
+    pub fn r_max_mm(&self, nm: f32) -> f32 {
+        self.mix(nm)
+            .iter()
+            .filter(|(_, w)| *w > 0.0)
+            .map(|(row, _)| self.radii_mm[row.len - 1])
+            .fold(0.0, f32::max)
+    }
+
+    /// Density p(r) = 2πr R(r) of one row at `r_mm`, mm⁻¹ (0 beyond the row).
+    fn row_p(&self, row: &Row, r_mm: f32) -> f32 {
+        let rs = &self.radii_mm[..row.len];
+        if r_mm.is_nan() || r_mm < 0.0 || r_mm > rs[row.len - 1] {
+            return 0.0;
+        }
+        let i = rs.partition_point(|&r| r < r_mm);
+        if i == 0 {
+            return row.p[0] * r_mm / rs[0];
+        }
+        let t = (r_mm - rs[i - 1]) / (rs[i] - rs[i - 1]);
+        row.p[i - 1] + t * (row.p[i] - row.p[i - 1])
+    }
+
+    /// R(r) at `nm` and distance `r_mm`, mm⁻² (integrates to [`ProfileTable::total`] over the plane).
+    #[must_use]
+    pub fn eval(&self, nm: f32, r_mm: f32) -> f32 {
+        let r = r_mm.max(0.5 * R_MIN_MM);
+        let p: f32 = self
+            .mix(nm)
+            .iter()
+            .map(|(row, w)| w * self.row_p(row, r))
+            .sum();
+        p / (2.0 * PI * r)
+    }
+
+    /// Density of [`ProfileTable::sample_radius`] at `nm` per unit *area* of the plane at distance
+    /// `r_mm`, mm⁻²: R(r) / R_tot.
+    #[must_use]
+    pub fn pdf_area(&self, nm: f32, r_mm: f32) -> f32 {
+        let total = self.total(nm);
+        if total > 0.0 {
+            self.eval(nm, r_mm) / total
+        } else {
+            0.0
+        }
+    }
+
+    /// A radius with density ∝ 2πr R(r) at `nm` from uniform `u` in [0, 1), mm.
+    #[must_use]
+    pub fn sample_radius(&self, nm: f32, u: f32) -> f32 {
+        let [(a, wa), (b, wb)] = self.mix(nm);
+        let (ea, eb) = (wa * a.total, wb * b.total);
+        // Choose the row by its share of the mixture's energy, then reuse u within the row.
+        let pa = if ea + eb > 0.0 { ea / (ea + eb) } else { 1.0 };
+        let (row, u) = if u < pa {
+            (a, u / pa)
+        } else {
+            (b, ((u - pa) / (1.0 - pa)).min(1.0))
+        };
+        self.invert(row, u.clamp(0.0, 1.0) * row.total)
+    }
+
+    /// The radius of `row` where its cumulative energy reaches `target`.
+    fn invert(&self, row: &Row, target: f32) -> f32 {
+        let n = row.len;
+        if target >= row.cdf[n - 1] {
+            return self.radii_mm[n - 1];
+        }
+        let i = row.cdf[..n].partition_point(|&c| c < target);
+        let (r0, c0, p0) = if i == 0 {
+            (0.0, 0.0, 0.0)
+        } else {
+            (self.radii_mm[i - 1], row.cdf[i - 1], row.p[i - 1])
+        };
+        let (r1, p1) = (self.radii_mm[i], row.p[i]);
+        let h = r1 - r0;
+        // p linear on the segment: solve p0 s + (p1 − p0) s² / (2h) = target − c0 for s ∈ [0, h]
+        // with the cancellation-free root.
+        let need = (target - c0).max(0.0);
+        let a = 0.5 * (p1 - p0) / h;
+        let disc = (p0 * p0 + 4.0 * a * need).max(0.0);
+        let denom = p0 + disc.sqrt();
+        let s = if denom > 0.0 { 2.0 * need / denom } else { 0.0 };
+        r0 + s.clamp(0.0, h)
+    }
+}
+
+/// Cumulative trapezoid of a density linear between `radii` (and from 0 at r = 0).
+fn cumulative(radii: &[f32], p: &[f32]) -> Vec<f32> {
+    let mut acc = 0.5 * radii[0] * p[0];
+    let mut out = Vec::with_capacity(p.len());
+    out.push(acc);
+    for i in 1..p.len() {
+        acc += 0.5 * (radii[i] - radii[i - 1]) * (p[i] + p[i - 1]);
+        out.push(acc);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use skin_optics::Preset;
+    use std::time::Instant;
+
+    fn light_table() -> ProfileTable {
+        ProfileTable::build(
+            &SkinParams::preset(Preset::Light),
+            Method::default(),
+            &TableOptions::default(),
+        )
+        .unwrap()
+    }
+
+    /// The table integrates to the model's R_tot at every tabulation wavelength and in between.
+    #[test]
+    fn table_integrates_to_the_model_total() {
+        let skin = SkinParams::preset(Preset::Light);
+        let t = light_table();
+        for nm in [380.0f32, 455.0, 560.0, 633.3, 780.0] {
+            let r_max = t.r_max_mm(nm);
+            // Midpoint rule in ln r (the grid is geometric) of 2πr² R(r).
+            let n = 20_000;
+            let (lo, hi) = ((0.5 * R_MIN_MM).ln(), r_max.ln());
+            let h = (hi - lo) / n as f32;
+            let mut s: f64 = (0..n)
+                .map(|i| {
+                    let r = (lo + (i as f32 + 0.5) * h).exp();
+                    f64::from(2.0 * PI * r * r * t.eval(nm, r) * h)
+                })
+                .sum();
+            // Below 0.5 µm: R is constant there, ∫ 2πr R dr = π r² R.
+            s += f64::from(PI * (0.5 * R_MIN_MM).powi(2) * t.eval(nm, 0.0));
+            let total = f64::from(t.total(nm));
+            assert!(
+                (s - total).abs() < 2e-3 * total,
+                "{nm} nm: ∫ = {s}, total {total}"
+            );
+            // ...and the total is the multipole's (at tabulation wavelengths exactly).
+            if (nm - 380.0) % 10.0 == 0.0 {
+                let want = multipole::skin::total_reflectance(
+                    &skin,
+                    skin_optics::Wavelength::new(f64::from(nm)).unwrap(),
+                    Method::default(),
+                )
+                .unwrap();
+                assert!(
+                    (total - want).abs() < 1e-5 * want,
+                    "{nm}: {total} vs {want}"
+                );
+            }
+        }
+    }
+
+    /// Sampling inverts the CDF: dr/du = 1 / pdf_r(r) with pdf_r = 2πr · pdf_area.
+    #[test]
+    fn sampling_matches_the_pdf() {
+        let t = light_table();
+        // At tabulation wavelengths (between them the row is chosen first, so u ↦ r is not one CDF).
+        for nm in [420.0f32, 580.0, 700.0] {
+            for u in [0.01f32, 0.2, 0.45, 0.8, 0.97] {
+                let du = 1e-3;
+                let (r0, r1) = (t.sample_radius(nm, u), t.sample_radius(nm, u + du));
+                let rm = 0.5 * (r0 + r1);
+                let pdf_r = 2.0 * PI * rm * t.pdf_area(nm, rm);
+                let got = (r1 - r0) / du;
+                assert!(
+                    (got * pdf_r - 1.0).abs() < 0.02,
+                    "{nm} nm u {u}: dr/du {got}, 1/pdf {}",
+                    1.0 / pdf_r
+                );
+            }
+        }
+    }
+
+    /// Table building time for the default scene's three presets (reported, not asserted).
+    #[test]
+    fn build_time_for_three_presets() {
+        let start = Instant::now();
+        for p in [Preset::Light, Preset::Medium, Preset::Dark] {
+            let t = ProfileTable::build(
+                &SkinParams::preset(p),
+                Method::default(),
+                &TableOptions::default(),
+            )
+            .unwrap();
+            eprintln!(
+                "{p:?}: r_max(450 nm) = {:.2} mm, r_max(650 nm) = {:.2} mm, R_tot(650) = {:.3}",
+                t.r_max_mm(450.0),
+                t.r_max_mm(650.0),
+                t.total(650.0)
+            );
+        }
+        eprintln!(
+            "three presets' profile tables: {:.3} s",
+            start.elapsed().as_secs_f64()
+        );
+    }
+
+    #[test]
+    fn rejects_bad_input() {
+        assert!(ProfileTable::from_profiles(380.0, 10.0, &[], 64).is_err());
+    }
+}
