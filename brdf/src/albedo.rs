@@ -18,6 +18,7 @@ use crate::fresnel::dielectric_reflectance;
 use crate::quadrature::gauss_legendre;
 use crate::{beckmann, v_cavity};
 use std::f64::consts::PI;
+use std::sync::{Arc, Mutex};
 
 /// Gauss–Legendre nodes per axis (u and φ) used to build the albedo table.
 pub const TABLE_NODES: usize = 64;
@@ -113,6 +114,42 @@ pub(crate) fn albedo_table(m: f64, eta: f64) -> Vec<f32> {
         .collect()
 }
 
+/// Most recently built tables, keyed by the f32 bit patterns of (m, η): building one costs ~0.2 s and
+/// ρ_s does not enter it, so lobes that differ only in oiliness (or are rebuilt) share it.
+static CACHE: Mutex<Vec<CacheEntry>> = Mutex::new(Vec::new());
+
+/// A cached table and its key, the bit patterns of (m, η).
+type CacheEntry = ((u32, u32), Arc<[f32]>);
+
+/// Tables kept in [`CACHE`]; the oldest is dropped beyond this (a parameter scan must not grow it).
+const CACHE_CAPACITY: usize = 32;
+
+/// The albedo table for (m, η), from the cache or freshly built (outside the lock, so threads building
+/// different tables do not wait for each other).
+pub(crate) fn cached_albedo_table(m: f32, eta: f32) -> Arc<[f32]> {
+    let key = (m.to_bits(), eta.to_bits());
+    // A poisoned lock only means another thread panicked mid-push; the Vec is still valid.
+    let lookup = |cache: &Vec<CacheEntry>| {
+        cache
+            .iter()
+            .find(|(k, _)| *k == key)
+            .map(|(_, t)| Arc::clone(t))
+    };
+    if let Some(t) = lookup(&CACHE.lock().unwrap_or_else(|e| e.into_inner())) {
+        return t;
+    }
+    let table: Arc<[f32]> = albedo_table(f64::from(m), f64::from(eta)).into();
+    let mut cache = CACHE.lock().unwrap_or_else(|e| e.into_inner());
+    if let Some(t) = lookup(&cache) {
+        return t;
+    }
+    if cache.len() >= CACHE_CAPACITY {
+        cache.remove(0);
+    }
+    cache.push((key, Arc::clone(&table)));
+    table
+}
+
 /// Catmull–Rom interpolation in a table built by [`albedo_table`]; `cos_theta` is clamped to [0, 1]
 /// and NaN reads as 0 (grazing). Ghost values beyond the ends are extrapolated linearly.
 pub(crate) fn lookup(table: &[f32], cos_theta: f32) -> f32 {
@@ -176,5 +213,15 @@ mod tests {
             }
             assert!(worst < 1e-4, "m = {m}: worst table error {worst:.2e}");
         }
+    }
+
+    #[test]
+    fn cache_shares_tables_by_parameters() {
+        let a = cached_albedo_table(0.123, 1.4);
+        let b = cached_albedo_table(0.123, 1.4);
+        assert!(Arc::ptr_eq(&a, &b));
+        let c = cached_albedo_table(0.123, 1.41);
+        assert!(!Arc::ptr_eq(&a, &c));
+        assert_eq!(a.len(), TABLE_SIZE);
     }
 }

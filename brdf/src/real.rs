@@ -23,6 +23,10 @@ pub(crate) trait Real:
     fn ln_1p(self) -> Self;
     /// Smaller of two values.
     fn min(self, other: Self) -> Self;
+    /// Square root.
+    fn sqrt(self) -> Self;
+    /// Clamp to [lo, hi] (NaN passes through).
+    fn clamp(self, lo: Self, hi: Self) -> Self;
 }
 
 impl Real for f32 {
@@ -35,6 +39,12 @@ impl Real for f32 {
     fn min(self, other: Self) -> Self {
         f32::min(self, other)
     }
+    fn sqrt(self) -> Self {
+        f32::sqrt(self)
+    }
+    fn clamp(self, lo: Self, hi: Self) -> Self {
+        f32::clamp(self, lo, hi)
+    }
 }
 
 impl Real for f64 {
@@ -46,5 +56,11 @@ impl Real for f64 {
     }
     fn min(self, other: Self) -> Self {
         f64::min(self, other)
+    }
+    fn sqrt(self) -> Self {
+        f64::sqrt(self)
+    }
+    fn clamp(self, lo: Self, hi: Self) -> Self {
+        f64::clamp(self, lo, hi)
     }
 }

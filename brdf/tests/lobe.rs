@@ -15,7 +15,7 @@ fn dir(cos_theta: f32, phi: f32) -> Vec3 {
     Vec3::new(sin_theta * phi.cos(), sin_theta * phi.sin(), cos_theta)
 }
 
-/// Lobes reused across proptest cases (construction tabulates the albedo, ~0.1 s).
+/// Lobes reused across proptest cases (construction tabulates the albedo, ~0.2 s).
 fn lobes() -> &'static [TorranceSparrow] {
     static LOBES: OnceLock<Vec<TorranceSparrow>> = OnceLock::new();
     LOBES.get_or_init(|| {
