@@ -59,10 +59,10 @@ impl Settings {
         } else {
             Self {
                 spectrum_step_nm: 10.0,
-                spectrum_photons: 200_000,
-                profile_photons: 2_000_000,
-                stability_cells: 14,
-                stability_photons: 40_000,
+                spectrum_photons: 50_000,
+                profile_photons: 1_000_000,
+                stability_cells: 12,
+                stability_photons: 20_000,
                 knob_max_photons: 1_000_000,
                 seed: 1,
             }

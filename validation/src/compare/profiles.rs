@@ -53,7 +53,10 @@ pub fn run(settings: &Settings, out: &Path, summary: &mut Summary) -> anyhow::Re
             abs_err += (m - v).abs() * area;
             total += v * area;
             rows.push(format!("{nm},{r:.4},{m:.6e},{v:.6e},{se:.3e}"));
-            line.push((r, m));
+            // The multipole table stops at its 99.9%-energy radius; beyond it there is no curve.
+            if r <= mp.r_max_mm() {
+                line.push((r, m));
+            }
             // Points whose noise is below half their value; the rest would clutter the log axis.
             if v > 0.0 && se < 0.5 * v {
                 pts.push((r, v));
