@@ -338,3 +338,33 @@ mod tests {
         );
     }
 }
+
+#[cfg(test)]
+mod direction_tests {
+    use super::*;
+    use crate::stack::Response;
+    use skin_optics::Preset;
+
+    #[test]
+    fn directional_stacking_differs_from_the_symmetric_shortcut() {
+        // physics.md §6: using ↓ for both directions overestimates light skin's red reflectance by
+        // about 16% at 650 nm. Pin the size (10–25%) and the sign.
+        let skin = SkinParams::preset(Preset::Light);
+        let st = stack(&skin, Wavelength::new(650.0).unwrap()).unwrap();
+        let directional = st.total_reflectance(Poles::Exact);
+        let epi = st.layers()[0].response(0.0, Poles::Exact);
+        let symmetric_epi = Response {
+            r_up: epi.r_down,
+            t_up: epi.t_down,
+            ..epi
+        };
+        let symmetric = symmetric_epi
+            .over(&st.layers()[1].response(0.0, Poles::Exact))
+            .r_down;
+        let excess = symmetric / directional - 1.0;
+        assert!(
+            (0.10..0.25).contains(&excess),
+            "symmetric/directional − 1 = {excess}"
+        );
+    }
+}
