@@ -94,16 +94,17 @@ impl TorranceSparrow {
     /// (both directions within ~1e-19 of the horizon) the result is 0. Never NaN or infinite.
     #[must_use]
     pub fn eval(&self, wo: Vec3, wi: Vec3) -> f32 {
-        let (cos_o, cos_i) = (wo.z, wi.z);
-        if !(cos_o > 0.0 && cos_i > 0.0) {
-            return 0.0;
+        match half_vector(wo, wi) {
+            Some((h, o_h)) => {
+                let d = beckmann::distribution(h, self.roughness_m);
+                self.value(h, o_h, wo.z, wi.z, d)
+            }
+            None => 0.0,
         }
-        let sum = wo + wi;
-        let len = sum.length();
-        // For unit ωo, ωi: ωo·h = ωi·h = |ωo + ωi| / 2, a form symmetric in the two directions.
-        let o_h = 0.5 * len;
-        let h = sum / len;
-        let d = beckmann::distribution(h, self.roughness_m);
+    }
+
+    /// f_s from the half-vector, ωo·h, the two cosines and D(h) (shared by `eval` and `sample`).
+    fn value(&self, h: Vec3, o_h: f32, cos_o: f32, cos_i: f32, d: f32) -> f32 {
         let g = v_cavity::g(h.z, cos_o, cos_i, o_h);
         let f = dielectric_reflectance_f32(o_h, self.eta);
         let denominator = 4.0 * cos_o * cos_i;
@@ -120,15 +121,12 @@ impl TorranceSparrow {
     /// the probability of a sample below the horizon, returned as `None`).
     #[must_use]
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        let (cos_o, cos_i) = (wo.z, wi.z);
-        if !(cos_o > 0.0 && cos_i > 0.0) {
-            return 0.0;
+        match half_vector(wo, wi) {
+            Some((h, o_h)) => {
+                pdf_from_half_vector(h, o_h, beckmann::distribution(h, self.roughness_m))
+            }
+            None => 0.0,
         }
-        let sum = wo + wi;
-        let len = sum.length();
-        let o_h = 0.5 * len;
-        let h = sum / len;
-        (beckmann::half_vector_pdf(h, self.roughness_m) / (4.0 * o_h)).min(f32::MAX)
     }
 
     /// Importance sample ωi for outgoing ωo from two uniforms in [0, 1): draws h with density
@@ -147,23 +145,25 @@ impl TorranceSparrow {
             return None;
         }
         let wi = (2.0 * o_h * h - wo).normalize();
-        if wi.z.is_nan() || wi.z <= 0.0 {
-            return None;
-        }
-        let pdf = self.pdf(wo, wi);
+        // Recompute h and D from (ωo, ωi) exactly as `eval` and `pdf` do, so a sample's value and pdf
+        // equal theirs bit for bit (multiple importance sampling compares them); D is evaluated once.
+        let (h, o_h) = half_vector(wo, wi)?;
+        let d = beckmann::distribution(h, self.roughness_m);
+        let pdf = pdf_from_half_vector(h, o_h, d);
         if pdf.is_nan() || pdf <= 0.0 {
             return None;
         }
         Some(Sample {
             wi,
-            value: self.eval(wo, wi),
+            value: self.value(h, o_h, wo.z, wi.z, d),
             pdf,
         })
     }
 
     /// Directional albedo ∫ f_s cosθi dωi (dimensionless, in [0, 1]) for incidence cosine
-    /// `cos_theta` (clamped to [0, 1]; NaN reads as grazing), by linear interpolation in the table of
-    /// 65 cosines built at construction with 96 × 96-node Gauss–Legendre quadrature (f64).
+    /// `cos_theta` (clamped to [0, 1]; NaN reads as grazing), by Catmull–Rom interpolation in the
+    /// table of 129 cosines (cube-root spaced) built at construction with 64-node Gauss–Legendre
+    /// quadrature per axis and piece (f64).
     /// Table error against [`Self::directional_albedo_quadrature`]: below 1e-4 (tested).
     #[must_use]
     pub fn directional_albedo(&self, cos_theta: f32) -> f32 {
@@ -201,4 +201,21 @@ impl TorranceSparrow {
             albedo::albedo_quadrature(f64::from(self.roughness_m), f64::from(self.eta), mu, nodes);
         Ok(f64::from(self.oiliness_rho_s) * unit)
     }
+}
+
+/// Half-vector h and ωo·h for unit ωo, ωi both strictly above the horizon, else `None`.
+fn half_vector(wo: Vec3, wi: Vec3) -> Option<(Vec3, f32)> {
+    if !(wo.z > 0.0 && wi.z > 0.0) {
+        return None;
+    }
+    let sum = wo + wi;
+    let len = sum.length();
+    // For unit ωo, ωi: ωo·h = ωi·h = |ωo + ωi| / 2, a form symmetric in the two directions. len > 0
+    // because both z components are positive.
+    Some((sum / len, 0.5 * len))
+}
+
+/// Sampling density of ωi, sr⁻¹: D(h) cosθh / (4 ωo·h), saturated at `f32::MAX`.
+fn pdf_from_half_vector(h: Vec3, o_h: f32, d: f32) -> f32 {
+    (d * h.z.max(0.0) / (4.0 * o_h)).min(f32::MAX)
 }
