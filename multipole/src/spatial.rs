@@ -52,14 +52,15 @@ impl Default for ProfileOptions {
 }
 
 impl ProfileOptions {
-    /// A converged setting used as the reference by `skin::profile_error` (Exact poles, 16 nodes per
-    /// panel, 256 transform radii, tolerance 1e-13, 1024 radial samples).
+    /// A converged setting used as the reference by `skin::profile_error` for the total and r₉₉ (Exact
+    /// poles, 12 nodes per panel, 96 transform radii, tolerance 1e-13, 1024 radial samples; R(r) itself
+    /// is compared with `reference_reflectance`).
     #[must_use]
     pub fn reference() -> Self {
         Self {
             radial_samples: 1024,
-            transform_nodes: 16,
-            transform_radii: 256,
+            transform_nodes: 12,
+            transform_radii: 96,
             transform_tolerance: 1e-13,
             ..Self::default()
         }
