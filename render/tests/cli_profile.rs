@@ -46,7 +46,7 @@ fn prints_csv_with_the_requested_samples() {
     let p = multipole::skin::profile(
         &skin_optics::SkinParams::preset(skin_optics::Preset::Light),
         skin_optics::Wavelength::new(550.0).unwrap(),
-        multipole::Method::Multipole,
+        multipole::Method::default(),
         &multipole::ProfileOptions {
             radial_samples: 64,
             ..Default::default()

@@ -27,8 +27,9 @@ pub struct ProfileArgs {
     /// Number of radii, geometric from 0.001 mm to the outer radius, in [2, 1000000].
     #[arg(long, value_name = "N", default_value_t = 256, value_parser = parse_samples, allow_hyphen_values = true)]
     pub samples: usize,
-    /// Diffusion method (only `multipole`, the paper's, for now).
-    #[arg(long, value_name = "METHOD", default_value = "multipole", value_parser = parse_method)]
+    /// Profile method: exact (the default: exact adding-doubling total, diffusion shape) or
+    /// multipole (the paper's diffusion, too bright for dark skin).
+    #[arg(long, value_name = "METHOD", default_value_t = Method::default(), value_parser = parse_method)]
     pub method: Method,
     /// Also draw the profiles at 450, 550 and 650 nm on log axes to this PNG file.
     #[arg(long, value_name = "FILE.png")]
