@@ -1,12 +1,223 @@
-//! `skin fit`.
+//! `skin fit`: the skin parameters (C_m, β_m, C_h) that match an sRGB colour or a measured reflectance
+//! spectrum, from `multipole::fit`; prints the fit, its colour, residual, CIELAB and ITA°, or JSON.
 
-use clap::Args;
+use anyhow::Context;
+use clap::{ArgGroup, Args};
+use multipole::Method;
+use multipole::fit::{BetaRange, FitOptions, MeasuredSpectrum, fit_colour, fit_spectrum};
+use skin_optics::SkinParams;
+use skin_optics::color::{Srgb, Xyz};
+use skin_optics::lab::Lab;
+use std::path::PathBuf;
 
 /// Arguments of `skin fit`.
 #[derive(Args, Debug, Clone)]
-pub struct FitArgs {}
+#[command(group(ArgGroup::new("target").required(true).args(["srgb", "spectrum"])))]
+pub struct FitArgs {
+    /// Target colour, sRGB hex '#RRGGBB' (e.g. picked from a photograph), read as the skin's diffuse
+    /// colour under D65.
+    #[arg(long, value_name = "HEX", value_parser = parse_hex)]
+    pub srgb: Option<Hex>,
+    /// Measured diffuse reflectance, CSV with header `lambda_nm,reflectance` (optional third column
+    /// `weight`), wavelengths increasing within 400-700 nm, '#' comment lines allowed.
+    #[arg(long, value_name = "FILE.csv")]
+    pub spectrum: Option<PathBuf>,
+    /// Forward model: `multipole` (the paper's diffusion; fast, the default here) or any other
+    /// `multipole::Method` such as `exact` (adding-doubling totals; far slower per fit).
+    #[arg(long, value_name = "METHOD", default_value = "multipole", value_parser = parse_method)]
+    pub method: Method,
+    /// Wavelength step of the model spectrum behind a colour, nm, in (0, 100].
+    #[arg(long = "step-nm", value_name = "NM", default_value_t = 10.0, value_parser = parse_step)]
+    pub step_nm: f64,
+    /// Print one JSON object instead of text.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// A parsed `#RRGGBB` colour with its original spelling.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Hex {
+    /// The colour.
+    pub srgb: Srgb,
+    /// Normalised `#rrggbb`.
+    pub text: String,
+}
+
+fn parse_hex(s: &str) -> Result<Hex, String> {
+    let srgb = Srgb::from_hex(s)
+        .ok_or_else(|| format!("'{s}' is not an sRGB colour (expected #RRGGBB, six hex digits)"))?;
+    Ok(Hex {
+        text: srgb.to_hex(),
+        srgb,
+    })
+}
+
+fn parse_method(s: &str) -> Result<Method, String> {
+    s.parse::<Method>().map_err(|e| e.to_string())
+}
+
+fn parse_step(s: &str) -> Result<f64, String> {
+    let v: f64 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("'{s}' is not a number (valid range (0, 100] nm)"))?;
+    if !(v > 0.0 && v <= 100.0) {
+        return Err(format!("{v} outside (0, 100] nm"));
+    }
+    Ok(v)
+}
+
+fn hex_of(xyz: Xyz) -> String {
+    xyz.to_linear_srgb().to_srgb().to_hex()
+}
+
+fn lab_json(lab: Lab) -> serde_json::Value {
+    serde_json::json!({
+        "l": lab.l, "a": lab.a, "b": lab.b,
+        "ita_deg": lab.ita_deg(), "ita_category": lab.ita_category().name(),
+    })
+}
+
+fn colour_line(label: &str, hex: &str, lab: Lab) -> String {
+    format!(
+        "{label:<9}{hex}  L*a*b* ({:.2}, {:.2}, {:.2})  ITA° {:.1} ({})",
+        lab.l,
+        lab.a,
+        lab.b,
+        lab.ita_deg(),
+        lab.ita_category()
+    )
+}
+
+fn skin_line(skin: &SkinParams, method: Method) -> String {
+    format!(
+        "{:<9}C_m = {:.4}  β_m = {:.3}  C_h = {:.4}  (method {method})",
+        "skin",
+        skin.melanin(),
+        skin.eumelanin_blend(),
+        skin.hemoglobin()
+    )
+}
+
+fn beta_line(range: Option<BetaRange>, unit: &str, prior: f64) -> Option<String> {
+    range.map(|r| {
+        format!(
+            "{:<9}the target allows β_m in [{:.1}, {:.1}] (residual within {} {unit} of the best); ties go to β_m = {prior}",
+            "β_m", r.min, r.max, r.tolerance
+        )
+    })
+}
+
+fn beta_json(range: Option<BetaRange>) -> serde_json::Value {
+    range.map_or(serde_json::Value::Null, |r| {
+        serde_json::json!({ "min": r.min, "max": r.max, "tolerance": r.tolerance, "samples": r.samples })
+    })
+}
+
+fn params_json(skin: &SkinParams) -> serde_json::Value {
+    serde_json::json!({
+        "melanin": skin.melanin(),
+        "eumelanin_blend": skin.eumelanin_blend(),
+        "hemoglobin": skin.hemoglobin(),
+    })
+}
 
 /// Run `skin fit`.
-pub fn run(_args: &FitArgs) -> anyhow::Result<()> {
-    anyhow::bail!("`skin fit` is not available yet in this build")
+pub fn run(args: &FitArgs) -> anyhow::Result<()> {
+    let opts = FitOptions {
+        method: args.method,
+        step_nm: args.step_nm,
+        ..FitOptions::default()
+    };
+    if let Some(hex) = &args.srgb {
+        let target = Lab::from_srgb(hex.srgb);
+        let fit = fit_colour(target, &opts)?;
+        let fitted_hex = hex_of(fit.xyz);
+        if args.json {
+            let out = serde_json::json!({
+                "target": { "srgb": hex.text, "lab": lab_json(target) },
+                "method": args.method.to_string(),
+                "parameters": params_json(&fit.skin),
+                "fitted": { "srgb": fitted_hex, "lab": lab_json(fit.lab) },
+                "residual": { "delta_e_2000": fit.delta_e },
+                "in_gamut": fit.in_gamut,
+                "gamut_threshold_delta_e_2000": opts.gamut_threshold_de,
+                "beta_range": beta_json(fit.beta_range),
+                "beta_prior": opts.beta_prior,
+                "evaluations": fit.evaluations,
+            });
+            println!("{out}");
+        } else {
+            println!("{}", colour_line("target", &hex.text, target));
+            println!("{}", skin_line(&fit.skin, args.method));
+            println!("{}", colour_line("fitted", &fitted_hex, fit.lab));
+            println!("{:<9}ΔE2000 = {:.3}", "residual", fit.delta_e);
+            if let Some(l) = beta_line(fit.beta_range, "ΔE2000", opts.beta_prior) {
+                println!("{l}");
+            }
+        }
+        if !fit.in_gamut {
+            anyhow::bail!(
+                "{} is out of gamut: no skin has this colour; the nearest skin (above) is ΔE2000 {:.1} away (threshold {})",
+                hex.text,
+                fit.delta_e,
+                opts.gamut_threshold_de
+            );
+        }
+        return Ok(());
+    }
+    let Some(path) = &args.spectrum else {
+        // clap's ArgGroup requires one of the two.
+        anyhow::bail!("give --srgb '#RRGGBB' or --spectrum FILE.csv");
+    };
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("cannot read spectrum {}", path.display()))?;
+    let measured =
+        MeasuredSpectrum::parse_csv(&text).with_context(|| path.display().to_string())?;
+    let fit = fit_spectrum(&measured, &opts)?;
+    let fitted_hex = fit.lab.to_srgb().to_hex();
+    if args.json {
+        let out = serde_json::json!({
+            "target": { "spectrum": path.display().to_string(), "points": measured.len() },
+            "method": args.method.to_string(),
+            "parameters": params_json(&fit.skin),
+            "fitted": {
+                "srgb": fitted_hex,
+                "lab": lab_json(fit.lab),
+                "lambda_nm": measured.lambda_nm(),
+                "reflectance": fit.model,
+            },
+            "residual": { "rms_reflectance": fit.rms },
+            "within_tolerance": fit.within_tolerance,
+            "max_rms_reflectance": opts.max_rms,
+            "beta_range": beta_json(fit.beta_range),
+            "beta_prior": opts.beta_prior,
+            "evaluations": fit.evaluations,
+        });
+        println!("{out}");
+    } else {
+        println!(
+            "{:<9}{} ({} wavelengths, {}-{} nm)",
+            "target",
+            path.display(),
+            measured.len(),
+            measured.lambda_nm()[0],
+            measured.lambda_nm()[measured.len() - 1]
+        );
+        println!("{}", skin_line(&fit.skin, args.method));
+        println!("{}", colour_line("fitted", &fitted_hex, fit.lab));
+        println!("{:<9}RMS reflectance = {:.5}", "residual", fit.rms);
+        if let Some(l) = beta_line(fit.beta_range, "RMS", opts.beta_prior) {
+            println!("{l}");
+        }
+    }
+    if !fit.within_tolerance {
+        anyhow::bail!(
+            "{}: no skin reproduces this spectrum; the nearest skin (above) has RMS reflectance error {:.3} (threshold {})",
+            path.display(),
+            fit.rms,
+            opts.max_rms
+        );
+    }
+    Ok(())
 }
