@@ -148,7 +148,7 @@ mod tests {
         let dir = std::env::temp_dir().join(format!("skin-film-{}", std::process::id()));
         let mut film = Film::new(4, 3);
         let white = xyz_white();
-        film.add_pass(&vec![white; 12]);
+        film.add_pass(&[white; 12]);
         film.write_exr(&dir.join("a.exr")).unwrap();
         film.write_png(&dir.join("a.png"), 0.0).unwrap();
         let img = exr::prelude::read_first_rgba_layer_from_file(

@@ -83,6 +83,9 @@ impl RenderStats {
     }
 }
 
+/// A tile's top-left pixel and its pixels' XYZ, row by row.
+type TileResult = ((usize, usize), Vec<[f32; 3]>);
+
 /// Seed of pixel `pixel`'s sample `sample`: a SplitMix64-style mix, decorrelated per sample.
 fn sample_seed(seed: u64, pixel: u64, sample: u32) -> u64 {
     let mut z = seed ^ pixel.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ (u64::from(sample) << 40);
@@ -148,7 +151,7 @@ fn render_passes(scene: &Scene, s: &RenderSettings) -> Result<(Film, RenderStats
     let mut pass = vec![[0.0f32; 3]; w * h];
     let mut last = Duration::ZERO;
     for sample in 0..s.spp {
-        let results: Vec<((usize, usize), Vec<[f32; 3]>)> = tiles
+        let results: Vec<TileResult> = tiles
             .par_iter()
             .map(|&(x0, y0)| {
                 let mut tile_rays = 0u64;

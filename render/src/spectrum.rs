@@ -224,6 +224,8 @@ pub fn luminance_of(s: impl Fn(f64) -> f64) -> f64 {
 #[derive(Debug, Clone, PartialEq)]
 pub struct SpectrumTable {
     values: Vec<f32>,
+    /// Mean of `values`, cached (light selection reads it per shading point).
+    mean: f32,
 }
 
 impl SpectrumTable {
@@ -237,7 +239,12 @@ impl SpectrumTable {
         let values = (0..n)
             .map(|i| f(f64::from(LAMBDA_MIN_NM + i as f32 * Self::STEP_NM)) as f32)
             .collect();
-        Self { values }
+        Self::from_values(values)
+    }
+
+    fn from_values(values: Vec<f32>) -> Self {
+        let mean = values.iter().sum::<f32>() / values.len() as f32;
+        Self { values, mean }
     }
 
     /// The same value at every wavelength.
@@ -270,16 +277,13 @@ impl SpectrumTable {
     /// Mean of the tabulated values.
     #[must_use]
     pub fn mean(&self) -> f32 {
-        self.values.iter().sum::<f32>() / self.values.len() as f32
+        self.mean
     }
 
     /// Multiply every value by `s`.
     #[must_use]
-    pub fn scaled(mut self, s: f32) -> Self {
-        for v in &mut self.values {
-            *v *= s;
-        }
-        self
+    pub fn scaled(self, s: f32) -> Self {
+        Self::from_values(self.values.into_iter().map(|v| v * s).collect())
     }
 }
 
