@@ -3,7 +3,8 @@
 //! Multipole profile knobs (poles, radial samples, transform nodes per panel): time of one
 //! `multipole::skin::profile` call (best of 3) against `multipole::skin::profile_error`'s maximum
 //! energy-density error relative to the converged reference. MC photon count: run time against the
-//! relative error of the total against adding-doubling (`Method::Exact`, independent exact transport).
+//! relative error of the total against adding-doubling (`Method::Exact`, independent exact transport),
+//! with the run's own relative standard error beside it (the error is noise of that size).
 
 use super::{Settings, Summary, progress, timed_mc, write_csv};
 use crate::montecarlo::{DEFAULT_SKIN_G, LayerStack, McOptions};
@@ -84,12 +85,15 @@ pub fn run(settings: &Settings, out: &Path, summary: &mut Summary) -> anyhow::Re
     }
     let exact = multipole::skin::diffuse_reflectance(&skin, lambda, Method::Exact)?;
     let stack = LayerStack::skin(&skin, lambda, DEFAULT_SKIN_G)?;
-    let mut mc_pts = Vec::new();
+    let (mut mc_pts, mut se_pts) = (Vec::new(), Vec::new());
     for &n in &photon_counts {
         let (r, s) = timed_mc(&stack, &McOptions::new(n, 16, settings.seed)?);
         let err = (r.diffuse_reflectance.mean - exact).abs() / exact;
         rows.push(format!("monte carlo photons,{n},{s:.6e},{err:.4e}"));
+        let se = r.diffuse_reflectance.stderr / exact;
+        rows.push(format!("monte carlo standard error,{n},{s:.6e},{se:.4e}"));
         mc_pts.push((s, err));
+        se_pts.push((s, se));
         bar.inc(1);
     }
     bar.finish_and_clear();
@@ -140,9 +144,11 @@ pub fn run(settings: &Settings, out: &Path, summary: &mut Summary) -> anyhow::Re
             Series::line(format!("multipole {knob}"), pts).with_style(SeriesStyle::LinePoints),
         );
     }
-    chart = chart.with_series(
-        Series::line("Monte Carlo photons", mc_pts).with_style(SeriesStyle::LinePoints),
-    );
+    chart = chart
+        .with_series(
+            Series::line("Monte Carlo photons", mc_pts).with_style(SeriesStyle::LinePoints),
+        )
+        .with_series(Series::dashed("Monte Carlo standard error", se_pts));
     write_csv(
         &out.join("knobs.csv"),
         "knob,setting,seconds,relative_error",
