@@ -217,3 +217,34 @@ fn bad_usage_exits_with_code_2() {
         stderr(&out)
     );
 }
+
+#[test]
+fn skin_spectrum_reports_lab_and_ita_on_stderr() {
+    let out = Command::new(env!("CARGO_BIN_EXE_skin"))
+        .args(["spectrum", "--preset", "medium", "--method", "multipole"])
+        .output()
+        .expect("run skin");
+    assert!(out.status.success(), "{}", stderr(&out));
+    let err = stderr(&out);
+    let line = err
+        .lines()
+        .find(|l| l.starts_with("lab L*="))
+        .expect("lab line");
+    // Same numbers as the fit's colour model at the same grid (400-700 nm every 10 nm).
+    let opts = FitOptions::default();
+    let model = ColourModel::new(10.0, opts.method, opts.base).unwrap();
+    let lab = model
+        .lab(&skin_optics::SkinParams::preset(
+            skin_optics::Preset::Medium,
+        ))
+        .unwrap();
+    let want = format!(
+        "lab L*={:.2} a*={:.2} b*={:.2} ITA°={:.1} ({})",
+        lab.l,
+        lab.a,
+        lab.b,
+        lab.ita_deg(),
+        lab.ita_category()
+    );
+    assert_eq!(line, want);
+}

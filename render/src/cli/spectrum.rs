@@ -149,9 +149,19 @@ pub fn run(args: &SpectrumArgs) -> anyhow::Result<()> {
 
     let reflectance =
         GridSpectrum::new(grid, rows.iter().map(|r| r.diffuse_reflectance).collect())?;
-    let srgb = reflectance_to_xyz(&reflectance).to_linear_srgb().to_srgb();
+    let xyz = reflectance_to_xyz(&reflectance);
+    let srgb = xyz.to_linear_srgb().to_srgb();
     let hex = srgb.to_hex();
     eprintln!("srgb {hex}");
+    let lab = skin_optics::lab::Lab::from_xyz(xyz);
+    eprintln!(
+        "lab L*={:.2} a*={:.2} b*={:.2} ITA°={:.1} ({})",
+        lab.l,
+        lab.a,
+        lab.b,
+        lab.ita_deg(),
+        lab.ita_category()
+    );
     if grid.start_nm() > 400.0 || grid.nm(grid.len() - 1) < 700.0 {
         eprintln!(
             "note: the grid does not cover 400-700 nm; the colour holds the end reflectances beyond it"
