@@ -239,7 +239,7 @@ mod tests {
         let model = ColourModel::new(opts.step_nm, opts.method, opts.base).unwrap();
         let mut rng = SplitMix(8);
         let mut worst: f64 = 0.0;
-        let cases = if cfg!(debug_assertions) { 20 } else { 200 };
+        let cases = 200;
         for _ in 0..cases {
             let p = [
                 rng.range(0.0, 0.5),
