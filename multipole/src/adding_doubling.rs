@@ -22,6 +22,9 @@
 mod layer;
 mod matrix;
 mod quadrature;
+mod split;
+
+pub use split::{LayerTotals, skin_layer_totals};
 
 use layer::{Angles, LayerBuild, Operator};
 use matrix::Mat;

@@ -173,18 +173,19 @@ impl Remainder {
 }
 
 /// Closed-form energy of the top layer's first source pair within radius r.
-fn head_cumulative(top: &Layer, r: f64) -> f64 {
-    match top {
-        Layer::Slab(s) => {
-            let st = s.medium().sigma_tr();
-            let z0 = s.source_depth_mm();
-            let zv = -z0 - 2.0 * s.medium().extrapolation_mm(s.a_boundaries().0);
-            0.5 * s.scattered_weight()
-                * s.medium().albedo_prime()
-                * (pole_energy_within(z0, r, st) - pole_energy_within(zv, r, st))
+fn head_cumulative(stack: &Stack, r: f64) -> f64 {
+    stack.head_scale()
+        * match stack.top() {
+            Layer::Slab(s) => {
+                let st = s.medium().sigma_tr();
+                let z0 = s.source_depth_mm();
+                let zv = -z0 - 2.0 * s.medium().extrapolation_mm(s.a_boundaries().0);
+                0.5 * s.scattered_weight()
+                    * s.medium().albedo_prime()
+                    * (pole_energy_within(z0, r, st) - pole_energy_within(zv, r, st))
+            }
+            Layer::SemiInfinite(d) => d.reflectance_within(r),
         }
-        Layer::SemiInfinite(d) => d.reflectance_within(r),
-    }
 }
 
 /// A first window radius (mm): the largest `fraction` radius of any layer's medium taken as a
@@ -202,8 +203,7 @@ fn window_estimate(stack: &Stack, fraction: f64) -> f64 {
 pub fn stack_profile(stack: &Stack, opts: &ProfileOptions) -> Result<Profile, MultipoleError> {
     opts.validate()?;
     let total = stack.total_reflectance(opts.poles);
-    let top = stack.top();
-    let cum = |rem: &Remainder, r: f64| head_cumulative(top, r) + rem.cumulative(r);
+    let cum = |rem: &Remainder, r: f64| head_cumulative(stack, r) + rem.cumulative(r);
     let (rem, r_max) = match opts.r_max_mm {
         Some(r) => (Remainder::compute(stack, opts, r), r),
         None => {
@@ -242,7 +242,7 @@ pub fn stack_profile(stack: &Stack, opts: &ProfileOptions) -> Result<Profile, Mu
     let mut r = r_min;
     for i in 0..n {
         let ri = if i == n - 1 { r_max } else { r };
-        let v = top.head_reflectance_mm2(ri) + rem.eval(ri);
+        let v = stack.head_reflectance_mm2(ri) + rem.eval(ri);
         // Converged values are ≥ 0; a negative one is numerical (truncated transform): clamp and count.
         let v = if v.is_finite() && v >= 0.0 {
             v
@@ -260,9 +260,8 @@ pub fn stack_profile(stack: &Stack, opts: &ProfileOptions) -> Result<Profile, Mu
 /// The stack's R(r) at the given radii (mm⁻²) by direct, converged quadrature (16-node Gauss panels
 /// of width π/r_max up to the 1e-14 cutoff, J0 from `libm`): the reference for knob errors.
 pub fn reference_reflectance(stack: &Stack, poles: Poles, radii_mm: &[f64]) -> Vec<f64> {
-    let top = stack.top();
     let r_hi = radii_mm.iter().copied().fold(1.0, f64::max);
-    let f = |q: f64| stack.reflectance_transform(q, poles) - top.head_transform(q);
+    let f = |q: f64| stack.reflectance_transform(q, poles) - stack.head_transform(q);
     let q_max = frequency_cutoff(f, 0.1 / r_hi, 1e5, 1e-14);
     let (gx, gw) = crate::hankel::gauss_legendre(16);
     let h = PI / r_hi;
@@ -278,7 +277,7 @@ pub fn reference_reflectance(stack: &Stack, poles: Poles, radii_mm: &[f64]) -> V
         .iter()
         .map(|&r| {
             let rem: f64 = nodes.iter().map(|(q, wf)| wf * libm::j0(q * r)).sum();
-            top.head_reflectance_mm2(r) + rem / (2.0 * PI)
+            stack.head_reflectance_mm2(r) + rem / (2.0 * PI)
         })
         .collect()
 }

@@ -35,6 +35,14 @@ pub struct Response {
 }
 
 impl Response {
+    /// Unit factors for [`Response::scaled`] (changes nothing).
+    pub const IDENTITY_SCALE: Self = Self {
+        r_down: 1.0,
+        t_down: 1.0,
+        r_up: 1.0,
+        t_up: 1.0,
+    };
+
     /// The identity layer: reflects nothing, transmits everything (a zero-thickness layer).
     pub const IDENTITY: Self = Self {
         r_down: 0.0,
@@ -42,6 +50,18 @@ impl Response {
         r_up: 0.0,
         t_up: 1.0,
     };
+
+    /// Componentwise product: a response rescaled by per-component factors (`factors` holds the
+    /// dimensionless multipliers of R̂↓, T̂↓, R̂↑, T̂↑).
+    #[must_use]
+    pub fn scaled(&self, factors: &Response) -> Response {
+        Response {
+            r_down: self.r_down * factors.r_down,
+            t_down: self.t_down * factors.t_down,
+            r_up: self.r_up * factors.r_up,
+            t_up: self.t_up * factors.t_up,
+        }
+    }
 
     /// `self` over `below`, directional Kubelka–Munk (module doc).
     #[must_use]
@@ -153,10 +173,12 @@ impl Layer {
     }
 }
 
-/// A vertical stack of layers, top first.
+/// A vertical stack of layers, top first, each with optional frequency-independent factors on its
+/// response (all 1 unless set by [`Stack::with_scales`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Stack {
     layers: Vec<Layer>,
+    scales: Vec<Response>,
 }
 
 impl Stack {
@@ -174,7 +196,50 @@ impl Stack {
                 "only the bottom layer may be semi-infinite",
             ));
         }
-        Ok(Self { layers })
+        let scales = vec![Response::IDENTITY_SCALE; n];
+        Ok(Self { layers, scales })
+    }
+
+    /// The same stack with each layer's response R̂(q), T̂(q) multiplied by constant factors (one
+    /// [`Response`] of multipliers per layer, top first): R̂_scaled(q) = R̂(q) · s, used to give each
+    /// diffusion layer an exact total before stacking (`skin::profile`). Factors must be finite and ≥ 0.
+    pub fn with_scales(mut self, scales: Vec<Response>) -> Result<Self, MultipoleError> {
+        if scales.len() != self.layers.len() {
+            return Err(MultipoleError::Stack("one scale per layer"));
+        }
+        let ok = |v: f64| v.is_finite() && v >= 0.0;
+        if !scales
+            .iter()
+            .all(|s| ok(s.r_down) && ok(s.t_down) && ok(s.r_up) && ok(s.t_up))
+        {
+            return Err(MultipoleError::Stack("layer scales must be finite and ≥ 0"));
+        }
+        self.scales = scales;
+        Ok(self)
+    }
+
+    /// The per-layer response factors, top first (all 1 for an unscaled stack).
+    #[must_use]
+    pub fn scales(&self) -> &[Response] {
+        &self.scales
+    }
+
+    /// Factor on the top layer's R̂↓, which also scales its closed-form head.
+    #[must_use]
+    pub fn head_scale(&self) -> f64 {
+        self.scales[0].r_down
+    }
+
+    /// Head transform of the top layer (its first source pair), scaled like its R̂↓.
+    #[must_use]
+    pub fn head_transform(&self, q: f64) -> f64 {
+        self.head_scale() * self.top().head_transform(q)
+    }
+
+    /// Closed-form spatial R(r) of the top layer's first source pair, scaled like its R̂↓, mm⁻².
+    #[must_use]
+    pub fn head_reflectance_mm2(&self, r_mm: f64) -> f64 {
+        self.head_scale() * self.top().head_reflectance_mm2(r_mm)
     }
 
     /// The layers, top first.
@@ -188,7 +253,10 @@ impl Stack {
     pub fn response(&self, q: f64, poles: Poles) -> Response {
         self.layers
             .iter()
-            .fold(Response::IDENTITY, |acc, l| acc.over(&l.response(q, poles)))
+            .zip(&self.scales)
+            .fold(Response::IDENTITY, |acc, (l, s)| {
+                acc.over(&l.response(q, poles).scaled(s))
+            })
     }
 
     /// R̂↓(q) − head̂(q): the stack's reflectance spectrum without the top layer's first source pair,
@@ -198,8 +266,11 @@ impl Stack {
         let (first, head) = self.layers[0].response_and_head(q, poles);
         let r = self.layers[1..]
             .iter()
-            .fold(first, |acc, l| acc.over(&l.response(q, poles)));
-        r.r_down - head
+            .zip(&self.scales[1..])
+            .fold(first.scaled(&self.scales[0]), |acc, (l, s)| {
+                acc.over(&l.response(q, poles).scaled(s))
+            });
+        r.r_down - self.head_scale() * head
     }
 
     /// R̂↓(q) of the stack, dimensionless.

@@ -76,7 +76,6 @@ impl Mat {
     }
 
     /// Matrix-vector product self · v.
-    #[cfg(test)]
     pub(crate) fn mul_vec(&self, v: &[f64]) -> Vec<f64> {
         let n = self.n;
         (0..n)
