@@ -16,7 +16,8 @@
 //!   batch order, so the same seed gives the same bits on any number of threads. Standard errors
 //!   come from the spread of the batch means.
 //!
-//! The module depends only on `skin-optics`, `brdf::fresnel`, `rand`/`rand_xoshiro` and `rayon`.
+//! The module depends only on `skin-optics`, `brdf::fresnel`, `rand`/`rand_xoshiro`/`rand_distr`
+//! (the ziggurat exponential) and `rayon`: it can move into `multipole` unchanged.
 
 mod stack;
 mod tally;

@@ -28,7 +28,8 @@ pub(crate) struct SlabOptics {
     inv_mu_t: f64,
     /// σa / σt: the fraction of the weight deposited at each interaction (implicit capture).
     absorb_fraction: f64,
-    g: f64,
+    /// Henyey–Greenstein sampling constants, precomputed (see [`HgSampler`]).
+    hg: HgSampler,
     n: f64,
     /// Index beyond the top and the bottom face of this layer.
     n_up: f64,
@@ -55,7 +56,7 @@ impl Medium {
                 mu_t,
                 inv_mu_t: if mu_t > 0.0 { 1.0 / mu_t } else { 0.0 },
                 absorb_fraction: if mu_t > 0.0 { l.sigma_a() / mu_t } else { 0.0 },
-                g: l.g(),
+                hg: HgSampler::new(l.g()),
                 n: l.n(),
                 n_up: if i == 0 {
                     stack.n_above()
@@ -81,14 +82,39 @@ fn uniform(rng: &mut impl RngCore) -> f64 {
     (rng.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
 }
 
-/// Cosine of the Henyey–Greenstein scattering angle ([WJZ95] eq 3.15; isotropic when g = 0).
-#[inline(always)]
-fn sample_hg_cos(g: f64, xi: f64) -> f64 {
-    if g.abs() < 1.0e-6 {
-        return 2.0 * xi - 1.0;
+/// Henyey–Greenstein cosine sampling ([WJZ95] eq 3.15) with the per-layer constants hoisted:
+/// cos θ = (1 + g² − t²) / (2g), t = (1 − g²) / (1 − g + 2gξ); isotropic (2ξ − 1) when g ≈ 0.
+#[derive(Debug, Clone, Copy)]
+struct HgSampler {
+    isotropic: bool,
+    one_plus_g2: f64,
+    one_minus_g2: f64,
+    one_minus_g: f64,
+    two_g: f64,
+    inv_two_g: f64,
+}
+
+impl HgSampler {
+    fn new(g: f64) -> Self {
+        let isotropic = g.abs() < 1.0e-6;
+        Self {
+            isotropic,
+            one_plus_g2: 1.0 + g * g,
+            one_minus_g2: 1.0 - g * g,
+            one_minus_g: 1.0 - g,
+            two_g: 2.0 * g,
+            inv_two_g: if isotropic { 0.0 } else { 0.5 / g },
+        }
     }
-    let t = (1.0 - g * g) / (1.0 - g + 2.0 * g * xi);
-    ((1.0 + g * g - t * t) / (2.0 * g)).clamp(-1.0, 1.0)
+
+    #[inline(always)]
+    fn cos_theta(&self, xi: f64) -> f64 {
+        if self.isotropic {
+            return 2.0 * xi - 1.0;
+        }
+        let t = self.one_minus_g2 / (self.one_minus_g + self.two_g * xi);
+        ((self.one_plus_g2 - t * t) * self.inv_two_g).clamp(-1.0, 1.0)
+    }
 }
 
 /// The photon state: position (mm), direction cosines, weight, current layer.
@@ -130,14 +156,6 @@ pub(crate) fn trace_batch(
         let mut s_left = 0.0;
         loop {
             let slab = &slabs[p.layer];
-            // Distance to the face the photon is heading for.
-            let d_face = if p.uz > 0.0 {
-                (slab.z_bottom - p.z) / p.uz
-            } else if p.uz < 0.0 {
-                (slab.z_top - p.z) / p.uz
-            } else {
-                f64::INFINITY
-            };
             let step = if slab.mu_t == 0.0 {
                 f64::INFINITY
             } else {
@@ -148,16 +166,25 @@ pub(crate) fn trace_batch(
                 }
                 s_left * slab.inv_mu_t
             };
-            if step >= d_face {
+            // Does the step reach the face the photon heads for? (No division unless it does.)
+            let z_new = p.z + step * p.uz;
+            let crosses = if p.uz > 0.0 {
+                z_new >= slab.z_bottom
+            } else {
+                p.uz < 0.0 && z_new <= slab.z_top
+            };
+            if crosses {
                 // Hit the face: move there, keep the unused optical depth, cross or reflect.
+                let up = p.uz < 0.0;
+                let d_face = (if up { slab.z_top } else { slab.z_bottom } - p.z) / p.uz;
                 p.x += d_face * p.ux;
                 p.y += d_face * p.uy;
+                // Rounding may make d_face exceed the step by an ulp: never carry a negative depth.
                 s_left = if slab.mu_t == 0.0 {
                     0.0
                 } else {
-                    (step - d_face) * slab.mu_t
+                    ((step - d_face) * slab.mu_t).max(0.0)
                 };
-                let up = p.uz < 0.0;
                 p.z = if up { slab.z_top } else { slab.z_bottom };
                 let n_next = if up { slab.n_up } else { slab.n_down };
                 let cos_i = p.uz.abs();
@@ -211,7 +238,7 @@ pub(crate) fn trace_batch(
             tally.absorbed_by_layer[p.layer] += dw;
             p.w -= dw;
             tally.interactions += 1;
-            scatter(&mut p, slab.g, rng);
+            scatter(&mut p, &slab.hg, rng);
             if p.w < ROULETTE_THRESHOLD {
                 if uniform(rng) < ROULETTE_SURVIVAL {
                     let gained = p.w * (1.0 / ROULETTE_SURVIVAL - 1.0);
@@ -244,8 +271,8 @@ fn sample_azimuth(rng: &mut impl RngCore) -> (f64, f64) {
 
 /// New direction after a Henyey–Greenstein scattering ([WJZ95] eqs 3.15–3.20).
 #[inline(always)]
-fn scatter(p: &mut Photon, g: f64, rng: &mut impl RngCore) {
-    let cos_t = sample_hg_cos(g, uniform(rng));
+fn scatter(p: &mut Photon, hg: &HgSampler, rng: &mut impl RngCore) {
+    let cos_t = hg.cos_theta(uniform(rng));
     let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
     let (cos_p, sin_p) = sample_azimuth(rng);
     if p.uz.abs() > COS_ZERO {
@@ -292,10 +319,8 @@ mod tests {
         let mut rng = Xoshiro256StarStar::seed_from_u64(1);
         for g in [0.0, 0.5, 0.9, -0.3] {
             let n = 200_000;
-            let m: f64 = (0..n)
-                .map(|_| sample_hg_cos(g, uniform(&mut rng)))
-                .sum::<f64>()
-                / n as f64;
+            let hg = HgSampler::new(g);
+            let m: f64 = (0..n).map(|_| hg.cos_theta(uniform(&mut rng))).sum::<f64>() / n as f64;
             // sd of cos θ ≤ 1, so 5 standard errors ≤ 5/√n ≈ 0.011.
             assert!((m - g).abs() < 0.011, "g {g}: mean cosine {m}");
         }
