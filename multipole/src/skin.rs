@@ -14,6 +14,9 @@ use skin_optics::{SkinParams, Wavelength, WavelengthGrid};
 use std::fmt;
 use std::str::FromStr;
 
+mod explain;
+pub use explain::{DIFFUSION_OK, Explanation, explain};
+
 /// How the skin's diffuse reflectance is computed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[non_exhaustive]
