@@ -22,7 +22,9 @@
 //! the geometric middle of its range and the light preset's value; the β_m term fades out below
 //! C_m ≈ 0.001 where β_m means nothing), with w = [`FitOptions::prior_weight_de`] = 0.01 ΔE00 for
 //! colours and [`FitOptions::prior_weight_rms`] = 1e-4 reflectance for spectra. It costs at most about
-//! 0.01 ΔE00, so it only decides between fits the data cannot tell apart. The result then reports
+//! 0.01 ΔE00, so it only decides between fits the data cannot tell apart. (A colour fit stops
+//! refining further starts once one reproduces the target to ΔE00 < 0.001, [`EXACT_DE`], so the prior
+//! then acts within that start's basin; the sweep still reports every β_m the colour allows.) The result then reports
 //! which β_m the data do allow ([`BetaRange`]): β_m is swept over [`FitOptions::beta_scan`] values
 //! with C_m and C_h refitted at each, and the connected range around the fit whose residual stays
 //! within a tolerance of the best is returned.

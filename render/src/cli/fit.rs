@@ -102,7 +102,7 @@ fn skin_line(skin: &SkinParams, method: Method) -> String {
 fn beta_line(range: Option<BetaRange>, unit: &str, prior: f64) -> Option<String> {
     range.map(|r| {
         format!(
-            "{:<9}the target allows β_m in [{:.1}, {:.1}] (residual within {} {unit} of the best); ties go to β_m = {prior}",
+            "{:<9}allowed range [{:.1}, {:.1}] (residual within {} {unit} of the best; ties resolved towards β_m = {prior})",
             "β_m", r.min, r.max, r.tolerance
         )
     })
