@@ -27,10 +27,15 @@ pub struct ProfileArgs {
     /// Number of radii, geometric from 0.001 mm to the outer radius, in [2, 1000000].
     #[arg(long, value_name = "N", default_value_t = 256, value_parser = parse_samples, allow_hyphen_values = true)]
     pub samples: usize,
-    /// Profile method: exact (the default: exact adding-doubling total, diffusion shape) or
+    /// Profile method: exact (the default: exact adding-doubling total, diffusion layers rescaled to
+    /// exact per-layer totals) or
     /// multipole (the paper's diffusion, too bright for dark skin).
     #[arg(long, value_name = "METHOD", default_value_t = Method::default(), value_parser = parse_method)]
     pub method: Method,
+    /// Print to stderr the treatment used and why (layer albedos, epidermis thickness in mean free
+    /// paths, diffusion versus exact total, the exact profile's per-layer factors).
+    #[arg(long)]
+    pub explain: bool,
     /// Also draw the profiles at 450, 550 and 650 nm on log axes to this PNG file.
     #[arg(long, value_name = "FILE.png")]
     pub plot: Option<PathBuf>,
@@ -83,6 +88,12 @@ pub fn run(args: &ProfileArgs) -> anyhow::Result<()> {
     };
     let lambda = Wavelength::new(args.lambda).context("--lambda")?;
     let prof = profile(&skin, lambda, args.method, &opts)?;
+    if args.explain {
+        eprintln!(
+            "{}",
+            multipole::skin::explain(&skin, lambda, args.method, true).context("--explain")?
+        );
+    }
     let stdout = std::io::stdout();
     let mut out = BufWriter::new(stdout.lock());
     writeln!(out, "r_mm,reflectance_per_mm2")?;

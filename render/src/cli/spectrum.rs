@@ -60,6 +60,10 @@ pub struct SpectrumArgs {
     /// skin tone) or multipole (the paper's diffusion, [DJ05]; too bright for dark skin).
     #[arg(long, value_name = "NAME", default_value_t = Method::default())]
     pub method: Method,
+    /// Print to stderr, per wavelength, the treatment used and why (layer albedos, epidermis thickness
+    /// in mean free paths, diffusion versus exact total).
+    #[arg(long)]
+    pub explain: bool,
     /// Also draw the absorption spectra (log axis, 1 nm resolution) and the reflectance to this PNG.
     #[arg(long, value_name = "FILE.png")]
     pub plot: Option<PathBuf>,
@@ -142,6 +146,15 @@ pub fn run(args: &SpectrumArgs) -> anyhow::Result<()> {
     let skin = args.skin.to_params()?;
     let grid = grid(args)?;
     let rows = rows(&skin, &grid, args.method)?;
+    if args.explain {
+        for lambda in grid.iter() {
+            eprintln!(
+                "{}",
+                multipole::skin::explain(&skin, lambda, args.method, false)
+                    .with_context(|| format!("--explain at {} nm", lambda.nm()))?
+            );
+        }
+    }
     let stdout = io::stdout();
     let mut out = io::BufWriter::new(stdout.lock());
     write_csv(&mut out, &rows)?;
