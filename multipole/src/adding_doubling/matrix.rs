@@ -98,6 +98,15 @@ impl Mat {
         out
     }
 
+    /// I + self.
+    pub(crate) fn identity_plus(&self) -> Mat {
+        let mut out = self.clone();
+        for i in 0..self.n {
+            out[(i, i)] += 1.0;
+        }
+        out
+    }
+
     /// I − self.
     pub(crate) fn identity_minus(&self) -> Mat {
         let mut out = self.clone();
@@ -214,6 +223,7 @@ fn swap_rows(m: &mut [f64], cols: usize, i: usize, j: usize) {
 }
 
 impl Mat {
+    #[cfg(test)]
     /// self · self for a symmetric self (the result is symmetric: upper triangle by row dot products,
     /// mirrored).
     pub(crate) fn symmetric_square(&self) -> Mat {
