@@ -139,7 +139,8 @@ pub(crate) fn redistribution(angles: &Angles, g: f64) -> (Mat, Mat) {
 /// last weight, g) bits, which identify a grid of this module; a few entries per process.
 fn redistribution_cached(angles: &Angles, g: f64) -> Arc<(Mat, Mat)> {
     type Key = (usize, u64, u64, u64);
-    static CACHE: OnceLock<Mutex<HashMap<Key, Arc<(Mat, Mat)>>>> = OnceLock::new();
+    type Cache = Mutex<HashMap<Key, Arc<(Mat, Mat)>>>;
+    static CACHE: OnceLock<Cache> = OnceLock::new();
     let n = angles.n();
     let key = (
         n,
