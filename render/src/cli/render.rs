@@ -20,10 +20,10 @@ pub struct RenderArgs {
     #[arg(long, value_name = "N", default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..))]
     pub spp: u32,
     /// Image width, pixels.
-    #[arg(long, value_name = "W", default_value_t = 768, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    #[arg(long, value_name = "W", default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=16384))]
     pub width: u32,
     /// Image height, pixels.
-    #[arg(long, value_name = "H", default_value_t = 384, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    #[arg(long, value_name = "H", default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=16384))]
     pub height: u32,
     /// Wall-clock budget in seconds: no pass starts that would end past it (0 = no limit).
     #[arg(long, value_name = "SECONDS", default_value_t = 60.0)]
