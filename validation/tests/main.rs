@@ -3,5 +3,6 @@
 //! Photon counts are scaled down in debug builds (`cargo test` without `--release`): every
 //! tolerance is stated in standard errors, so the tests stay meaningful at either count.
 
+mod exact;
 mod montecarlo;
 mod properties;

@@ -30,6 +30,18 @@ struct Cli {
 enum Command {
     /// One Monte Carlo run for a skin at one wavelength; prints one CSV line with its header.
     Mc(McArgs),
+    /// Only the exact-versus-multipole study (totals over C_m, light/dark profiles) into --out.
+    Exact(ExactArgs),
+}
+
+#[derive(Args, Debug)]
+struct ExactArgs {
+    /// Fewer wavelengths and photons (well under two minutes).
+    #[arg(long)]
+    quick: bool,
+    /// Output folder for the charts, CSV and summary.
+    #[arg(long, value_name = "DIR", default_value = "out/validation")]
+    out: PathBuf,
 }
 
 /// Parse a wavelength in nm, [250, 1000].
@@ -100,6 +112,7 @@ fn main() {
     let cli = Cli::parse();
     let result = match &cli.command {
         Some(Command::Mc(args)) => run_mc(args),
+        Some(Command::Exact(args)) => validation::compare::run_exact(args.quick, &args.out),
         None => validation::compare::run_comparison(cli.quick, &cli.out),
     };
     if let Err(e) = result {

@@ -5,12 +5,14 @@
 //! 1. [`spectra`]: observable diffuse reflectance over 400–700 nm per preset, multipole vs MC;
 //! 2. [`profiles`]: radial profiles at 450/550/650 nm for the light preset (log axis);
 //! 3. [`stability`]: diffusion's relative error over reduced albedo × slab thickness;
-//! 4. [`knobs`]: time against error for every knob of `multipole` and the MC photon count.
+//! 4. [`knobs`]: time against error for every knob of `multipole` and the MC photon count;
+//! 5. [`exact`]: `Method::Exact` beside `Method::Multipole` against MC, totals over C_m and profiles.
 //!
 //! The observable compared is the diffuse reflectance per incident photon at normal incidence,
 //! specular excluded: the MC's R_d against (1 − F_r(0)) R_d of diffusion
 //! (`multipole::skin::diffuse_reflectance`).
 
+pub mod exact;
 pub mod knobs;
 pub mod profiles;
 pub mod spectra;
@@ -134,7 +136,27 @@ pub(crate) fn write_csv(path: &Path, header: &str, rows: &[String]) -> anyhow::R
         .with_context(|| format!("writing {}", path.display()))
 }
 
-/// Run all four studies into `out` and write `summary.md`; prints the total time.
+/// Run only study 5 ([`exact`]) into `out` and write `summary.md`; prints the total time.
+pub fn run_exact(quick: bool, out: &Path) -> anyhow::Result<()> {
+    let settings = Settings::new(quick);
+    let start = Instant::now();
+    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    let mut summary = Summary::default();
+    exact::run(&settings, out, &mut summary)?;
+    let seconds = start.elapsed().as_secs_f64();
+    let command = format!(
+        "cargo run --release -p validation --bin skin-validate -- exact{} --out {}",
+        if quick { " --quick" } else { "" },
+        out.display()
+    );
+    let md = summary.to_markdown(&command, seconds);
+    render::atomic::write_bytes(&out.join("summary.md"), md.as_bytes())?;
+    println!("{md}");
+    eprintln!("skin-validate: wrote {} in {seconds:.1} s", out.display());
+    Ok(())
+}
+
+/// Run all five studies into `out` and write `summary.md`; prints the total time.
 pub fn run_comparison(quick: bool, out: &Path) -> anyhow::Result<()> {
     let settings = Settings::new(quick);
     let start = Instant::now();
@@ -144,6 +166,7 @@ pub fn run_comparison(quick: bool, out: &Path) -> anyhow::Result<()> {
     profiles::run(&settings, out, &mut summary)?;
     stability::run(&settings, out, &mut summary)?;
     knobs::run(&settings, out, &mut summary)?;
+    exact::run(&settings, out, &mut summary)?;
     let seconds = start.elapsed().as_secs_f64();
     let command = format!(
         "cargo run --release -p validation --bin skin-validate --{} --out {}",

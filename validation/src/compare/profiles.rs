@@ -12,7 +12,7 @@ use std::path::Path;
 pub const PROFILE_WAVELENGTHS_NM: [f64; 3] = [450.0, 550.0, 650.0];
 
 /// Mean of the multipole profile over annulus `i` (area weighted, 8 points), observable scale.
-fn annulus_mean(p: &multipole::Profile, grid: &RadialGrid, i: usize, eta: f64) -> f64 {
+pub(crate) fn annulus_mean(p: &multipole::Profile, grid: &RadialGrid, i: usize, eta: f64) -> f64 {
     let (r0, dr) = (i as f64 * grid.dr_mm(), grid.dr_mm());
     let (mut num, mut den) = (0.0, 0.0);
     for k in 0..8 {
