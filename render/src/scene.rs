@@ -327,8 +327,10 @@ impl Loader<'_> {
                         }
                         _ if albedo_texture.is_some() => SpectrumTable::constant(1.0),
                         _ => {
-                            return Err(self
-                                .err(&key, "expected one of albedo, albedo_srgb, albedo_spectrum"));
+                            return Err(self.err(
+                                &key,
+                                "expected one of albedo, albedo_srgb, albedo_spectrum",
+                            ));
                         }
                     };
                     Material::Diffuse(DiffuseMaterial {
