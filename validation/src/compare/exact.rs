@@ -46,17 +46,17 @@ fn spectra(settings: &Settings, out: &Path, summary: &mut Summary) -> anyhow::Re
     for (k, &cm) in MELANIN_FRACTIONS.iter().enumerate() {
         let skin = SkinParams::new(cm, EUMELANIN_BLEND, HEMOGLOBIN, 0.0)?;
         let mut curves: [Vec<(f64, f64)>; 2] = [Vec::new(), Vec::new()];
-        let mut worst = [(0.0f64, 0.0f64); 2];
+        let mut worst = [(0.0f64, 0.0f64, 0.0f64); 2];
         for lambda in grid.iter() {
             let stack = LayerStack::skin(&skin, lambda, DEFAULT_SKIN_G)?;
-            let opts = McOptions::new(settings.spectrum_photons, 16, settings.seed)?;
+            let opts = McOptions::new(settings.exact_photons, 16, settings.seed)?;
             let mc = montecarlo::run(&stack, &opts).diffuse_reflectance;
             let mut values = [0.0; 2];
             for (j, method) in METHODS.into_iter().enumerate() {
                 let v = multipole::skin::diffuse_reflectance(&skin, lambda, method)?;
                 let rel = (v - mc.mean) / mc.mean;
                 if rel.abs() > worst[j].0.abs() {
-                    worst[j] = (rel, lambda.nm());
+                    worst[j] = (rel, lambda.nm(), mc.stderr / mc.mean);
                 }
                 curves[j].push((lambda.nm(), 100.0 * rel));
                 values[j] = v;
@@ -70,7 +70,7 @@ fn spectra(settings: &Settings, out: &Path, summary: &mut Summary) -> anyhow::Re
                 mc.stderr,
                 (values[0] - mc.mean) / mc.mean,
                 (values[1] - mc.mean) / mc.mean,
-                settings.spectrum_photons
+                settings.exact_photons
             ));
             bar.inc(1);
         }
@@ -86,7 +86,7 @@ fn spectra(settings: &Settings, out: &Path, summary: &mut Summary) -> anyhow::Re
                 "5 exact vs multipole",
                 &format!("{method}, C_m {cm} (β_m {EUMELANIN_BLEND}, C_h {HEMOGLOBIN})"),
                 format!("{:+.1}%", 100.0 * worst[j].0),
-                format!("{} nm", worst[j].1),
+                format!("{} nm (MC ±{:.1}%)", worst[j].1, 100.0 * worst[j].2),
             );
         }
     }

@@ -34,6 +34,8 @@ pub struct Settings {
     pub spectrum_photons: u64,
     /// Photons per MC run of the radial profiles.
     pub profile_photons: u64,
+    /// Photons per MC run of the exact-versus-multipole spectra (dark skin needs many: R_d ≈ 0.005).
+    pub exact_photons: u64,
     /// Cells per axis of the stability map.
     pub stability_cells: usize,
     /// Photons per cell of the stability map.
@@ -53,6 +55,7 @@ impl Settings {
                 spectrum_step_nm: 100.0,
                 spectrum_photons: 10_000,
                 profile_photons: 40_000,
+                exact_photons: 100_000,
                 stability_cells: 6,
                 stability_photons: 3_000,
                 knob_max_photons: 30_000,
@@ -63,6 +66,7 @@ impl Settings {
                 spectrum_step_nm: 10.0,
                 spectrum_photons: 50_000,
                 profile_photons: 1_000_000,
+                exact_photons: 300_000,
                 stability_cells: 12,
                 stability_photons: 20_000,
                 knob_max_photons: 1_000_000,
