@@ -1,7 +1,15 @@
 //! Materials and their BSDFs at a shading point: `Skin` (oily Torrance–Sparrow surface over a
 //! diffusing body) and `Diffuse` (Lambert) for backdrops.
 //!
-//! # Skin until subsurface scattering lands (issue 7)
+//! # Skin with subsurface scattering (issue 7, the default)
+//!
+//! When the material carries a [`Subsurface`] model, its BSDF is the surface lobe alone
+//! (`Lobes::SkinSurface`) and the body is rendered by the separable BSSRDF in the integrator
+//! (`crate::bssrdf`): at each skin hit the path follows the surface lobe with probability p
+//! (∝ ρ_dr(θ_o) against T(θ_o) R̄_tot) or the subsurface branch with 1 − p. The energy split is
+//! the same as below, so on a flat slab both forms render the same radiance.
+//!
+//! # Skin without subsurface scattering (`--no-subsurface`)
 //!
 //! Skin shades as its surface lobe ([TS67], `brdf::TorranceSparrow`, m = 0.3, ρ_s from the
 //! `SkinParams`, η = 1.4) plus a Lambertian body term built from the multipole model's total
@@ -19,6 +27,7 @@
 //! spatial detail (brows, lips, pores) without replacing the model's spectral colour; the product
 //! is clamped at 1.
 
+use crate::bssrdf::Subsurface;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths, SpectrumTable, linear_srgb_at_nm};
 use crate::texture::{Texture, luminance};
 use brdf::{Frame, TorranceSparrow};
@@ -48,6 +57,8 @@ pub struct SkinMaterial {
     pub albedo_texture: Option<TextureRef>,
     /// T̄ = ∫ T(θ) 2 cosθ dcosθ, the cosine-weighted mean of the transmitted fraction.
     pub mean_transmitted: f32,
+    /// The BSSRDF (issue 7); when present it replaces the Lambertian body term.
+    pub subsurface: Option<Subsurface>,
 }
 
 impl SkinMaterial {
@@ -73,7 +84,23 @@ impl SkinMaterial {
             total_reflectance,
             albedo_texture,
             mean_transmitted,
+            subsurface: None,
         }
+    }
+
+    /// The same skin shading its body with the BSSRDF `subsurface` instead of the Lambertian term.
+    #[must_use]
+    pub fn with_subsurface(mut self, subsurface: Subsurface) -> Self {
+        self.subsurface = Some(subsurface);
+        self
+    }
+
+    /// The albedo texture's relative luminance m(uv) (texture luminance / its mean; 1 without one).
+    #[must_use]
+    pub fn texture_factor(&self, uv: Vec2, textures: &[Texture]) -> f32 {
+        self.albedo_texture.map_or(1.0, |t| {
+            luminance(textures[t.index].lookup(uv)) / t.mean_luminance
+        })
     }
 }
 
@@ -114,6 +141,13 @@ enum Lobes<'a> {
         /// ρ(λ) / π.
         body: SampledSpectrum,
     },
+    /// Skin whose body is rendered by the BSSRDF: only the surface lobe is a BSDF here; the
+    /// integrator takes the subsurface branch with probability 1 − p (`subsurface_probability`).
+    SkinSurface {
+        surface: &'a TorranceSparrow,
+        /// Mean over the path's wavelengths of R_tot(λ) m(uv), for choosing the branch.
+        subsurface_albedo: f32,
+    },
 }
 
 /// A sampled incident direction with the BSDF value and density there.
@@ -139,10 +173,15 @@ impl Material {
     ) -> Bsdf<'a> {
         let frame = Frame::from_normal(n);
         let lobes = match self {
+            Material::Skin(s) if s.subsurface.is_some() => {
+                let m = s.texture_factor(uv, textures);
+                Lobes::SkinSurface {
+                    surface: &s.surface,
+                    subsurface_albedo: (s.total_reflectance.eval(wl).average() * m).min(1.0),
+                }
+            }
             Material::Skin(s) => {
-                let m = s.albedo_texture.map_or(1.0, |t| {
-                    luminance(textures[t.index].lookup(uv)) / t.mean_luminance
-                });
+                let m = s.texture_factor(uv, textures);
                 let rd = s.total_reflectance.eval(wl).map(|r| (r * m).min(1.0));
                 Lobes::Skin {
                     surface: &s.surface,
@@ -181,6 +220,18 @@ impl Bsdf<'_> {
                 *body * split + SampledSpectrum::splat(surface.eval(o, i))
             }
             Lobes::Lambert { body } => *body,
+            Lobes::SkinSurface { surface, .. } => SampledSpectrum::splat(surface.eval(o, i)),
+        }
+    }
+
+    /// Probability that the integrator follows the subsurface branch at this point for `wo`
+    /// (0 unless the skin's body is rendered by the BSSRDF).
+    #[must_use]
+    pub fn subsurface_probability(&self, wo: Vec3) -> f32 {
+        let o = self.frame.to_local(wo);
+        match &self.lobes {
+            Lobes::SkinSurface { .. } if o.z > 0.0 => 1.0 - self.specular_probability(o.z),
+            _ => 0.0,
         }
     }
 
@@ -193,6 +244,20 @@ impl Bsdf<'_> {
                 let d = body.average() * std::f32::consts::PI * surface.transmitted_fraction(o_z);
                 if s <= 0.0 {
                     0.0
+                } else if d <= 0.0 {
+                    1.0
+                } else {
+                    (s / (s + d)).clamp(0.05, 0.95)
+                }
+            }
+            Lobes::SkinSurface {
+                surface,
+                subsurface_albedo,
+            } => {
+                let s = surface.directional_albedo(o_z);
+                let d = subsurface_albedo * surface.transmitted_fraction(o_z);
+                if s <= 0.0 {
+                    0.05
                 } else if d <= 0.0 {
                     1.0
                 } else {
@@ -214,6 +279,8 @@ impl Bsdf<'_> {
         let diffuse = i.z * FRAC_1_PI;
         match &self.lobes {
             Lobes::Skin { surface, .. } => p * surface.pdf(o, i) + (1.0 - p) * diffuse,
+            // The other branch (1 − p) leaves through the BSSRDF, not through a direction here.
+            Lobes::SkinSurface { surface, .. } => p * surface.pdf(o, i),
             Lobes::Lambert { .. } => diffuse,
         }
     }
@@ -228,6 +295,8 @@ impl Bsdf<'_> {
         let p = self.specular_probability(o.z);
         let i = match &self.lobes {
             Lobes::Skin { surface, .. } if u_lobe < p => surface.sample(o, [u.x, u.y])?.wi,
+            // The integrator already chose the surface branch (with probability p).
+            Lobes::SkinSurface { surface, .. } => surface.sample(o, [u.x, u.y])?.wi,
             _ => crate::light::cosine_hemisphere(u),
         };
         if i.z <= 0.0 {

@@ -4,6 +4,7 @@
 //! Scene files are parsed by `scene_file` and validated here; every error names the file, the key
 //! and what was expected, and a missing mesh or texture names its path.
 
+use crate::bssrdf::{Directional, EnergySplit, ProfileTable, Subsurface, TableOptions};
 use crate::builtin;
 use crate::camera::Camera;
 use crate::error::RenderError;
@@ -28,6 +29,9 @@ use std::path::{Path, PathBuf};
 pub struct SceneOptions {
     /// How skin reflectance is computed (multipole diffusion).
     pub method: multipole::Method,
+    /// Shade skin's body with the Lambertian stand-in instead of the BSSRDF (for comparisons;
+    /// default false: subsurface scattering on).
+    pub no_subsurface: bool,
 }
 
 /// What a ray hit first: a surface or an area light.
@@ -291,7 +295,13 @@ impl Loader<'_> {
                     .map_err(|e| self.err(format!("{key}.roughness"), e.to_string()))?;
                     let tex = texture(albedo_texture)?;
                     let rd = self.skin_table(&key, &params)?;
-                    Material::Skin(SkinMaterial::new(params, surface, rd, tex))
+                    let skin = SkinMaterial::new(params, surface, rd, tex);
+                    if self.opts.no_subsurface {
+                        Material::Skin(skin)
+                    } else {
+                        let ss = self.subsurface(&key, &skin)?;
+                        Material::Skin(skin.with_subsurface(ss))
+                    }
                 }
                 MaterialDesc::Diffuse {
                     albedo,
@@ -482,6 +492,15 @@ impl Loader<'_> {
     }
 
     /// R_d(λ) of a skin from the multipole model at 10-nm steps over 380–780 nm.
+    /// The BSSRDF of a skin: its radial profiles at 10-nm steps (`bssrdf::ProfileTable`) and the
+    /// directional term with the surface lobe's energy split.
+    fn subsurface(&self, key: &str, skin: &SkinMaterial) -> Result<Subsurface, RenderError> {
+        let table = ProfileTable::build(&skin.params, self.opts.method, &TableOptions::default())
+            .map_err(|e| self.err(key, format!("skin profiles: {e}")))?;
+        let directional = Directional::new(skin.surface.clone(), EnergySplit::default());
+        Ok(Subsurface::new(std::sync::Arc::new(table), directional))
+    }
+
     fn skin_table(&self, key: &str, params: &SkinParams) -> Result<SpectrumTable, RenderError> {
         let n = ((780.0 - 380.0) / SKIN_TABLE_STEP_NM) as usize + 1;
         let rd = (0..n)

@@ -34,9 +34,13 @@ pub struct RenderArgs {
     /// Worker threads (default: all cores).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=1024))]
     pub threads: Option<u32>,
-    /// Skin reflectance method.
-    #[arg(long, value_name = "M", default_value = "multipole")]
+    /// Skin reflectance method (the BSSRDF's radial profiles and the totals).
+    #[arg(long, value_name = "M", default_value_t = multipole::Method::default())]
     pub method: multipole::Method,
+    /// Shade skin's body with a Lambertian term of its total diffuse reflectance instead of the
+    /// BSSRDF (no light transport under the skin; for comparisons and timing).
+    #[arg(long)]
+    pub no_subsurface: bool,
     /// PNG exposure in stops, added to the scene's own.
     #[arg(
         long,
@@ -69,6 +73,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         &args.scene,
         &SceneOptions {
             method: args.method,
+            no_subsurface: args.no_subsurface,
         },
     )?;
     let load = t0.elapsed();
