@@ -36,7 +36,14 @@ pub struct Accel {
 /// A ray from `origin` along unit `dir`, valid for t in [`tmin`, `tmax`] (mm).
 #[must_use]
 pub fn ray(origin: Vec3, dir: Vec3, tmin: f32, tmax: f32) -> Ray {
-    Ray::new(Vec3A::from(origin), Vec3A::from(dir), tmin, tmax)
+    // `+ 0.0` turns −0.0 direction components into +0.0: obvhs 0.4's CWBVH traversal misses
+    // axis-aligned rays whose zero components are −0.0 (1/−0 = −∞ picks the wrong octant).
+    Ray::new(
+        Vec3A::from(origin),
+        Vec3A::from(dir + Vec3::ZERO),
+        tmin,
+        tmax,
+    )
 }
 
 impl Accel {
@@ -209,6 +216,31 @@ mod tests {
             hits > 4000,
             "only {hits} hits: the test would not test much"
         );
+    }
+
+    /// Axis-aligned rays with −0.0 components hit a flat quad (obvhs misses them unless the
+    /// direction is canonicalised in `ray`).
+    #[test]
+    fn negative_zero_directions_hit() {
+        let q = [
+            [
+                Vec3::new(-1.0, -1.0, 0.0),
+                Vec3::new(1.0, -1.0, 0.0),
+                Vec3::new(1.0, 1.0, 0.0),
+            ],
+            [
+                Vec3::new(-1.0, -1.0, 0.0),
+                Vec3::new(1.0, 1.0, 0.0),
+                Vec3::new(-1.0, 1.0, 0.0),
+            ],
+        ];
+        let accel = Accel::build(&q);
+        let dir = -Vec3::Z; // (−0, −0, −1)
+        let h = accel.closest(&ray(Vec3::new(0.3, -0.2, 1.0), dir, 0.0, f32::INFINITY));
+        assert!(h.is_some_and(|h| (h.t - 1.0).abs() < 1e-6), "{h:?}");
+        let mut n = 0;
+        accel.for_each_hit(&ray(Vec3::new(0.3, -0.2, 1.0), dir, 0.0, 2.0), |_| n += 1);
+        assert_eq!(n, 1);
     }
 
     /// A shadow ray is blocked exactly when its length exceeds the closest-hit distance.
