@@ -4,52 +4,14 @@
 //! at the edges of their ranges render finite, non-negative images.
 
 use render::bssrdf::{Directional, EnergySplit};
-use render::film::Film;
-use render::renderer::{RenderSettings, render};
-use render::scene::{Scene, SceneOptions};
-use skin_optics::color::{cie_xyz_bar, cie_y_integral, d65};
+mod common;
+
+use common::{mean_xyz, run, scene, xyz_of};
+use skin_optics::color::d65;
 use skin_optics::{Preset, SkinParams, Wavelength};
 
-fn scene(text: &str) -> Scene {
-    Scene::from_toml(text, "test.toml", None, &SceneOptions::default()).unwrap()
-}
-
-fn run(scene: &Scene, w: usize, h: usize, spp: u32) -> Film {
-    let settings = RenderSettings {
-        width: w,
-        height: h,
-        spp,
-        seed: 7,
-        ..Default::default()
-    };
-    render(scene, &settings).unwrap().0
-}
-
-fn mean_xyz(film: &Film) -> [f64; 3] {
-    let (w, h) = film.size();
-    let mut s = [0.0f64; 3];
-    for y in 0..h {
-        for x in 0..w {
-            let v = film.xyz(x, y);
-            for c in 0..3 {
-                s[c] += f64::from(v[c]) / (w * h) as f64;
-            }
-        }
-    }
-    s
-}
-
-/// XYZ of a spectrum over 380–780 nm, normalised like the film (constant 1 has Y = 1 / ∫ȳ·∫ȳ).
-fn xyz_of(s: impl Fn(f64) -> f64) -> [f64; 3] {
-    let mut xyz = [0.0; 3];
-    for nm in 380..=780 {
-        let bar = cie_xyz_bar(f64::from(nm));
-        for c in 0..3 {
-            xyz[c] += s(f64::from(nm)) * bar[c];
-        }
-    }
-    xyz.map(|v| v / cie_y_integral())
-}
+/// Seed of every render in this file.
+const SEED: u64 = 7;
 
 /// A 2 m wide slab of skin under a distant D65 light of irradiance E (luminance 1) at normal
 /// incidence, seen head-on, has radiance E(λ) [f_s(n, n) + T(0°) R_tot(λ) T(0°) / (π c)]
@@ -78,7 +40,7 @@ fn flat_slab_renders_to_the_total_diffuse_reflectance_plus_specular() {
             intensity = 1
             "#
         ));
-        let film = run(&s, 32, 32, 48);
+        let film = run(&s, 32, 32, 48, SEED);
         let skin = SkinParams::preset(preset.parse::<Preset>().unwrap());
         let ts = brdf::TorranceSparrow::new(
             brdf::DEFAULT_ROUGHNESS,
@@ -140,7 +102,7 @@ fn skin_sphere_in_a_white_furnace_never_exceeds_the_environment() {
             "#,
             radius * 8.0
         ));
-        let film = run(&s, 24, 24, 32);
+        let film = run(&s, 24, 24, 32, SEED);
         let y = xyz_of(|_| 1.0)[1];
         let env = xyz_of(|_| 1.0 / y);
         let got = mean_xyz(&film);
@@ -191,7 +153,7 @@ fn edge_parameters_render_finite_non_negative_images() {
             intensity = 30
             "#
         ));
-        let film = run(&s, 16, 16, 4);
+        let film = run(&s, 16, 16, 4, SEED);
         let (w, h) = film.size();
         let mut total = 0.0;
         for py in 0..h {

@@ -2,61 +2,14 @@
 //! plane under a distant light, D65 round trip to sRGB white, bad scenes, the default scene,
 //! and thread-count independence.
 
-use render::film::Film;
+mod common;
+
+use common::{assert_close, mean_xyz, run, scene, xyz_of};
 use render::renderer::{RenderSettings, render};
 use render::scene::{Scene, SceneOptions};
-use skin_optics::color::cie_xyz_bar;
 
-fn scene(text: &str) -> Scene {
-    Scene::from_toml(text, "test.toml", None, &SceneOptions::default()).unwrap()
-}
-
-fn run(scene: &Scene, w: usize, h: usize, spp: u32) -> Film {
-    let settings = RenderSettings {
-        width: w,
-        height: h,
-        spp,
-        seed: 42,
-        ..Default::default()
-    };
-    render(scene, &settings).unwrap().0
-}
-
-/// Mean XYZ over the whole film.
-fn mean_xyz(film: &Film) -> [f64; 3] {
-    let (w, h) = film.size();
-    let mut s = [0.0f64; 3];
-    for y in 0..h {
-        for x in 0..w {
-            let v = film.xyz(x, y);
-            for c in 0..3 {
-                s[c] += f64::from(v[c]);
-            }
-        }
-    }
-    s.map(|v| v / (w * h) as f64)
-}
-
-/// XYZ of a spectrum s(λ) over the rendered range 380–780 nm, normalised like the film.
-fn xyz_of(s: impl Fn(f64) -> f64) -> [f64; 3] {
-    let mut xyz = [0.0; 3];
-    for nm in 380..=780 {
-        let bar = cie_xyz_bar(f64::from(nm));
-        for c in 0..3 {
-            xyz[c] += s(f64::from(nm)) * bar[c];
-        }
-    }
-    xyz.map(|v| v / skin_optics::color::cie_y_integral())
-}
-
-fn assert_close(got: [f64; 3], want: [f64; 3], rel: f64, what: &str) {
-    for c in 0..3 {
-        assert!(
-            (got[c] - want[c]).abs() <= rel * want[c].abs(),
-            "{what}: channel {c}: {got:?} vs {want:?}"
-        );
-    }
-}
+/// Seed of every render in this file.
+const SEED: u64 = 42;
 
 /// A diffuse albedo-1 sphere inside a uniform environment of radiance 1 looks exactly like the
 /// environment: every path's energy is conserved and the MIS weights sum to one.
@@ -80,7 +33,7 @@ fn white_furnace_sphere_matches_environment() {
         scale = 100
         "#,
     );
-    let film = run(&s, 32, 32, 16);
+    let film = run(&s, 32, 32, 16, SEED);
     // Equal-energy radiance with Y = 1.
     let y = xyz_of(|_| 1.0)[1];
     let want = xyz_of(|_| 1.0 / y);
@@ -111,7 +64,7 @@ fn lambertian_plane_under_distant_light() {
         intensity = 2
         "#,
     );
-    let film = run(&s, 32, 32, 8);
+    let film = run(&s, 32, 32, 8, SEED);
     let d65_y = xyz_of(skin_optics::color::d65)[1];
     let radiance = 0.5 * 2.0 * 0.5 / std::f64::consts::PI;
     let want = xyz_of(|nm| skin_optics::color::d65(nm) / d65_y * radiance);
@@ -140,7 +93,7 @@ fn d65_white_plane_is_srgb_white() {
         scale = 1000
         "#,
     );
-    let film = run(&s, 32, 32, 8);
+    let film = run(&s, 32, 32, 8, SEED);
     let (w, h) = film.size();
     let mut rgb = [0.0f64; 3];
     for y in 0..h {
@@ -203,7 +156,7 @@ fn image_does_not_depend_on_thread_count() {
 #[test]
 fn default_scene_renders_small() {
     let s = Scene::load("builtin:three-heads", &SceneOptions::default()).unwrap();
-    let film = run(&s, 64, 48, 2);
+    let film = run(&s, 64, 48, 2, SEED);
     let mut ys = Vec::new();
     for y in 0..48 {
         for x in 0..64 {
