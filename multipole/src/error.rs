@@ -29,6 +29,9 @@ pub enum MultipoleError {
     /// A layer stack that cannot be combined (empty, or a semi-infinite layer above another layer).
     #[error("invalid layer stack: {0}")]
     Stack(&'static str),
+    /// A Monte Carlo layer stack that cannot be traced (empty, or a semi-infinite layer not last).
+    #[error("invalid Monte Carlo layer stack: {0}")]
+    McStack(String),
     /// An unknown method name (valid: `exact`, `multipole`).
     #[error("unknown method '{0}' (valid: exact, multipole)")]
     UnknownMethod(String),

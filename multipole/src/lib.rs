@@ -7,6 +7,7 @@ pub mod error;
 pub mod fit;
 pub mod hankel;
 pub mod medium;
+pub mod montecarlo;
 pub mod profile;
 pub mod skin;
 pub mod slab;

@@ -44,8 +44,7 @@ fn error(p: &Profile, mc: &McResult) -> f64 {
     let tot = mc.diffuse_reflectance.mean;
     (0..g.bins())
         .map(|i| {
-            let a = i as f64 * g.dr_mm();
-            let model = enter * annulus_energy(p, a, a + g.dr_mm());
+            let model = enter * annulus_energy(p, g.inner_mm(i), g.outer_mm(i));
             let measured = mc.radial.reflectance_per_mm2[i] * g.annulus_area_mm2(i);
             (model - measured).abs()
         })
@@ -97,11 +96,11 @@ fn main() -> anyhow::Result<()> {
                 for w in edges.windows(2) {
                     let (mut em, mut ep, mut er, mut e) = (0.0, 0.0, 0.0, 0.0);
                     for i in 0..g.bins() {
-                        let a = i as f64 * g.dr_mm();
+                        let a = g.inner_mm(i);
                         if a < w[0] - 1e-12 || a >= w[1] - 1e-12 {
                             continue;
                         }
-                        let b = a + g.dr_mm();
+                        let b = g.outer_mm(i);
                         let enter = 1.0 - mc.specular_reflectance;
                         e += mc.radial.reflectance_per_mm2[i] * g.annulus_area_mm2(i);
                         em += enter * annulus_energy(&multi, a, b);

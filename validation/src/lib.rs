@@ -1,7 +1,5 @@
 #![doc = include_str!("../README.md")]
 
 pub mod compare;
-pub mod error;
-pub mod montecarlo;
-
-pub use error::ValidationError;
+/// The layered Monte Carlo (owned by `multipole`, which uses it for exact profile shapes).
+pub use multipole::montecarlo;

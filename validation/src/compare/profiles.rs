@@ -13,7 +13,7 @@ pub const PROFILE_WAVELENGTHS_NM: [f64; 3] = [450.0, 550.0, 650.0];
 
 /// Mean of the multipole profile over annulus `i` (area weighted, 8 points), observable scale.
 pub(crate) fn annulus_mean(p: &multipole::Profile, grid: &RadialGrid, i: usize, eta: f64) -> f64 {
-    let (r0, dr) = (i as f64 * grid.dr_mm(), grid.dr_mm());
+    let (r0, dr) = (grid.inner_mm(i), grid.outer_mm(i) - grid.inner_mm(i));
     let (mut num, mut den) = (0.0, 0.0);
     for k in 0..8 {
         let r = r0 + (k as f64 + 0.5) / 8.0 * dr;

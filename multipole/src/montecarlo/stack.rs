@@ -1,6 +1,6 @@
 //! The plane-parallel medium the Monte Carlo walks through: validated layers and ambient indices.
 
-use crate::error::{ValidationError, check_range};
+use crate::error::{MultipoleError, check_range};
 use skin_optics::{SkinParams, Wavelength};
 
 /// Largest accepted absorption or scattering coefficient, mm⁻¹ (beyond it a history is one step long).
@@ -28,7 +28,7 @@ impl Layer {
         g: f64,
         n: f64,
         thickness_mm: Option<f64>,
-    ) -> Result<Self, ValidationError> {
+    ) -> Result<Self, MultipoleError> {
         let range = "[0, 1e4] mm⁻¹";
         check_range(
             "absorption σa (mm⁻¹)",
@@ -49,7 +49,7 @@ impl Layer {
         if let Some(d) = thickness_mm
             && (d.is_nan() || d <= 0.0 || d > MAX_THICKNESS_MM)
         {
-            return Err(ValidationError::OutOfRange {
+            return Err(MultipoleError::OutOfRange {
                 name: "layer thickness (mm)",
                 value: d,
                 range: "(0, 1000] mm",
@@ -72,7 +72,7 @@ impl Layer {
         g: f64,
         n: f64,
         thickness_mm: f64,
-    ) -> Result<Self, ValidationError> {
+    ) -> Result<Self, MultipoleError> {
         Self::checked(sigma_a, sigma_s, g, n, Some(thickness_mm))
     }
 
@@ -83,9 +83,9 @@ impl Layer {
         sigma_s: f64,
         g: f64,
         n: f64,
-    ) -> Result<Self, ValidationError> {
+    ) -> Result<Self, MultipoleError> {
         if sigma_a.is_nan() || sigma_a <= 0.0 {
-            return Err(ValidationError::OutOfRange {
+            return Err(MultipoleError::OutOfRange {
                 name: "absorption σa of a semi-infinite layer (mm⁻¹)",
                 value: sigma_a,
                 range: "(0, 1e4] mm⁻¹",
@@ -102,7 +102,7 @@ impl Layer {
         g: f64,
         n: f64,
         thickness_mm: Option<f64>,
-    ) -> Result<Self, ValidationError> {
+    ) -> Result<Self, MultipoleError> {
         check_range("anisotropy g", g, -0.999, 0.999, "[-0.999, 0.999]")?;
         let sigma_s = sigma_s_prime / (1.0 - g);
         match thickness_mm {
@@ -155,17 +155,17 @@ pub struct LayerStack {
 impl LayerStack {
     /// A stack of at least one layer; only the last may be semi-infinite (then `n_below` is unused).
     /// Ambient indices in [1, 3].
-    pub fn new(layers: Vec<Layer>, n_above: f64, n_below: f64) -> Result<Self, ValidationError> {
+    pub fn new(layers: Vec<Layer>, n_above: f64, n_below: f64) -> Result<Self, MultipoleError> {
         check_range("ambient index above", n_above, 1.0, 3.0, "[1, 3]")?;
         check_range("ambient index below", n_below, 1.0, 3.0, "[1, 3]")?;
         if layers.is_empty() {
-            return Err(ValidationError::Stack("no layers".into()));
+            return Err(MultipoleError::McStack("no layers".into()));
         }
         if let Some(i) = layers[..layers.len() - 1]
             .iter()
             .position(|l| l.thickness_mm.is_none())
         {
-            return Err(ValidationError::Stack(format!(
+            return Err(MultipoleError::McStack(format!(
                 "layer {i} is semi-infinite but not the last of {}",
                 layers.len()
             )));
@@ -182,7 +182,7 @@ impl LayerStack {
     /// `SkinParams::coefficients` (eqs 1–6); σs = σs' / (1 − g) with HG anisotropy `g`
     /// ([`DEFAULT_SKIN_G`] = 0.9 is the usual choice). The dermis is semi-infinite as in the model
     /// ([DJ05] stacks the epidermis slab on a dipole half-space).
-    pub fn skin(skin: &SkinParams, lambda: Wavelength, g: f64) -> Result<Self, ValidationError> {
+    pub fn skin(skin: &SkinParams, lambda: Wavelength, g: f64) -> Result<Self, MultipoleError> {
         let c = skin.coefficients(lambda);
         let n = skin.eta();
         let epidermis = Layer::from_reduced(

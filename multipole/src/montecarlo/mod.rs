@@ -17,7 +17,7 @@
 //!   come from the spread of the batch means.
 //!
 //! The module depends only on `skin-optics`, `brdf::fresnel`, `rand`/`rand_xoshiro`/`rand_distr`
-//! (the ziggurat exponential) and `rayon`: it can move into `multipole` unchanged.
+//! (the ziggurat exponential) and `rayon`: it lives in `multipole` because `Method::Exact` profiles use it; `validation` compares with it.
 
 mod stack;
 mod tally;
@@ -27,7 +27,7 @@ pub use stack::{DEFAULT_SKIN_G, Layer, LayerStack, MAX_COEFFICIENT_PER_MM, MAX_T
 pub use tally::{Estimate, McResult, RadialGrid, RadialProfile};
 pub use transport::{ROULETTE_SURVIVAL, ROULETTE_THRESHOLD};
 
-use crate::error::ValidationError;
+use crate::error::MultipoleError;
 use rand::SeedableRng;
 use rand_xoshiro::Xoshiro256StarStar;
 use rayon::prelude::*;
@@ -58,16 +58,16 @@ impl Default for McOptions {
 impl McOptions {
     /// `photons` in [1, 1e12] histories split into `batches` in [2, 1e6] equal batches (rounded up
     /// to a multiple of `batches`), with `seed` for the generator and the default grid.
-    pub fn new(photons: u64, batches: u32, seed: u64) -> Result<Self, ValidationError> {
+    pub fn new(photons: u64, batches: u32, seed: u64) -> Result<Self, MultipoleError> {
         if !(1..=1_000_000_000_000).contains(&photons) {
-            return Err(ValidationError::OutOfRange {
+            return Err(MultipoleError::OutOfRange {
                 name: "photons",
                 value: photons as f64,
                 range: "[1, 1e12]",
             });
         }
         if !(2..=1_000_000).contains(&batches) {
-            return Err(ValidationError::OutOfRange {
+            return Err(MultipoleError::OutOfRange {
                 name: "batches",
                 value: f64::from(batches),
                 range: "[2, 1e6]",

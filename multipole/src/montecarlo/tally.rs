@@ -1,11 +1,21 @@
 //! What one batch of photons scores, and how independent batches become means with standard errors.
 
-use crate::error::{ValidationError, check_range};
+use crate::error::{MultipoleError, check_range};
 
-/// A uniform radial grid for R_d(r): `bins` annuli of width `dr_mm` from r = 0.
+/// How the annuli of a [`RadialGrid`] are spaced.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Spacing {
+    /// Annuli of equal width, mm.
+    Uniform { dr_mm: f64 },
+    /// A disc of radius `r0_mm`, then annuli whose outer radii grow by e^`ln_ratio` each.
+    Geometric { r0_mm: f64, ln_ratio: f64 },
+}
+
+/// The radial grid of R_d(r): uniform annuli from r = 0, or a central disc and geometric annuli
+/// (the shape tables of `skin::exact_profile`, which span 10⁻³ to 10 mm with few photons per bin).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RadialGrid {
-    dr_mm: f64,
+    spacing: Spacing,
     bins: usize,
 }
 
@@ -13,7 +23,7 @@ impl Default for RadialGrid {
     /// 0.01 mm × 1000 bins: resolves the epidermal peak and reaches 10 mm (the dermal tail of red light).
     fn default() -> Self {
         Self {
-            dr_mm: 0.01,
+            spacing: Spacing::Uniform { dr_mm: 0.01 },
             bins: 1000,
         }
     }
@@ -21,41 +31,101 @@ impl Default for RadialGrid {
 
 impl RadialGrid {
     /// A grid of `bins` in [1, 1e6] annuli, each `dr_mm` in (0, 100] mm wide.
-    pub fn new(dr_mm: f64, bins: usize) -> Result<Self, ValidationError> {
-        if dr_mm.is_nan() || dr_mm <= 0.0 || dr_mm > 100.0 {
-            return Err(ValidationError::OutOfRange {
-                name: "radial bin width (mm)",
-                value: dr_mm,
-                range: "(0, 100] mm",
-            });
-        }
+    pub fn new(dr_mm: f64, bins: usize) -> Result<Self, MultipoleError> {
+        check_range(
+            "radial bin width (mm)",
+            dr_mm,
+            f64::MIN_POSITIVE,
+            100.0,
+            "(0, 100] mm",
+        )?;
         check_range("radial bins", bins as f64, 1.0, 1.0e6, "[1, 1e6]")?;
-        Ok(Self { dr_mm, bins })
+        Ok(Self {
+            spacing: Spacing::Uniform { dr_mm },
+            bins,
+        })
     }
-    /// Bin width, mm.
-    #[must_use]
-    pub fn dr_mm(&self) -> f64 {
-        self.dr_mm
+
+    /// A disc of radius `r0_mm` then `bins − 1` geometric annuli out to `r_max_mm`
+    /// (1e-6 ≤ r0 < r_max ≤ 1000 mm, bins in [2, 1e6]).
+    pub fn geometric(r0_mm: f64, r_max_mm: f64, bins: usize) -> Result<Self, MultipoleError> {
+        check_range(
+            "first radius (mm)",
+            r0_mm,
+            1.0e-6,
+            1000.0,
+            "[1e-6, 1000] mm",
+        )?;
+        check_range(
+            "outer radius (mm)",
+            r_max_mm,
+            r0_mm * (1.0 + 1e-9),
+            1000.0,
+            "(r0, 1000] mm",
+        )?;
+        check_range("radial bins", bins as f64, 2.0, 1.0e6, "[2, 1e6]")?;
+        Ok(Self {
+            spacing: Spacing::Geometric {
+                r0_mm,
+                ln_ratio: (r_max_mm / r0_mm).ln() / (bins - 1) as f64,
+            },
+            bins,
+        })
     }
+
     /// Number of annuli.
     #[must_use]
     pub fn bins(&self) -> usize {
         self.bins
     }
+    /// Inner radius of annulus `i`, mm.
+    #[must_use]
+    pub fn inner_mm(&self, i: usize) -> f64 {
+        match self.spacing {
+            Spacing::Uniform { dr_mm } => i as f64 * dr_mm,
+            Spacing::Geometric { .. } if i == 0 => 0.0,
+            Spacing::Geometric { r0_mm, ln_ratio } => r0_mm * ((i - 1) as f64 * ln_ratio).exp(),
+        }
+    }
+    /// Outer radius of annulus `i`, mm.
+    #[must_use]
+    pub fn outer_mm(&self, i: usize) -> f64 {
+        match self.spacing {
+            Spacing::Uniform { dr_mm } => (i + 1) as f64 * dr_mm,
+            Spacing::Geometric { r0_mm, ln_ratio } => r0_mm * (i as f64 * ln_ratio).exp(),
+        }
+    }
     /// Outer radius of the grid, mm.
     #[must_use]
     pub fn r_max_mm(&self) -> f64 {
-        self.dr_mm * self.bins as f64
+        self.outer_mm(self.bins - 1)
     }
-    /// Mid radius of annulus `i`, mm.
+    /// Representative radius of annulus `i`, mm: the middle of a uniform annulus, the geometric
+    /// mean of a geometric one's radii, half the radius of the central disc.
     #[must_use]
     pub fn r_mid_mm(&self, i: usize) -> f64 {
-        (i as f64 + 0.5) * self.dr_mm
+        match self.spacing {
+            Spacing::Uniform { .. } => 0.5 * (self.inner_mm(i) + self.outer_mm(i)),
+            Spacing::Geometric { r0_mm, .. } if i == 0 => 0.5 * r0_mm,
+            Spacing::Geometric { .. } => (self.inner_mm(i) * self.outer_mm(i)).sqrt(),
+        }
     }
-    /// Area of annulus `i`, π((i+1)² − i²) dr², mm².
+    /// Area of annulus `i`, π(r_out² − r_in²), mm².
     #[must_use]
     pub fn annulus_area_mm2(&self, i: usize) -> f64 {
-        std::f64::consts::PI * (2.0 * i as f64 + 1.0) * self.dr_mm * self.dr_mm
+        let (a, b) = (self.inner_mm(i), self.outer_mm(i));
+        std::f64::consts::PI * (b - a) * (b + a)
+    }
+    /// The annulus holding radius `r_mm` ≥ 0, or `None` beyond the grid.
+    #[inline(always)]
+    #[must_use]
+    pub fn bin(&self, r_mm: f64) -> Option<usize> {
+        let i = match self.spacing {
+            Spacing::Uniform { dr_mm } => (r_mm / dr_mm) as usize,
+            Spacing::Geometric { r0_mm, .. } if r_mm < r0_mm => 0,
+            Spacing::Geometric { r0_mm, ln_ratio } => 1 + ((r_mm / r0_mm).ln() / ln_ratio) as usize,
+        };
+        (i < self.bins).then_some(i)
     }
 }
 
@@ -233,6 +303,24 @@ mod tests {
         assert!((e.mean - 2.5).abs() < 1e-15);
         // sd = sqrt(5/3), stderr = sd / 2
         assert!((e.stderr - (5.0f64 / 3.0).sqrt() / 2.0).abs() < 1e-15);
+    }
+
+    #[test]
+    fn geometric_annuli_tile_the_disc_and_bin_their_radii() {
+        let g = RadialGrid::geometric(0.01, 10.0, 31).unwrap();
+        let total: f64 = (0..31).map(|i| g.annulus_area_mm2(i)).sum();
+        assert!(
+            (total - std::f64::consts::PI * 100.0).abs() < 1e-9,
+            "{total}"
+        );
+        assert!((g.r_max_mm() - 10.0).abs() < 1e-12);
+        for i in 0..31 {
+            assert_eq!(g.bin(g.r_mid_mm(i)), Some(i));
+            assert!(g.inner_mm(i) < g.outer_mm(i));
+        }
+        assert_eq!(g.bin(10.5), None);
+        assert!(RadialGrid::geometric(1.0, 0.5, 10).is_err());
+        assert!(RadialGrid::geometric(0.01, 10.0, 1).is_err());
     }
 
     #[test]

@@ -138,7 +138,6 @@ pub(crate) fn trace_batch(
     rng: &mut impl RngCore,
     tally: &mut BatchTally,
 ) {
-    let inv_dr = 1.0 / grid.dr_mm();
     let slabs = &medium.slabs[..];
     let last = slabs.len() - 1;
     for _ in 0..photons {
@@ -207,11 +206,9 @@ pub(crate) fn trace_batch(
                     if p.layer == 0 {
                         tally.diffuse_reflectance += p.w;
                         let r = (p.x * p.x + p.y * p.y).sqrt();
-                        let bin = (r * inv_dr) as usize;
-                        if bin < tally.radial.len() {
-                            tally.radial[bin] += p.w;
-                        } else {
-                            tally.beyond_grid += p.w;
+                        match grid.bin(r) {
+                            Some(bin) => tally.radial[bin] += p.w,
+                            None => tally.beyond_grid += p.w,
                         }
                         break;
                     }
