@@ -11,6 +11,7 @@ use crate::error::{MultipoleError, check_range};
 use crate::hankel::{HankelTable, Pchip, frequency_cutoff};
 use crate::medium::pole_energy_within;
 use crate::profile::Profile;
+use crate::skin::ExactShape;
 use crate::slab::Poles;
 use crate::stack::{Layer, Stack};
 use std::f64::consts::PI;
@@ -35,6 +36,13 @@ pub struct ProfileOptions {
     pub transform_radii: usize,
     /// Spectrum cutoff: stop at Q where |F(Q)| Q² < tolerance × peak (default 1e-5; [1e-16, 0.1]).
     pub transform_tolerance: f64,
+    /// Shape of `Method::Exact` profiles (default [`ExactShape::MonteCarlo`] with
+    /// [`crate::skin::DEFAULT_SHAPE_ESCAPES`]); the other fields are the diffusion knobs.
+    pub exact_shape: ExactShape,
+    /// Wavelength spacing of Monte Carlo shapes in `SpectralProfiles`, nm (default 10; [0.01, 1000]):
+    /// rows between two shape wavelengths mix their unit-energy shapes linearly in λ, each row
+    /// scaled to its own exact total.
+    pub shape_step_nm: f64,
 }
 
 impl Default for ProfileOptions {
@@ -47,6 +55,8 @@ impl Default for ProfileOptions {
             transform_nodes: 5,
             transform_radii: 48,
             transform_tolerance: 1e-5,
+            exact_shape: ExactShape::default(),
+            shape_step_nm: 10.0,
         }
     }
 }
@@ -75,6 +85,13 @@ impl ProfileOptions {
                 Err(MultipoleError::InvalidOption { name, value, range })
             }
         };
+        opt(
+            "shape_step_nm",
+            self.shape_step_nm,
+            0.01,
+            1000.0,
+            "[0.01, 1000] nm",
+        )?;
         opt(
             "radial_samples",
             self.radial_samples as f64,

@@ -6,6 +6,8 @@
 //! own noise contributes: the "noise" column is Σ √(2/π) σ_bin / R_mc, the expected value of that sum
 //! for a model equal to the truth.
 //!
+//! The Monte Carlo shapes (`ExactShape::MonteCarlo`) are timed (wall, ms, all cores).
+//!
 //! `cargo run --release -p validation --example exact_profiles [photons]` (default 1e6, seed 7).
 
 use indicatif::{ProgressBar, ProgressStyle};
@@ -13,6 +15,9 @@ use multipole::skin::{ExactShape, Method, exact_profile, profile};
 use multipole::{Profile, ProfileOptions};
 use skin_optics::{Preset, SkinParams, Wavelength};
 use validation::montecarlo::{DEFAULT_SKIN_G, LayerStack, McOptions, McResult, run};
+
+/// Knob values of the Monte Carlo shape (escaping photons per wavelength).
+const ESCAPES: [u64; 3] = [1_000, 4_000, 16_000];
 
 /// Annulus energy of `p` on [a, b] (mm), 8-point Gauss–Legendre on 2πr R(r).
 fn annulus_energy(p: &Profile, a: f64, b: f64) -> f64 {
@@ -68,9 +73,10 @@ fn main() -> anyhow::Result<()> {
         "{bar:30} {pos}/{len} MC runs {elapsed}",
     )?);
     println!(
-        "| preset | λ (nm) | R_mc | R_exact/R_mc − 1 | multipole | exact, rescaled total | exact, per layer | MC noise |"
+        "| preset | λ (nm) | R_mc | R_exact/R_mc − 1 | multipole | exact, rescaled total | exact, per layer | {} | MC noise |",
+        ESCAPES.map(|e| format!("MC shape {e} escapes (ms)")).join(" | ")
     );
-    println!("| --- | --- | --- | --- | --- | --- | --- | --- |");
+    println!("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |");
     for (preset, nm) in cases {
         let skin = SkinParams::preset(preset);
         let lambda = Wavelength::new(nm)?;
@@ -79,6 +85,12 @@ fn main() -> anyhow::Result<()> {
         let multi = profile(&skin, lambda, Method::Multipole, &opts)?;
         let resc = exact_profile(&skin, lambda, ExactShape::RescaledTotal, &opts)?;
         let per = exact_profile(&skin, lambda, ExactShape::PerLayer, &opts)?;
+        let mut shapes = Vec::new();
+        for escapes in ESCAPES {
+            let t0 = std::time::Instant::now();
+            let p = exact_profile(&skin, lambda, ExactShape::MonteCarlo { escapes }, &opts)?;
+            shapes.push((p, t0.elapsed().as_secs_f64() * 1e3));
+        }
         let tot = mc.diffuse_reflectance.mean;
         let g = mc.radial.grid;
         let noise: f64 = (0..g.bins())
@@ -116,11 +128,16 @@ fn main() -> anyhow::Result<()> {
         }
         bar.suspend(|| {
             println!(
-                "| {preset:?} | {nm} | {tot:.5} | {:+.2}% | {:.1}% | {:.1}% | {:.1}% | {:.1}% |",
+                "| {preset:?} | {nm} | {tot:.5} | {:+.2}% | {:.1}% | {:.1}% | {:.1}% | {} | {:.1}% |",
                 100.0 * (exact_obs / tot - 1.0),
                 100.0 * error(&multi, &mc),
                 100.0 * error(&resc, &mc),
                 100.0 * error(&per, &mc),
+                shapes
+                    .iter()
+                    .map(|(p, ms)| format!("{:.1}% ({ms:.0})", 100.0 * error(p, &mc)))
+                    .collect::<Vec<_>>()
+                    .join(" | "),
                 100.0 * noise,
             );
         });

@@ -39,3 +39,5 @@ fn exact_matches_monte_carlo_medium_550_nm() {
 fn exact_matches_monte_carlo_dark_550_nm() {
     check(Preset::Dark, 93);
 }
+
+mod profile_shape;
