@@ -9,9 +9,10 @@
 //!   otherwise Gauss on [0, μc] and Radau on [μc, 1], μc the critical cosine inside, so μ = 1 (the
 //!   normally incident beam) is a node and the Fresnel kink falls between the two rules;
 //! - phase function: HG redistribution by Legendre series with the δ-M truncation (M = quadrature points);
-//! - each layer: diamond initialisation of a layer thinner than the smallest μ, then doubling (to
-//!   convergence for a semi-infinite layer); layers and interfaces combined by the adding equations with
-//!   directional operators.
+//! - each layer: R and T in closed form from the eigenmodes of the discrete-ordinate equations
+//!   (module `modes`; a semi-infinite layer without iterating), or, for a conservative layer (albedo 1
+//!   after δ-M), diamond initialisation of a layer thinner than the smallest μ, then doubling; layers and
+//!   interfaces combined by the adding equations with directional operators.
 //!
 //! The knob is `quadrature_points`; the δ-M truncation and the angular discretisation are its only
 //! approximations (measured: see the tests and BENCHMARKS.md `## Exact method`).
@@ -19,8 +20,10 @@
 //! Symbols: `sigma_a` σa (mm⁻¹), `sigma_s` σs (mm⁻¹, not reduced), `g` HG anisotropy, `albedo` a = σs/σt,
 //! `tau` optical thickness σt·d, `eta` refractive index of the stack, `mu` μ = cos θ inside the stack.
 
+mod eigen;
 mod layer;
 mod matrix;
+mod modes;
 mod quadrature;
 mod split;
 

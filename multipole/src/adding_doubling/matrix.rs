@@ -299,6 +299,29 @@ impl Mat {
         out
     }
 
+    /// Lᵀ⁻¹ B for lower-triangular self = L (back substitution with the transpose, on whole rows of B).
+    pub(crate) fn back_substitute_transpose(&self, b: &Mat) -> Mat {
+        let n = self.n;
+        let mut x = b.clone();
+        for i in (0..n).rev() {
+            let (head, rest) = x.data.split_at_mut((i + 1) * n);
+            let x_i = &mut head[i * n..];
+            for (k, x_k) in (i + 1..n).zip(rest.chunks_exact(n)) {
+                axpy(x_i, -self.data[k * n + i], x_k);
+            }
+            let inv = 1.0 / self.data[i * n + i];
+            for v in x_i.iter_mut() {
+                *v *= inv;
+            }
+        }
+        x
+    }
+
+    /// The transpose.
+    pub(crate) fn transpose(&self) -> Mat {
+        Mat::from_fn(self.n, |i, j| self[(j, i)])
+    }
+
     /// (self + selfᵀ)/2: removes rounding asymmetry from a matrix that is symmetric in exact arithmetic.
     pub(crate) fn symmetrised(&self) -> Mat {
         Mat::from_fn(self.n, |i, j| 0.5 * (self[(i, j)] + self[(j, i)]))
