@@ -323,8 +323,8 @@ impl LayeredSlab {
         } else {
             0.0
         };
-        let rule = quadrature::slab_rule(quadrature_points, mu_c);
-        Angles::new(rule.nodes, rule.weights)
+        let rule = quadrature::slab_rule_cached(quadrature_points, mu_c);
+        Angles::new(rule.nodes.clone(), rule.weights.clone())
     }
 
     /// Diffuse reflectance, specular reflectance and transmittance for a normally incident beam.

@@ -13,8 +13,10 @@ pub(crate) fn symmetric_eigen(a: &Mat) -> Result<(Vec<f64>, Mat), Singular> {
     let mut d = vec![0.0; n];
     let mut e = vec![0.0; n];
     tridiagonalise(&mut v, &mut d, &mut e);
-    ql_implicit(&mut v, &mut d, &mut e)?;
-    Ok((d, v))
+    // The QL rotations combine pairs of eigenvectors: keep them as rows so each update is contiguous.
+    let mut vt = v.transpose();
+    ql_implicit(&mut vt, &mut d, &mut e)?;
+    Ok((d, vt.transpose()))
 }
 
 /// Householder reduction of the symmetric `v` to tridiagonal form: on return `d` holds the diagonal,
@@ -108,9 +110,20 @@ fn tridiagonalise(v: &mut Mat, d: &mut [f64], e: &mut [f64]) {
     e[0] = 0.0;
 }
 
-/// Implicit QL with Wilkinson-like shifts on the tridiagonal (`d`, `e`), rotating `v` along.
-fn ql_implicit(v: &mut Mat, d: &mut [f64], e: &mut [f64]) -> Result<(), Singular> {
-    let n = v.n();
+/// √(a² + b²) without the cost of `hypot`, falling back to it where squaring could over- or underflow.
+fn hyp(a: f64, b: f64) -> f64 {
+    let m = a.abs().max(b.abs());
+    if m > 1e150 || m < 1e-150 {
+        a.hypot(b)
+    } else {
+        (a * a + b * b).sqrt()
+    }
+}
+
+/// Implicit QL with Wilkinson-like shifts on the tridiagonal (`d`, `e`), rotating the eigenvector
+/// rows of `vt` along.
+fn ql_implicit(vt: &mut Mat, d: &mut [f64], e: &mut [f64]) -> Result<(), Singular> {
+    let n = vt.n();
     for i in 1..n {
         e[i - 1] = e[i];
     }
@@ -135,7 +148,7 @@ fn ql_implicit(v: &mut Mat, d: &mut [f64], e: &mut [f64]) -> Result<(), Singular
                 // Implicit shift.
                 let mut g = d[l];
                 let mut p = (d[l + 1] - g) / (2.0 * e[l]);
-                let mut r = p.hypot(1.0);
+                let mut r = hyp(p, 1.0);
                 if p < 0.0 {
                     r = -r;
                 }
@@ -158,17 +171,17 @@ fn ql_implicit(v: &mut Mat, d: &mut [f64], e: &mut [f64]) -> Result<(), Singular
                     s2 = s;
                     g = c * e[i];
                     h = c * p;
-                    r = p.hypot(e[i]);
+                    r = hyp(p, e[i]);
                     e[i + 1] = s * r;
                     s = e[i] / r;
                     c = p / r;
                     p = c * d[i] - s * g;
                     d[i + 1] = h + s * (c * g + s * d[i]);
-                    for k in 0..n {
-                        let h = v[(k, i + 1)];
-                        let vi = v[(k, i)];
-                        v[(k, i + 1)] = s * vi + c * h;
-                        v[(k, i)] = c * vi - s * h;
+                    let (row_i, row_next) = vt.rows_pair_mut(i);
+                    for (vi, h) in row_i.iter_mut().zip(row_next.iter_mut()) {
+                        let (a, b) = (*vi, *h);
+                        *h = s * a + c * b;
+                        *vi = c * a - s * b;
                     }
                 }
                 p = -s * s2 * c3 * el1 * e[l] / dl1;

@@ -317,6 +317,28 @@ impl Mat {
         x
     }
 
+    /// Rows i and i + 1, mutably.
+    pub(crate) fn rows_pair_mut(&mut self, i: usize) -> (&mut [f64], &mut [f64]) {
+        let n = self.n;
+        let (a, b) = self.data[i * n..(i + 2) * n].split_at_mut(n);
+        (a, b)
+    }
+
+    /// Solve self · X = B and self · Y = C with one factorisation.
+    pub(crate) fn solve_two(&self, b: &Mat, c: &Mat) -> Result<(Mat, Mat), Singular> {
+        let n = self.n;
+        // Side by side: n rows of 2n entries.
+        let mut bc = Vec::with_capacity(2 * n * n);
+        for i in 0..n {
+            bc.extend_from_slice(&b.data[i * n..(i + 1) * n]);
+            bc.extend_from_slice(&c.data[i * n..(i + 1) * n]);
+        }
+        self.solve_in_place(2 * n, &mut bc)?;
+        let x = Mat::from_fn(n, |i, j| bc[i * 2 * n + j]);
+        let y = Mat::from_fn(n, |i, j| bc[i * 2 * n + n + j]);
+        Ok((x, y))
+    }
+
     /// The transpose.
     pub(crate) fn transpose(&self) -> Mat {
         Mat::from_fn(self.n, |i, j| self[(j, i)])

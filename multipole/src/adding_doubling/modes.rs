@@ -79,7 +79,6 @@ pub(crate) fn layer_by_modes(
     let gg = g_up.mul(&gamma_e);
     let xt = Mat::from_fn(n, |i, j| g_down_e[(i, j)] - gg[(i, j)]);
     // X N⁻¹ = (N⁻ᵀ Xᵀ)ᵀ; both results are symmetric, so the transpose is only rounding.
-    let r = nt.solve(&xr.transpose())?;
-    let t = nt.solve(&xt.transpose())?;
+    let (r, t) = nt.solve_two(&xr.transpose(), &xt.transpose())?;
     Ok((r.symmetrised(), t.symmetrised()))
 }
