@@ -113,7 +113,7 @@ fn tridiagonalise(v: &mut Mat, d: &mut [f64], e: &mut [f64]) {
 /// √(a² + b²) without the cost of `hypot`, falling back to it where squaring could over- or underflow.
 fn hyp(a: f64, b: f64) -> f64 {
     let m = a.abs().max(b.abs());
-    if m > 1e150 || m < 1e-150 {
+    if !(1e-150..=1e150).contains(&m) {
         a.hypot(b)
     } else {
         (a * a + b * b).sqrt()
