@@ -29,12 +29,23 @@
 //! with C_m and C_h refitted at each, and the connected range around the fit whose residual stays
 //! within a tolerance of the best is returned.
 //!
+//! **Forward model.** [`FitOptions::method`], default [`Method::Exact`] (adding-doubling totals: right
+//! for every skin tone, where diffusion draws dark skin two to three times too bright and so returns
+//! the wrong melanin, issue [exact]). An exact fit runs in two stages (module `forward`): the search
+//! above with adding-doubling at [`FitOptions::search_quadrature_points`] (8) and
+//! [`FitOptions::search_step_nm`] (20 nm), then output space mapping onto the full model (24 points,
+//! [`FitOptions::step_nm`]) in two to four full evaluations, about 0.7 CPU-s per colour fit instead
+//! of some 7 for the full model throughout, with the same answer (BENCHMARKS.md `## Fit`).
+//! [`Method::Multipole`] (the paper's diffusion, ~47 ms per colour fit) runs in one stage and
+//! reproduces [DJ06].
+//!
 //! **Out of gamut.** A target no skin can produce (pure green) still gets its nearest skin, with
 //! `in_gamut = false` when ΔE00 exceeds [`FitOptions::gamut_threshold_de`] (3), or for spectra
 //! when the RMS exceeds [`FitOptions::max_rms`] (0.02).
 
 mod colour;
 mod error;
+mod forward;
 mod measured;
 mod nelder_mead;
 mod spectrum;
@@ -58,10 +69,19 @@ pub const HEMOGLOBIN_RANGE: [f64; 2] = [0.001, 0.1];
 /// Knobs of a fit. `Default` gives the documented values.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FitOptions {
-    /// Forward model passed through to [`crate::skin::diffuse_reflectance`]. Default
-    /// [`Method::Multipole`] (the paper's diffusion, closed-form totals, ~1 µs per wavelength), not
-    /// the crate-wide default: a fit evaluates the model a few thousand times.
+    /// Forward model passed through to [`crate::skin::diffuse_reflectance`]. Default [`Method::Exact`]
+    /// (adding-doubling totals, right for every skin tone), searched with a cheaper quadrature and
+    /// corrected to the full model (module `forward`); [`Method::Multipole`] is the paper's diffusion
+    /// (closed-form totals, one stage, reproduces [DJ06]; wrong for dark skin, issue [exact]).
     pub method: Method,
+    /// Quadrature points per hemisphere of the adding-doubling model in the search stage (grid,
+    /// starts, β_m sweep) of an exact fit; even, in [4, 64]. Default 8 (about 12 times cheaper than the
+    /// default 24). A value ≥ the default 24 searches with the full model in a single stage.
+    pub search_quadrature_points: usize,
+    /// Wavelength step of the search model's spectrum in a two-stage exact colour fit, nm, in (0, 100]
+    /// (default 20: colour error 0.18 ΔE00 against 1 nm, removed with the quadrature error by the
+    /// correction, which uses [`FitOptions::step_nm`]).
+    pub search_step_nm: f64,
     /// Wavelength step of the model spectrum behind a colour, nm, over 400–700 nm (default 10; (0, 100]).
     /// Measured colour error against a 1-nm step, worst over skins spanning the ranges:
     /// 5 nm 0.016, 10 nm 0.046, 20 nm 0.18, 30 nm 0.71 ΔE00.
@@ -97,7 +117,9 @@ pub struct FitOptions {
 impl Default for FitOptions {
     fn default() -> Self {
         Self {
-            method: Method::Multipole,
+            method: Method::Exact,
+            search_quadrature_points: 8,
+            search_step_nm: 20.0,
             step_nm: 10.0,
             grid: [7, 7, 6],
             starts: 6,
@@ -131,6 +153,12 @@ impl FitOptions {
             self.step_nm > 0.0 && self.step_nm <= 100.0,
             "(0, 100] nm",
         )?;
+        check(
+            "search_step_nm",
+            self.search_step_nm,
+            self.search_step_nm > 0.0 && self.search_step_nm <= 100.0,
+            "(0, 100] nm",
+        )?;
         for n in self.grid {
             check(
                 "grid nodes",
@@ -140,6 +168,14 @@ impl FitOptions {
             )?;
         }
         check("starts", self.starts as f64, self.starts >= 1, "[1, ∞)")?;
+        check(
+            "search_quadrature_points",
+            self.search_quadrature_points as f64,
+            (4..=crate::adding_doubling::MAX_QUADRATURE_POINTS)
+                .contains(&self.search_quadrature_points)
+                && self.search_quadrature_points.is_multiple_of(2),
+            "even numbers in [4, 64]",
+        )?;
         check(
             "beta_prior",
             self.beta_prior,
@@ -255,9 +291,17 @@ pub(crate) fn with_chromophores(base: &SkinParams, p: [f64; 3]) -> Result<SkinPa
 }
 
 /// Budget of the main refinement: 1e-4 of the unit box is below every reported digit.
-const REFINE: Budget = Budget {
+pub(crate) const REFINE: Budget = Budget {
     x_tol: 1e-4,
     f_tol: 1e-10,
+    max_evals: 400,
+};
+
+/// Budget of the refinement in the search stage of a two-stage fit: the space-mapping correction
+/// refines further, so the search optimum is needed only to well within the search model's own error.
+pub(crate) const SEARCH: Budget = Budget {
+    x_tol: 1e-3,
+    f_tol: 1e-8,
     max_evals: 400,
 };
 
@@ -276,13 +320,14 @@ pub(crate) fn global_minimum(
     objective: &mut impl FnMut(&[f64; 3]) -> f64,
     exact: impl Fn(&[f64; 3]) -> bool,
     opts: &FitOptions,
+    budget: Budget,
 ) -> ([f64; 3], f64, usize) {
     let grid = grid_search(objective, opts.grid);
     let mut evals = grid.len();
     let spacing = 1.0 / (opts.grid.iter().copied().max().unwrap_or(2) - 1) as f64;
     let mut best = (grid[0].1, grid[0].2);
     for start in distinct_starts(&grid, opts.starts) {
-        let m = minimize(objective, start, 0.5 * spacing.max(0.05), REFINE);
+        let m = minimize(objective, start, 0.5 * spacing.max(0.05), budget);
         evals += m.evals;
         if m.f < best.1 {
             best = (m.x, m.f);

@@ -1,12 +1,13 @@
 //! Fit to a measured spectrum: weighted least squares in reflectance at the measured wavelengths.
 
+use super::forward::{Forward, space_mapping};
 use super::{
-    BetaRange, ColourModel, FitError, FitOptions, MeasuredSpectrum, beta_sweep, global_minimum,
-    infeasibility, prior_penalty2, search_to_params, with_chromophores,
+    BetaRange, ColourModel, FitError, FitOptions, MeasuredSpectrum, REFINE, SEARCH, beta_sweep,
+    global_minimum, infeasibility, prior_penalty2, search_to_params, with_chromophores,
 };
-use crate::skin::diffuse_reflectance;
 use skin_optics::lab::Lab;
 use skin_optics::{SkinParams, Wavelength};
+use std::cell::RefCell;
 
 /// Result of [`fit_spectrum`].
 #[derive(Debug, Clone, PartialEq)]
@@ -23,12 +24,16 @@ pub struct SpectrumFit {
     pub lab: Lab,
     /// The β_m values the spectrum allows (within [`FitOptions::beta_tolerance_rms`]), if swept.
     pub beta_range: Option<BetaRange>,
-    /// Objective evaluations spent (each one model spectrum at the measured wavelengths).
+    /// Objective evaluations spent (each one model spectrum at the measured wavelengths; search
+    /// model and full model together).
     pub evaluations: usize,
+    /// Of these, full-model evaluations in the space-mapping correction (0 for a single-stage fit).
+    pub full_evaluations: usize,
 }
 
 /// Fit C_m, β_m, C_h to a measured reflectance spectrum by weighted least squares (see the module
-/// doc for the search, the β_m prior and the tolerance test).
+/// doc for the search, the β_m prior and the tolerance test, and module `forward` for the two-stage
+/// exact fit).
 pub fn fit_spectrum(
     measured: &MeasuredSpectrum,
     opts: &FitOptions,
@@ -40,63 +45,100 @@ pub fn fit_spectrum(
         .map(|&nm| Wavelength::new(nm))
         .collect::<Result<Vec<_>, _>>()?;
     let weight_sum: f64 = measured.weights().iter().sum();
-    let model_at = |skin: &SkinParams| -> Result<Vec<f64>, FitError> {
-        lambdas
+    let full = Forward::Method(opts.method);
+    let search_forward = Forward::search(opts.method, opts.search_quadrature_points);
+    let search = search_forward.unwrap_or(full);
+    // Reflectance added to the search model's at each wavelength (space mapping; zero until then).
+    let shift: RefCell<Vec<f64>> = RefCell::new(vec![0.0; lambdas.len()]);
+    let weighted_rms = |model: &[f64]| -> f64 {
+        let ss: f64 = model
             .iter()
-            .map(|&l| diffuse_reflectance(skin, l, opts.method).map_err(FitError::from))
-            .collect()
+            .zip(measured.reflectance())
+            .zip(measured.weights())
+            .map(|((r_hat, r), w)| w * (r - r_hat).powi(2))
+            .sum();
+        (ss / weight_sum).sqrt()
     };
-    let mut failure: Option<FitError> = None;
+    let failure: RefCell<Option<FitError>> = RefCell::new(None);
     // Weighted RMS residual of the skin with parameters p = (C_m, β_m, C_h), or +∞ if the model failed.
-    let mut rms = |p: &[f64; 3]| -> f64 {
+    let rms = |p: &[f64; 3]| -> f64 {
         let model = with_chromophores(&opts.base, *p)
             .map_err(FitError::from)
-            .and_then(|s| model_at(&s));
+            .and_then(|s| search.spectrum(&s, &lambdas));
         match model {
-            Ok(m) => {
-                let ss: f64 = m
-                    .iter()
-                    .zip(measured.reflectance())
-                    .zip(measured.weights())
-                    .map(|((r_hat, r), w)| w * (r - r_hat).powi(2))
-                    .sum();
-                (ss / weight_sum).sqrt()
+            Ok(mut m) => {
+                for (r, b) in m.iter_mut().zip(shift.borrow().iter()) {
+                    *r += b;
+                }
+                weighted_rms(&m)
             }
             Err(e) => {
-                failure.get_or_insert(e);
+                failure.borrow_mut().get_or_insert(e);
                 f64::INFINITY
             }
         }
     };
     let (w, prior) = (opts.prior_weight_rms, opts.beta_prior);
+    let penalties =
+        |x: &[f64; 3], p: [f64; 3]| prior_penalty2(p, w, opts) + (10.0 * infeasibility(x)).powi(2);
     let mut objective = |x: &[f64; 3]| {
         let p = search_to_params(x, prior);
-        rms(&p).powi(2) + prior_penalty2(p, w, opts) + (10.0 * infeasibility(x)).powi(2)
+        rms(&p).powi(2) + penalties(x, p)
     };
-    let (x, _, mut evaluations) = global_minimum(&mut objective, |_| false, opts);
+    let budget = if search_forward.is_some() {
+        SEARCH
+    } else {
+        REFINE
+    };
+    let (mut x, _, mut evaluations) = global_minimum(&mut objective, |_| false, opts, budget);
+    let mut full_evaluations = 0;
+    if search_forward.is_some() {
+        let full_at = |x: &[f64; 3]| -> Result<(Vec<f64>, f64), FitError> {
+            let p = search_to_params(x, prior);
+            let skin = with_chromophores(&opts.base, p)?;
+            let f = full.spectrum(&skin, &lambdas)?;
+            let c = search.spectrum(&skin, &lambdas)?;
+            let diff = f.iter().zip(&c).map(|(f, c)| f - c).collect();
+            Ok((diff, weighted_rms(&f).powi(2) + penalties(x, p)))
+        };
+        let (xm, search_evals, full_evals) = space_mapping(
+            x,
+            &mut objective,
+            |b| *shift.borrow_mut() = b,
+            full_at,
+            REFINE,
+        )?;
+        x = xm;
+        evaluations += search_evals + 2 * full_evals;
+        full_evaluations = full_evals;
+    }
     let p = search_to_params(&x, prior);
-    let best = rms(&p);
-    let (beta_range, sweep_evals) = beta_sweep(&mut rms, p, best, opts.beta_tolerance_rms, opts);
+    let skin = with_chromophores(&opts.base, p)?;
+    let model = full.spectrum(&skin, &lambdas)?;
+    let best = weighted_rms(&model);
+    let (beta_range, sweep_evals) =
+        beta_sweep(&mut |p| rms(p), p, best, opts.beta_tolerance_rms, opts);
     evaluations += sweep_evals + 1;
-    if let Some(e) = failure {
+    if let Some(e) = failure.into_inner() {
         return Err(e);
     }
-    let skin = with_chromophores(&opts.base, p)?;
     let colour = ColourModel::new(opts.step_nm, opts.method, opts.base)?;
     Ok(SpectrumFit {
-        model: model_at(&skin)?,
+        model,
         lab: colour.lab(&skin)?,
         skin,
         rms: best,
         within_tolerance: best <= opts.max_rms,
         beta_range,
         evaluations,
+        full_evaluations,
     })
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::Method;
 
     /// Gaussian deviates from a seeded SplitMix64 (Box–Muller), so the test needs no RNG crate.
     struct Noise(u64);
@@ -119,10 +161,20 @@ mod tests {
     /// wavelengths, weighted by the inverse noise variance, fits back to C_m within 10 % and β_m
     /// within 0.1 where melanin shapes the spectrum (C_m ≥ 0.02), and C_h within 15 % where the
     /// dermis shows through (C_m ≤ 0.1; at C_m = 0.3 the whole range of C_h changes this spectrum by
-    /// under 0.1 %, so C_h is not determined and the prior decides).
+    /// under 0.1 %, so C_h is not determined and the prior decides). For both forward models, each
+    /// fitting spectra it generated (the exact one through its two-stage search).
     #[test]
     fn noisy_spectrum_fits_back_to_its_parameters() {
-        let opts = FitOptions::default();
+        for method in [Method::Exact, Method::Multipole] {
+            noisy_spectrum_round_trip(method);
+        }
+    }
+
+    fn noisy_spectrum_round_trip(method: Method) {
+        let opts = FitOptions {
+            method,
+            ..FitOptions::default()
+        };
         let mut noise = Noise(2026);
         for truth in [
             [0.02, 0.5, 0.01],
@@ -135,7 +187,12 @@ mod tests {
             let clean: Vec<f64> = lambda
                 .iter()
                 .map(|&nm| {
-                    diffuse_reflectance(&skin, Wavelength::new(nm).unwrap(), opts.method).unwrap()
+                    crate::skin::diffuse_reflectance(
+                        &skin,
+                        Wavelength::new(nm).unwrap(),
+                        opts.method,
+                    )
+                    .unwrap()
                 })
                 .collect();
             let noisy: Vec<f64> = clean
@@ -148,7 +205,7 @@ mod tests {
             let fit = fit_spectrum(&measured, &opts).unwrap();
             let s = fit.skin;
             let msg = format!(
-                "truth {truth:?} fit {:?} rms {}",
+                "{method}: truth {truth:?} fit {:?} rms {}",
                 [s.melanin(), s.eumelanin_blend(), s.hemoglobin()],
                 fit.rms
             );
