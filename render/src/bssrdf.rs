@@ -29,7 +29,7 @@ pub mod table;
 
 pub use sampling::{ProbeFrame, choose_axis, pdf_exit, probe};
 pub use separable::{Directional, EnergySplit, texture_modulation};
-pub use table::{ProfileTable, TableOptions};
+pub use table::{ProfileTable, RENDER_SHAPE_ESCAPES, RENDER_SHAPE_STEP_NM, TableOptions};
 
 use crate::accel::ray;
 use crate::geometry::{Geometry, SurfaceHit};
@@ -245,14 +245,16 @@ mod tests {
     fn sampled_radius_follows_the_profile_chi2() {
         let ss = subsurface(Preset::Light);
         let geo = slab();
-        let nm = 600.0f32;
+        // An anchor of the tables' Monte Carlo shapes (380 + 6 × 40 nm), where the row is the shape
+        // itself, not a mix of two.
+        let nm = 620.0f32;
         let wl = SampledWavelengths::sample_visible((nm - 380.0) / 400.0);
         assert!((wl.nm(0) - nm).abs() < 1e-3);
         let reference = multipole::skin::profile(
             &SkinParams::preset(Preset::Light),
             Wavelength::new(f64::from(nm)).unwrap(),
             multipole::Method::default(),
-            &multipole::ProfileOptions::default(),
+            &TableOptions::default().profile,
         )
         .unwrap();
         let k = 20;

@@ -25,13 +25,26 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 /// Choices made when a scene is loaded.
-#[derive(Debug, Clone, Copy, Default)]
+#[derive(Debug, Clone, Copy)]
 pub struct SceneOptions {
-    /// How skin reflectance is computed (multipole diffusion).
+    /// How skin reflectance is computed (default exact: adding-doubling totals, Monte Carlo shapes).
     pub method: multipole::Method,
     /// Shade skin's body with the Lambertian stand-in instead of the BSSRDF (for comparisons;
     /// default false: subsurface scattering on).
     pub no_subsurface: bool,
+    /// Escaping photons per Monte Carlo profile shape (`Method::Exact`; default
+    /// [`crate::bssrdf::RENDER_SHAPE_ESCAPES`]).
+    pub shape_escapes: u64,
+}
+
+impl Default for SceneOptions {
+    fn default() -> Self {
+        Self {
+            method: multipole::Method::default(),
+            no_subsurface: false,
+            shape_escapes: crate::bssrdf::RENDER_SHAPE_ESCAPES,
+        }
+    }
 }
 
 /// What a ray hit first: a surface or an area light.
@@ -495,7 +508,11 @@ impl Loader<'_> {
     /// The BSSRDF of a skin: its radial profiles at 10-nm steps (`bssrdf::ProfileTable`) and the
     /// directional term with the surface lobe's energy split.
     fn subsurface(&self, key: &str, skin: &SkinMaterial) -> Result<Subsurface, RenderError> {
-        let table = ProfileTable::build(&skin.params, self.opts.method, &TableOptions::default())
+        let mut opts = TableOptions::default();
+        opts.profile.exact_shape = multipole::skin::ExactShape::MonteCarlo {
+            escapes: self.opts.shape_escapes,
+        };
+        let table = ProfileTable::build(&skin.params, self.opts.method, &opts)
             .map_err(|e| self.err(key, format!("skin profiles: {e}")))?;
         let directional = Directional::new(skin.surface.clone(), EnergySplit::default());
         Ok(Subsurface::new(std::sync::Arc::new(table), directional))

@@ -1,7 +1,7 @@
 //! Why a method is (or is not) trustworthy at one wavelength: the numbers behind the choice of
 //! treatment, printed by `skin spectrum --explain` and `skin profile --explain` (issue [exact]).
 
-use super::{Method, layer_scales, total_reflectance};
+use super::{ExactShape, Method, layer_scales, shape_photons, total_reflectance};
 use crate::error::MultipoleError;
 use crate::medium::Medium;
 use crate::slab::Poles;
@@ -32,6 +32,10 @@ pub struct Explanation {
     /// `Method::Exact` profile only: factors (exact / diffusion at q = 0) on the epidermis R↓, T↓,
     /// R↑, T↑ and the dermis R, and the final correction to the exact two-layer total.
     pub profile_scales: Option<([f64; 5], f64)>,
+    /// `Method::Exact` profile only: its shape.
+    pub shape: Option<ExactShape>,
+    /// Photons the Monte Carlo shape traces (with [`ExactShape::MonteCarlo`]).
+    pub shape_photons: Option<u64>,
 }
 
 impl Explanation {
@@ -73,11 +77,31 @@ impl fmt::Display for Explanation {
             ),
             Method::Exact => {
                 write!(f, "Method exact: total by adding-doubling")?;
+                match (self.shape, self.shape_photons) {
+                    (Some(ExactShape::MonteCarlo { escapes }), Some(n)) => write!(
+                        f,
+                        "; profile shape = layered Monte Carlo ({n} photons for {escapes} escapes), scaled to the exact total"
+                    )?,
+                    (Some(ExactShape::RescaledTotal), _) => {
+                        f.write_str("; profile = multipole shape scaled to the exact total")?;
+                    }
+                    _ => {}
+                }
                 if let Some((s, c)) = self.profile_scales {
                     write!(
                         f,
-                        "; profile = diffusion layers rescaled before stacking (epidermis R↓ ×{:.3}, T↓ ×{:.3}, R↑ ×{:.3}, T↑ ×{:.3}; dermis R ×{:.3}; then ×{:.3} to the exact total)",
-                        s[0], s[1], s[2], s[3], s[4], c
+                        "; diffusion layers rescaled to exact per-layer totals{}: epidermis R↓ ×{:.3}, T↓ ×{:.3}, R↑ ×{:.3}, T↑ ×{:.3}; dermis R ×{:.3}; then ×{:.3} to the exact total",
+                        if self.shape == Some(ExactShape::PerLayer) {
+                            " (the profile)"
+                        } else {
+                            " (not used: shown for how far diffusion is off per layer)"
+                        },
+                        s[0],
+                        s[1],
+                        s[2],
+                        s[3],
+                        s[4],
+                        c
                     )?;
                 }
                 f.write_str(".")
@@ -86,14 +110,16 @@ impl fmt::Display for Explanation {
     }
 }
 
-/// The diagnostic of `method` for `skin` at `lambda`; `with_profile` adds the profile's layer factors
-/// (`Method::Exact` only; costs one more adding-doubling solve).
+/// The diagnostic of `method` for `skin` at `lambda`; `profile` (the exact profile's shape, if a
+/// profile is made) adds its treatment and diffusion's per-layer factors (`Method::Exact` only;
+/// costs one more adding-doubling solve).
 pub fn explain(
     skin: &SkinParams,
     lambda: Wavelength,
     method: Method,
-    with_profile: bool,
+    profile: Option<ExactShape>,
 ) -> Result<Explanation, MultipoleError> {
+    let with_profile = profile.is_some();
     let c = skin.coefficients(lambda);
     let epi = Medium::from_coefficients(&c.epidermis)?;
     let derm = Medium::from_coefficients(&c.dermis)?;
@@ -121,6 +147,13 @@ pub fn explain(
         multipole_total,
         exact_total,
         profile_scales,
+        shape: profile.filter(|_| method == Method::Exact),
+        shape_photons: match (method, profile) {
+            (Method::Exact, Some(ExactShape::MonteCarlo { escapes })) => {
+                Some(shape_photons(escapes, exact_total, skin.eta()))
+            }
+            _ => None,
+        },
     })
 }
 
@@ -136,7 +169,7 @@ mod tests {
             &SkinParams::preset(Preset::Light),
             lambda,
             Method::Exact,
-            true,
+            Some(ExactShape::default()),
         )
         .unwrap();
         // BENCHMARKS.md `## Exact method`: light skin within −2.2% to +3.1% over 400–700 nm.
@@ -146,7 +179,7 @@ mod tests {
             &SkinParams::preset(Preset::Dark),
             lambda,
             Method::Multipole,
-            true,
+            Some(ExactShape::default()),
         )
         .unwrap();
         // Dark skin: diffusion at least 60% too bright, low-albedo epidermis; no profile factors asked.
@@ -162,7 +195,9 @@ mod tests {
         );
         let text = light.to_string();
         assert!(
-            text.contains("adding-doubling") && text.contains("dermis R ×"),
+            text.contains("adding-doubling")
+                && text.contains("dermis R ×")
+                && text.contains("layered Monte Carlo"),
             "{text}"
         );
         // The final correction of the per-layer profile is small (the scalars ignore angles only).

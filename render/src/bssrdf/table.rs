@@ -18,9 +18,18 @@
 //! R_tot / ∫table so the table integrates to the model's total R_tot (exact, from q = 0): the 0.1%
 //! tail is redistributed over the table instead of being lost.
 
+use multipole::skin::ExactShape;
 use multipole::{Method, MultipoleError, Profile, ProfileOptions, SpectralProfiles};
 use skin_optics::{SkinParams, WavelengthGrid};
 use std::f32::consts::PI;
+
+/// Escaping photons per Monte Carlo shape in the render's tables (`Method::Exact`): the energy-weighted
+/// shape error is 7–11% at 1,000 against 4–7% at 4,000, for a quarter of the cost
+/// (`cargo run --release -p validation --example shape_step`, BENCHMARKS.md `## Renderer`).
+pub const RENDER_SHAPE_ESCAPES: u64 = 1_000;
+/// Wavelength step between Monte Carlo shapes in the render's tables, nm (rows between mix the
+/// neighbouring shapes; each keeps its exact total): 40 nm adds < 1% to the shape error of 10 nm.
+pub const RENDER_SHAPE_STEP_NM: f64 = 40.0;
 
 /// Smallest radius of the grid, mm (matches the multipole tables' first radius).
 pub const R_MIN_MM: f32 = 1e-3;
@@ -36,7 +45,8 @@ pub struct TableOptions {
     pub step_nm: f64,
     /// Radii of the common geometric grid (≥ 8).
     pub radii: usize,
-    /// Multipole knobs of each profile.
+    /// Knobs of each profile: the multipole's, and the exact method's Monte Carlo shape
+    /// ([`RENDER_SHAPE_ESCAPES`] escapes every [`RENDER_SHAPE_STEP_NM`] by default).
     pub profile: ProfileOptions,
 }
 
@@ -47,7 +57,13 @@ impl Default for TableOptions {
             to_nm: 780.0,
             step_nm: 10.0,
             radii: 128,
-            profile: ProfileOptions::default(),
+            profile: ProfileOptions {
+                exact_shape: ExactShape::MonteCarlo {
+                    escapes: RENDER_SHAPE_ESCAPES,
+                },
+                shape_step_nm: RENDER_SHAPE_STEP_NM,
+                ..ProfileOptions::default()
+            },
         }
     }
 }

@@ -6,7 +6,7 @@ use crate::cli::args::SkinArgs;
 use crate::plot::{LineChart, Panel, Series, palette_color, save_png};
 use anyhow::Context;
 use clap::Args;
-use multipole::skin::{Method, profile};
+use multipole::skin::{DEFAULT_SHAPE_ESCAPES, ExactShape, Method, profile};
 use multipole::{Profile, ProfileOptions};
 use skin_optics::Wavelength;
 use std::io::{BufWriter, Write};
@@ -27,11 +27,14 @@ pub struct ProfileArgs {
     /// Number of radii, geometric from 0.001 mm to the outer radius, in [2, 1000000].
     #[arg(long, value_name = "N", default_value_t = 256, value_parser = parse_samples, allow_hyphen_values = true)]
     pub samples: usize,
-    /// Profile method: exact (the default: exact adding-doubling total, diffusion layers rescaled to
-    /// exact per-layer totals) or
-    /// multipole (the paper's diffusion, too bright for dark skin).
+    /// Profile method: exact (the default: adding-doubling total, shape from the layered Monte Carlo)
+    /// or multipole (the paper's diffusion, too bright for dark skin).
     #[arg(long, value_name = "METHOD", default_value_t = Method::default(), value_parser = parse_method)]
     pub method: Method,
+    /// Escaping photons of the exact profile's Monte Carlo shape, in [100, 1e9] (the accuracy knob:
+    /// noise ∝ 1/√N; the photons traced are N divided by the skin's reflectance).
+    #[arg(long, value_name = "N", default_value_t = DEFAULT_SHAPE_ESCAPES, value_parser = parse_escapes)]
+    pub escapes: u64,
     /// Print to stderr the treatment used and why (layer albedos, epidermis thickness in mean free
     /// paths, diffusion versus exact total, the exact profile's per-layer factors).
     #[arg(long)]
@@ -74,8 +77,38 @@ fn parse_samples(s: &str) -> Result<usize, String> {
     Ok(v)
 }
 
+fn parse_escapes(s: &str) -> Result<u64, String> {
+    let v = parse_number(s, "[100, 1e9]")?;
+    if !(100.0..=1e9).contains(&v) || v.fract() != 0.0 {
+        return Err(format!("{v} outside [100, 1e9] (whole number)"));
+    }
+    Ok(v as u64)
+}
+
 fn parse_method(s: &str) -> Result<Method, String> {
     s.parse::<Method>().map_err(|e| e.to_string())
+}
+
+/// `p` on `opts.radial_samples` geometric radii from 1e-3 mm to `opts.r_max_mm` (default: its own
+/// outer radius), as the diffusion tables are laid out; a Monte Carlo shape has its own grid.
+fn on_requested_radii(p: Profile, opts: &ProfileOptions) -> anyhow::Result<Profile> {
+    let n = opts.radial_samples;
+    if p.radii_mm().len() == n
+        && opts
+            .r_max_mm
+            .is_none_or(|r| (r - p.r_max_mm()).abs() < 1e-12)
+    {
+        return Ok(p);
+    }
+    let (r0, r1) = (
+        1e-3_f64,
+        opts.r_max_mm.unwrap_or_else(|| p.r_max_mm()).max(2e-3),
+    );
+    let radii: Vec<f64> = (0..n)
+        .map(|i| r0 * (r1 / r0).powf(i as f64 / (n - 1) as f64))
+        .collect();
+    let values = radii.iter().map(|&r| p.eval(r)).collect();
+    Ok(Profile::from_table(radii, values, p.total())?)
 }
 
 /// Run `skin profile`.
@@ -84,14 +117,18 @@ pub fn run(args: &ProfileArgs) -> anyhow::Result<()> {
     let opts = ProfileOptions {
         radial_samples: args.samples,
         r_max_mm: args.r_max,
+        exact_shape: ExactShape::MonteCarlo {
+            escapes: args.escapes,
+        },
         ..ProfileOptions::default()
     };
     let lambda = Wavelength::new(args.lambda).context("--lambda")?;
-    let prof = profile(&skin, lambda, args.method, &opts)?;
+    let prof = on_requested_radii(profile(&skin, lambda, args.method, &opts)?, &opts)?;
     if args.explain {
         eprintln!(
             "{}",
-            multipole::skin::explain(&skin, lambda, args.method, true).context("--explain")?
+            multipole::skin::explain(&skin, lambda, args.method, Some(opts.exact_shape))
+                .context("--explain")?
         );
     }
     let stdout = std::io::stdout();
@@ -113,7 +150,10 @@ pub fn run(args: &ProfileArgs) -> anyhow::Result<()> {
             .log_x()
             .log_y();
         for (i, nm) in [450.0, 550.0, 650.0].into_iter().enumerate() {
-            let p: Profile = profile(&skin, Wavelength::new(nm)?, args.method, &opts)?;
+            let p = on_requested_radii(
+                profile(&skin, Wavelength::new(nm)?, args.method, &opts)?,
+                &opts,
+            )?;
             let points = p
                 .radii_mm()
                 .iter()

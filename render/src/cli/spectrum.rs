@@ -150,7 +150,7 @@ pub fn run(args: &SpectrumArgs) -> anyhow::Result<()> {
         for lambda in grid.iter() {
             eprintln!(
                 "{}",
-                multipole::skin::explain(&skin, lambda, args.method, false)
+                multipole::skin::explain(&skin, lambda, args.method, None)
                     .with_context(|| format!("--explain at {} nm", lambda.nm()))?
             );
         }
