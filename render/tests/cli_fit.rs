@@ -1,5 +1,6 @@
 //! `skin fit` end to end: colour and spectrum fits, JSON output, out-of-gamut reporting, bad input.
 
+use multipole::Method;
 use multipole::fit::{ColourModel, FitOptions};
 use skin_optics::Wavelength;
 use skin_optics::lab::Lab;
@@ -32,41 +33,58 @@ fn json(out: &Output) -> serde_json::Value {
 
 #[test]
 fn colour_of_a_model_skin_fits_back_within_half_a_delta_e() {
+    // The default forward model is exact (recorded in the JSON); `--method multipole` fits with the
+    // paper's diffusion. Each fits a colour it generated.
+    for (args, method) in [
+        (&[][..], Method::Exact),
+        (&["--method", "multipole"][..], Method::Multipole),
+    ] {
+        let model = model_of(method);
+        let xyz = model.xyz(&model.skin(0.05, 0.6, 0.02).unwrap()).unwrap();
+        let hex = model_hex(method, [0.05, 0.6, 0.02]);
+        let mut all = vec!["--srgb", &hex, "--json"];
+        all.extend_from_slice(args);
+        let v = json(&skin_fit(&all));
+        assert_eq!(v["method"], method.to_string().as_str(), "{v}");
+        assert_eq!(v["target"]["srgb"], hex.as_str());
+        assert_eq!(v["in_gamut"], true);
+        // The 8-bit hex itself is up to ~0.3 ΔE00 from the model colour; the fit must reach the hex.
+        assert!(v["residual"]["delta_e_2000"].as_f64().unwrap() < 0.5, "{v}");
+        let p = &v["parameters"];
+        assert!((p["melanin"].as_f64().unwrap() - 0.05).abs() < 0.01, "{v}");
+        let ita = v["fitted"]["lab"]["ita_deg"].as_f64().unwrap();
+        let lab = Lab::from_xyz(xyz);
+        assert!(
+            (ita - lab.ita_deg()).abs() < 1.0,
+            "{method}: {ita} vs {}",
+            lab.ita_deg()
+        );
+        assert_eq!(
+            v["fitted"]["lab"]["ita_category"],
+            lab.ita_category().name()
+        );
+        // The two-stage exact fit reports its full-model evaluations; the multipole fit has none.
+        let full = v["full_evaluations"].as_u64().unwrap();
+        assert_eq!(full > 0, method == Method::Exact, "{v}");
+    }
+}
+
+/// The fit's colour model for `method` at the default options.
+fn model_of(method: Method) -> ColourModel {
     let opts = FitOptions::default();
-    let model = ColourModel::new(opts.step_nm, opts.method, opts.base).unwrap();
-    let xyz = model.xyz(&model.skin(0.05, 0.6, 0.02).unwrap()).unwrap();
-    let hex = model_hex([0.05, 0.6, 0.02]);
-    let v = json(&skin_fit(&["--srgb", &hex, "--json"]));
-    assert_eq!(v["target"]["srgb"], hex.as_str());
-    assert_eq!(v["in_gamut"], true);
-    // The 8-bit hex itself is up to ~0.3 ΔE00 from the model colour; the fit must reach the hex.
-    assert!(v["residual"]["delta_e_2000"].as_f64().unwrap() < 0.5, "{v}");
-    let p = &v["parameters"];
-    assert!((p["melanin"].as_f64().unwrap() - 0.05).abs() < 0.01, "{v}");
-    let ita = v["fitted"]["lab"]["ita_deg"].as_f64().unwrap();
-    let lab = Lab::from_xyz(xyz);
-    assert!(
-        (ita - lab.ita_deg()).abs() < 1.0,
-        "{ita} vs {}",
-        lab.ita_deg()
-    );
-    assert_eq!(
-        v["fitted"]["lab"]["ita_category"],
-        lab.ita_category().name()
-    );
+    ColourModel::new(opts.step_nm, method, opts.base).unwrap()
 }
 
 /// The hex colour of a model skin (C_m, β_m, C_h), so the target is inside the model's gamut.
-fn model_hex(p: [f64; 3]) -> String {
-    let opts = FitOptions::default();
-    let model = ColourModel::new(opts.step_nm, opts.method, opts.base).unwrap();
+fn model_hex(method: Method, p: [f64; 3]) -> String {
+    let model = model_of(method);
     let xyz = model.xyz(&model.skin(p[0], p[1], p[2]).unwrap()).unwrap();
     xyz.to_linear_srgb().to_srgb().to_hex()
 }
 
 #[test]
 fn text_output_names_parameters_colour_residual_and_ita() {
-    let hex = model_hex([0.02, 0.5, 0.01]);
+    let hex = model_hex(Method::Exact, [0.02, 0.5, 0.01]);
     let out = skin_fit(&["--srgb", &hex]);
     assert!(out.status.success(), "{}", stderr(&out));
     let text = String::from_utf8(out.stdout).unwrap();
@@ -80,6 +98,7 @@ fn text_output_names_parameters_colour_residual_and_ita() {
         "ΔE2000 = ",
         "ITA° ",
         "L*a*b* (",
+        "(method exact)",
     ] {
         assert!(text.contains(needle), "missing {needle:?} in\n{text}");
     }
@@ -103,22 +122,32 @@ fn pure_green_is_reported_out_of_gamut_with_the_nearest_skin() {
 
 #[test]
 fn spectrum_of_known_skin_fits_back() {
+    for method in [Method::Exact, Method::Multipole] {
+        spectrum_round_trip(method);
+    }
+}
+
+fn spectrum_round_trip(method: Method) {
     let truth = (0.1, 0.7, 0.03);
     let skin = skin_optics::SkinParams::new(truth.0, truth.1, truth.2, 0.25).unwrap();
     let mut csv = String::from("# model skin C_m 0.1, β_m 0.7, C_h 0.03\nlambda_nm,reflectance\n");
     for i in 0..31 {
         let nm = 400.0 + 10.0 * f64::from(i);
-        let r = multipole::skin::diffuse_reflectance(
-            &skin,
-            Wavelength::new(nm).unwrap(),
-            multipole::Method::Multipole,
-        )
-        .unwrap();
+        let r = multipole::skin::diffuse_reflectance(&skin, Wavelength::new(nm).unwrap(), method)
+            .unwrap();
         csv.push_str(&format!("{nm},{r}\n"));
     }
-    let path = temp_csv("known", &csv);
-    let v = json(&skin_fit(&["--spectrum", path.to_str().unwrap(), "--json"]));
+    let path = temp_csv(&format!("known-{method}"), &csv);
+    let name = method.to_string();
+    let v = json(&skin_fit(&[
+        "--spectrum",
+        path.to_str().unwrap(),
+        "--json",
+        "--method",
+        &name,
+    ]));
     std::fs::remove_file(&path).ok();
+    assert_eq!(v["method"], name.as_str());
     assert!(
         v["residual"]["rms_reflectance"].as_f64().unwrap() < 1e-3,
         "{v}"
@@ -232,7 +261,7 @@ fn skin_spectrum_reports_lab_and_ita_on_stderr() {
         .expect("lab line");
     // Same numbers as the fit's colour model at the same grid (400-700 nm every 10 nm).
     let opts = FitOptions::default();
-    let model = ColourModel::new(10.0, opts.method, opts.base).unwrap();
+    let model = ColourModel::new(10.0, Method::Multipole, opts.base).unwrap();
     let lab = model
         .lab(&skin_optics::SkinParams::preset(
             skin_optics::Preset::Medium,
@@ -247,4 +276,13 @@ fn skin_spectrum_reports_lab_and_ita_on_stderr() {
         lab.ita_category()
     );
     assert_eq!(line, want);
+}
+
+#[test]
+fn help_names_the_exact_default_and_the_multipole_alternative() {
+    let out = skin_fit(&["--help"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(text.contains("[default: exact]"), "{text}");
+    assert!(text.contains("multipole"), "{text}");
 }
