@@ -25,13 +25,12 @@ fn distance(p: &Profile, reference: &Profile) -> f64 {
             })
             .sum::<f64>()
     };
-    let head = energy(p, 0.0, edges[0]) - energy(reference, 0.0, edges[0]);
-    head.abs()
-        + edges
-            .windows(2)
-            .map(|w| (energy(p, w[0], w[1]) - energy(reference, w[0], w[1])).abs())
-            .sum::<f64>()
-            / reference.total()
+    let head = (energy(p, 0.0, edges[0]) - energy(reference, 0.0, edges[0])).abs();
+    let rest: f64 = edges
+        .windows(2)
+        .map(|w| (energy(p, w[0], w[1]) - energy(reference, w[0], w[1])).abs())
+        .sum();
+    (head + rest) / reference.total()
 }
 
 fn main() -> anyhow::Result<()> {

@@ -34,8 +34,11 @@ pub struct Settings {
     pub spectrum_photons: u64,
     /// Photons per MC run of the radial profiles.
     pub profile_photons: u64,
-    /// Photons per MC run of the exact-versus-multipole spectra (dark skin needs many: R_d ≈ 0.005).
+    /// Least photons per MC run of the exact-versus-multipole spectra.
     pub exact_photons: u64,
+    /// Escaping photons wanted per MC run of those spectra: dark skin (R_d ≈ 0.005) traces up to
+    /// 100 × `exact_photons` to keep the relative noise about the same for every skin tone.
+    pub exact_escapes: u64,
     /// Cells per axis of the stability map.
     pub stability_cells: usize,
     /// Photons per cell of the stability map.
@@ -56,6 +59,7 @@ impl Settings {
                 spectrum_photons: 10_000,
                 profile_photons: 40_000,
                 exact_photons: 100_000,
+                exact_escapes: 10_000,
                 stability_cells: 6,
                 stability_photons: 3_000,
                 knob_max_photons: 30_000,
@@ -67,6 +71,7 @@ impl Settings {
                 spectrum_photons: 50_000,
                 profile_photons: 1_000_000,
                 exact_photons: 300_000,
+                exact_escapes: 150_000,
                 stability_cells: 12,
                 stability_photons: 20_000,
                 knob_max_photons: 1_000_000,
