@@ -13,14 +13,23 @@ fn totals(c: &mut Criterion) {
     g.bench_function("skin_1lambda", |b| {
         b.iter(|| total_reflectance(black_box(&skin), lambda, Method::Multipole))
     });
-    let grid = WavelengthGrid::visible();
-    g.bench_function("skin_31lambda_observable", |b| {
-        b.iter(|| {
-            grid.iter()
-                .map(|l| diffuse_reflectance(black_box(&skin), l, Method::Multipole).unwrap_or(0.0))
-                .sum::<f64>()
-        })
+    g.bench_function("skin_1lambda_exact", |b| {
+        b.iter(|| total_reflectance(black_box(&skin), lambda, Method::Exact))
     });
+    let grid = WavelengthGrid::visible();
+    for method in [Method::Multipole, Method::Exact] {
+        let id = match method {
+            Method::Multipole => "skin_31lambda_observable".to_string(),
+            other => format!("skin_31lambda_observable_{other}"),
+        };
+        g.bench_function(id, |b| {
+            b.iter(|| {
+                grid.iter()
+                    .map(|l| diffuse_reflectance(black_box(&skin), l, method).unwrap_or(0.0))
+                    .sum::<f64>()
+            })
+        });
+    }
     let slab = Slab::new(Medium::new(0.1, 2.0).expect("medium"), 1.0, 1.4, 1.0).expect("slab");
     for (name, poles) in [
         ("exact", Poles::Exact),

@@ -451,3 +451,54 @@ fn print_cpu_time_per_spectrum() {
         println!("| {n} | {} |", row.join(" | "));
     }
 }
+
+#[test]
+#[ignore = "prints the worst quadrature error against 64 points for BENCHMARKS.md"]
+fn print_worst_error_against_64_points() {
+    // The four skins, 400–700 nm every 20 nm; observable diffuse reflectance.
+    let skins = [
+        [0.002, 0.5, 0.01],
+        [0.05, 0.7, 0.02],
+        [0.25, 0.9, 0.04],
+        [0.5, 0.9, 0.07],
+    ];
+    let lambdas: Vec<Wavelength> = (0..16)
+        .map(|i| Wavelength::new(400.0 + 20.0 * f64::from(i)).expect("visible"))
+        .collect();
+    let reference: Vec<Vec<f64>> = skins
+        .iter()
+        .map(|p| {
+            let skin = SkinParams::new(p[0], p[1], p[2], 0.25).expect("valid skin");
+            lambdas
+                .iter()
+                .map(|&l| {
+                    skin_totals(&skin, l, &opts(64))
+                        .expect("solves")
+                        .diffuse_reflectance
+                })
+                .collect()
+        })
+        .collect();
+    println!("| points | light (C_m 0.002) | C_m 0.05 | C_m 0.25 | C_m 0.5 |");
+    for n in [8, 12, 16, 20, 24, 32, 48] {
+        let row: Vec<String> = skins
+            .iter()
+            .zip(&reference)
+            .map(|(p, r)| {
+                let skin = SkinParams::new(p[0], p[1], p[2], 0.25).expect("valid skin");
+                let worst = lambdas
+                    .iter()
+                    .zip(r)
+                    .map(|(&l, &r64)| {
+                        let v = skin_totals(&skin, l, &opts(n))
+                            .expect("solves")
+                            .diffuse_reflectance;
+                        (v / r64 - 1.0).abs()
+                    })
+                    .fold(0.0f64, f64::max);
+                format!("{:.2}%", 100.0 * worst)
+            })
+            .collect();
+        println!("| {n} | {} |", row.join(" | "));
+    }
+}
