@@ -87,14 +87,14 @@ pub(crate) const LANES: usize = 2;
 
 /// The photon state: position (mm), direction cosines, weight, current layer.
 pub(super) struct Photon {
-    x: f64,
-    y: f64,
-    z: f64,
+    pub(super) x: f64,
+    pub(super) y: f64,
+    pub(super) z: f64,
     pub(super) ux: f64,
     pub(super) uy: f64,
     pub(super) uz: f64,
-    w: f64,
-    layer: usize,
+    pub(super) w: f64,
+    pub(super) layer: usize,
 }
 
 /// One history in flight.
