@@ -29,7 +29,7 @@ pub struct ColourModel {
 
 impl ColourModel {
     /// A model over 400–700 nm every `step_nm` (in (0, 100]), for skins built on `base` (which supplies
-    /// everything but C_m, β_m, C_h), with the diffusion `method`.
+    /// everything but C_m, β_m, C_h), with the forward model `method` (exact or multipole).
     pub fn new(step_nm: f64, method: Method, base: SkinParams) -> Result<Self, FitError> {
         Self::with_forward(step_nm, Forward::Method(method), base)
     }
