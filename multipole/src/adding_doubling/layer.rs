@@ -462,8 +462,9 @@ mod tests {
 
     /// The eigenmodes solve the discrete-ordinate equations exactly; a finely started doubling solves
     /// them to O((Δτ/μ)²). Every flux entry agrees within 1e-5 absolute (measured ≤ 2e-6), thin, thick
-    /// and semi-infinite, low albedo to near-conservative (a = 1 − 1e-6). (The production doubling starts at Δτ = μ_min and is
-    /// up to 1% off in R and T of grazing directions of thin layers; the μ = 1 column is far closer.)
+    /// and semi-infinite, low albedo to near-conservative (a = 1 − 1e-6). (The production doubling
+    /// starts at Δτ = μ_min and is up to 1% off in R and T of grazing directions of thin layers; the
+    /// μ = 1 column is far closer.)
     #[test]
     fn modes_agree_with_finely_started_doubling() {
         let mu_c = (1.0f64 - 1.0 / 1.96).sqrt();
