@@ -42,7 +42,10 @@ fn check(preset: Preset, nm: f64, photons: u64) {
     let model = profile(&skin, lambda, Method::Exact, &ProfileOptions::default()).unwrap();
     let stack = LayerStack::skin(&skin, lambda, DEFAULT_SKIN_G).unwrap();
     let grid = RadialGrid::new(0.02, 300).unwrap();
-    let mc = run(&stack, &McOptions::new(photons, 16, 4242).unwrap().with_grid(grid));
+    let mc = run(
+        &stack,
+        &McOptions::new(photons, 16, 4242).unwrap().with_grid(grid),
+    );
     let (err, noise) = energy_error(&model, &mc);
     assert!(
         err < 0.10,
