@@ -7,11 +7,15 @@ use rand::RngCore;
 /// |u_z| above which a direction is treated as along the normal when rotating ([WJZ95] eq 3.20).
 const COS_ZERO: f64 = 1.0 - 1.0e-12;
 
-/// Uniform in [0, 1) with 53 random bits.
+/// Uniform in [0, 1) on the grid k·2⁻⁵²: the top 52 random bits as the mantissa of a number in
+/// [1, 2), minus 1 (three integer and float operations, no integer-to-float conversion).
 #[inline(always)]
 pub(super) fn uniform(rng: &mut impl RngCore) -> f64 {
-    (rng.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+    f64::from_bits((rng.next_u64() >> 12) | ONE_BITS) - 1.0
 }
+
+/// Bit pattern of 1.0: sign 0, exponent 1023, mantissa 0.
+const ONE_BITS: u64 = 0x3ff0_0000_0000_0000;
 
 /// Henyey–Greenstein cosine sampling ([WJZ95] eq 3.15) with the per-layer constants hoisted:
 /// cos θ = (1 + g² − t²) / (2g), t = (1 − g²) / (1 − g + 2gξ); isotropic (2ξ − 1) when g ≈ 0.
@@ -50,7 +54,7 @@ impl HgSampler {
 
 /// Uniform azimuth as (cos φ, sin φ) from one 64-bit draw, with no branch and no division:
 /// φ = d + kπ/4 with k uniform in 0..8 (the top three bits) and d uniform in [−π/8, π/8)
-/// (the low 53 bits) is uniform on the circle. cos d and sin d come from their Taylor series,
+/// (the low 52 bits) is uniform on the circle. cos d and sin d come from their Taylor series,
 /// which on |d| ≤ π/8 are below an ulp after the d¹² and d¹³ terms (the next terms are
 /// ≤ 3e-17 relative); the turn by kπ/4 is one complex multiplication.
 #[inline(always)]
@@ -60,7 +64,8 @@ pub(super) fn sample_azimuth(rng: &mut impl RngCore) -> (f64, f64) {
     const SIN_K: [f64; 8] = [0.0, H, 1.0, H, 0.0, -H, -1.0, -H];
     let bits = rng.next_u64();
     let k = (bits >> 61) as usize;
-    let t = (bits & ((1u64 << 53) - 1)) as f64 * (1.0 / (1u64 << 52) as f64) - 1.0;
+    // The low 52 bits as the mantissa of a number in [2, 4), minus 3: t uniform in [−1, 1).
+    let t = f64::from_bits((bits & ((1u64 << 52) - 1)) | (ONE_BITS + (1u64 << 52))) - 3.0;
     let (c, s) = cos_sin_small(t * FRAC_PI_8);
     (c * COS_K[k] - s * SIN_K[k], s * COS_K[k] + c * SIN_K[k])
 }
@@ -102,7 +107,8 @@ fn cos_sin_small(d: f64) -> (f64, f64) {
 #[inline(always)]
 pub(super) fn scatter(p: &mut Photon, hg: &HgSampler, rng: &mut impl RngCore) {
     let cos_t = hg.cos_theta(uniform(rng));
-    let sin2_t = (1.0 - cos_t * cos_t).max(0.0);
+    // |cos θ| ≤ 1 (clamped), so its rounded square is ≤ 1 and this is never negative.
+    let sin2_t = 1.0 - cos_t * cos_t;
     let (cos_p, sin_p) = sample_azimuth(rng);
     if p.uz.abs() > COS_ZERO {
         let sin_t = sin2_t.sqrt();
