@@ -245,7 +245,7 @@ mod tests {
     fn sampled_radius_follows_the_profile_chi2() {
         let ss = subsurface(Preset::Light);
         let geo = slab();
-        // An anchor of the tables' Monte Carlo shapes (380 + 6 × 40 nm), where the row is the shape
+        // An anchor of the tables' Monte Carlo shapes (380 + 12 × 20 nm), where the row is the shape
         // itself, not a mix of two.
         let nm = 620.0f32;
         let wl = SampledWavelengths::sample_visible((nm - 380.0) / 400.0);

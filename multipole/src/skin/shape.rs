@@ -30,16 +30,16 @@ pub const SHAPE_SEED: u64 = 0x5EED_5111;
 
 /// How `Method::Exact` shapes its radial profile; every variant's total is the exact total.
 ///
-/// Measured against an independent layered Monte Carlo run (3·10⁵ photons, seed 7, energy-weighted
+/// Measured against an independent layered Monte Carlo run (10⁶ photons, seed 7, energy-weighted
 /// error Σ|2πr Δr (R − R_mc)| / R_mc over its 0.01 mm annuli to 10 mm, which includes that run's own
-/// noise, last column; `cargo run --release -p validation --example exact_profiles 300000`),
-/// light / dark preset, `MonteCarlo` at 1,000 / 4,000 / 16,000 escapes:
+/// noise, last column; `cargo run --release -p validation --example exact_profiles`), light / dark
+/// preset; `MonteCarlo` at 1,000 / 4,000 / 16,000 escapes (wall ms per profile on 2 cores):
 ///
-/// | λ | multipole | `RescaledTotal` | `PerLayer` | `MonteCarlo` 1k / 4k / 16k | reference noise |
-/// |---|---|---|---|---|---|
-/// | 450 nm | 29.2% / 218% | 29.0% / 75.6% | 27.6% / 75.6% | 11.0 / 5.4 / 2.6% ; 5.4 / 5.4 / 5.6% | 1.8% / 1.9% |
-/// | 550 nm | 32.2% / 229% | 32.5% / 67.5% | 30.1% / 67.5% | 11.4 / 6.0 / 3.4% ; 5.7 / 3.9 / 2.9% | 2.2% / 2.4% |
-/// | 650 nm | 26.2% / 183% | 26.2% / 61.3% | 25.1% / 58.3% | 9.5 / 6.7 / 4.0% ; 8.9 / 5.2 / 4.3% | 2.7% / 2.7% |
+/// | λ | multipole | `RescaledTotal` | `PerLayer` | `MonteCarlo`, light | `MonteCarlo`, dark | noise |
+/// |---|---|---|---|---|---|---|
+/// | 450 nm | 29.4% / 220% | 29.2% / 75.6% | 27.8% / 75.6% | 9.2 / 4.3 / 2.7% (13 / 52 / 214 ms) | 4.7 / 4.4 / 4.7% (36 / 145 / 567 ms) | 1.0% / 1.0% |
+/// | 550 nm | 32.0% / 224% | 32.3% / 67.8% | 29.8% / 67.8% | 10.0 / 5.3 / 2.8% (14 / 52 / 204 ms) | 5.6 / 3.9 / 3.2% (55 / 220 / 884 ms) | 1.2% / 1.3% |
+/// | 650 nm | 25.9% / 185% | 25.8% / 61.1% | 24.8% / 57.9% | 8.5 / 4.0 / 3.6% (27 / 105 / 406 ms) | 3.9 / 2.9 / 2.8% (226 / 882 / 3496 ms) | 1.5% / 1.5% |
 ///
 /// Neither diffusion shape meets issue [exact]'s 10%: the error is the shape of diffusion *within* a
 /// layer, which no scalar per layer can change. For dark skin the epidermis (transmitting 3·10⁻⁵ to

@@ -23,13 +23,16 @@ use multipole::{Method, MultipoleError, Profile, ProfileOptions, SpectralProfile
 use skin_optics::{SkinParams, WavelengthGrid};
 use std::f32::consts::PI;
 
-/// Escaping photons per Monte Carlo shape in the render's tables (`Method::Exact`): the energy-weighted
-/// shape error is 7–11% at 1,000 against 4–7% at 4,000, for a quarter of the cost
-/// (`cargo run --release -p validation --example shape_step`, BENCHMARKS.md `## Renderer`).
+/// Escaping photons per Monte Carlo shape in the render's tables (`Method::Exact`). With
+/// [`RENDER_SHAPE_STEP_NM`], the energy-weighted shape error against a 16,000-escape shape is at most
+/// 9.1% (light), 8.6% (medium), 6.0% (dark), for 0.4 / 0.9 / 2.6 s of table building on 2 cores
+/// (4,000 escapes every 10 nm: ≤ 5.3%, 3 / 7 / 20 s; `cargo run --release -p validation --example
+/// shape_step`, BENCHMARKS.md `## Renderer`).
 pub const RENDER_SHAPE_ESCAPES: u64 = 1_000;
 /// Wavelength step between Monte Carlo shapes in the render's tables, nm (rows between mix the
-/// neighbouring shapes; each keeps its exact total): 40 nm adds < 1% to the shape error of 10 nm.
-pub const RENDER_SHAPE_STEP_NM: f64 = 40.0;
+/// neighbouring shapes; each keeps its exact total): 40 nm would add up to 2% to the light skin's
+/// worst shape error.
+pub const RENDER_SHAPE_STEP_NM: f64 = 20.0;
 
 /// Smallest radius of the grid, mm (matches the multipole tables' first radius).
 pub const R_MIN_MM: f32 = 1e-3;
