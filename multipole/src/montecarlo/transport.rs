@@ -97,6 +97,22 @@ pub(super) struct Photon {
     pub(super) layer: usize,
 }
 
+impl Photon {
+    /// A collimated photon of weight `w` entering the top layer at the origin along +z.
+    pub(super) fn launched(w: f64) -> Self {
+        Self {
+            x: 0.0,
+            y: 0.0,
+            z: 0.0,
+            ux: 0.0,
+            uy: 0.0,
+            uz: 1.0,
+            w,
+            layer: 0,
+        }
+    }
+}
+
 /// One history in flight.
 struct Lane {
     p: Photon,
@@ -111,16 +127,7 @@ struct Lane {
 impl Lane {
     /// A collimated photon of weight `w0` entering at the origin along +z.
     fn launch(&mut self, w0: f64) {
-        self.p = Photon {
-            x: 0.0,
-            y: 0.0,
-            z: 0.0,
-            ux: 0.0,
-            uy: 0.0,
-            uz: 1.0,
-            w: w0,
-            layer: 0,
-        };
+        self.p = Photon::launched(w0);
         self.s_left = 0.0;
         self.w_entry = w0;
     }
@@ -264,16 +271,7 @@ fn trace_lanes<const K: usize>(
     let mut rng = rng.clone();
     let mut lanes: [Lane; K] = std::array::from_fn(|_| {
         let mut lane = Lane {
-            p: Photon {
-                x: 0.0,
-                y: 0.0,
-                z: 0.0,
-                ux: 0.0,
-                uy: 0.0,
-                uz: 1.0,
-                w: 0.0,
-                layer: 0,
-            },
+            p: Photon::launched(0.0),
             s_left: 0.0,
             w_entry: 0.0,
         };

@@ -169,16 +169,7 @@ mod tests {
     fn scattering_turns_by_hg_angles_and_keeps_unit_length() {
         let mut rng = Xoshiro256StarStar::seed_from_u64(4);
         let hg = HgSampler::new(0.9);
-        let mut p = Photon {
-            x: 0.0,
-            y: 0.0,
-            z: 0.0,
-            ux: 0.0,
-            uy: 0.0,
-            uz: 1.0,
-            w: 1.0,
-            layer: 0,
-        };
+        let mut p = Photon::launched(1.0);
         let n = 200_000;
         let (mut sum, mut sum_z) = (0.0, 0.0);
         for _ in 0..n {
