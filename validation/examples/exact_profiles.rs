@@ -74,7 +74,9 @@ fn main() -> anyhow::Result<()> {
     )?);
     println!(
         "| preset | λ (nm) | R_mc | R_exact/R_mc − 1 | multipole | exact, rescaled total | exact, per layer | {} | MC noise |",
-        ESCAPES.map(|e| format!("MC shape {e} escapes (ms)")).join(" | ")
+        ESCAPES
+            .map(|e| format!("MC shape {e} escapes (ms)"))
+            .join(" | ")
     );
     println!("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |");
     for (preset, nm) in cases {

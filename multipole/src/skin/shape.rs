@@ -138,11 +138,7 @@ pub fn exact_profile(
 /// `table` scaled by `total` / its own total (the table keeps its held fraction of the energy).
 fn rescale(table: &Profile, total: f64) -> Result<Profile, MultipoleError> {
     let own = table.total();
-    let scale = if own > 0.0 {
-        total / own
-    } else {
-        0.0
-    };
+    let scale = if own > 0.0 { total / own } else { 0.0 };
     let values = table
         .reflectance_per_mm2()
         .iter()
@@ -202,7 +198,13 @@ fn shape_grid() -> Result<RadialGrid, MultipoleError> {
 pub fn shape_radii() -> Result<Vec<f64>, MultipoleError> {
     let grid = shape_grid()?;
     Ok((0..grid.bins())
-        .map(|i| if i == 0 { grid.outer_mm(0) } else { grid.r_mid_mm(i) })
+        .map(|i| {
+            if i == 0 {
+                grid.outer_mm(0)
+            } else {
+                grid.r_mid_mm(i)
+            }
+        })
         .collect())
 }
 
