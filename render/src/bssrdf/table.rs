@@ -1,9 +1,11 @@
 //! Per-material radial profile tables for rendering: 2πr R(r) on one geometric radius grid per
 //! material, one row per tabulation wavelength, each with its CDF, in f32 (physics.md §8).
 //!
-//! The profiles themselves come from the owner, `multipole::SpectralProfiles` ([DJ05] multipole with
-//! frequency-domain stacking, [DJ06] two-layer skin); this module only re-tabulates them for speed
-//! and interpolates across wavelength for the hero wavelengths of a path.
+//! The profiles themselves come from the owner, `multipole::SpectralProfiles` (`Method::Exact`:
+//! adding-doubling totals with layered Monte Carlo shapes, [`RENDER_SHAPE_ESCAPES`] every
+//! [`RENDER_SHAPE_STEP_NM`]; `Method::Multipole`: [DJ05] multipole with frequency-domain stacking,
+//! [DJ06] two-layer skin); this module only re-tabulates them for speed and interpolates across
+//! wavelength for the hero wavelengths of a path.
 //!
 //! # Interpolation and sampling
 //! Within a row the density p(r) = 2πr R(r) is linear in r between grid radii (rising linearly
