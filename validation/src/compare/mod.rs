@@ -145,40 +145,43 @@ pub(crate) fn write_csv(path: &Path, header: &str, rows: &[String]) -> anyhow::R
         .with_context(|| format!("writing {}", path.display()))
 }
 
+/// One study: writes its charts and CSV into the folder and its worst errors into the summary.
+type Study = fn(&Settings, &Path, &mut Summary) -> anyhow::Result<()>;
+
 /// Run only study 5 ([`exact`]) into `out` and write `summary.md`; prints the total time.
 pub fn run_exact(quick: bool, out: &Path) -> anyhow::Result<()> {
-    let settings = Settings::new(quick);
-    let start = Instant::now();
-    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
-    let mut summary = Summary::default();
-    exact::run(&settings, out, &mut summary)?;
-    let seconds = start.elapsed().as_secs_f64();
-    let command = format!(
-        "cargo run --release -p validation --bin skin-validate -- exact{} --out {}",
-        if quick { " --quick" } else { "" },
-        out.display()
-    );
-    let md = summary.to_markdown(&command, seconds);
-    render::atomic::write_bytes(&out.join("summary.md"), md.as_bytes())?;
-    println!("{md}");
-    eprintln!("skin-validate: wrote {} in {seconds:.1} s", out.display());
-    Ok(())
+    run_studies(quick, out, " exact", &[exact::run])
 }
 
 /// Run all five studies into `out` and write `summary.md`; prints the total time.
 pub fn run_comparison(quick: bool, out: &Path) -> anyhow::Result<()> {
+    run_studies(
+        quick,
+        out,
+        "",
+        &[
+            spectra::run,
+            profiles::run,
+            stability::run,
+            knobs::run,
+            exact::run,
+        ],
+    )
+}
+
+/// Run `studies` in order into `out`, then write `summary.md` with the command that reproduces it
+/// (`subcommand` is what follows `skin-validate --`, with its leading space).
+fn run_studies(quick: bool, out: &Path, subcommand: &str, studies: &[Study]) -> anyhow::Result<()> {
     let settings = Settings::new(quick);
     let start = Instant::now();
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let mut summary = Summary::default();
-    spectra::run(&settings, out, &mut summary)?;
-    profiles::run(&settings, out, &mut summary)?;
-    stability::run(&settings, out, &mut summary)?;
-    knobs::run(&settings, out, &mut summary)?;
-    exact::run(&settings, out, &mut summary)?;
+    for study in studies {
+        study(&settings, out, &mut summary)?;
+    }
     let seconds = start.elapsed().as_secs_f64();
     let command = format!(
-        "cargo run --release -p validation --bin skin-validate --{} --out {}",
+        "cargo run --release -p validation --bin skin-validate --{subcommand}{} --out {}",
         if quick { " --quick" } else { "" },
         out.display()
     );
