@@ -177,7 +177,7 @@ pub struct Estimate {
 
 impl Estimate {
     /// Mean and standard error of equally sized batch values, combined in order (deterministic).
-    pub(crate) fn from_batches(values: impl Iterator<Item = f64> + Clone) -> Self {
+    pub fn from_batches(values: impl Iterator<Item = f64> + Clone) -> Self {
         let (mut n, mut sum) = (0usize, 0.0);
         for v in values.clone() {
             n += 1;

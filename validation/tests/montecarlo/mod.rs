@@ -3,6 +3,7 @@
 mod closed_forms;
 mod determinism;
 mod energy;
+pub(crate) mod mcml;
 mod reference;
 
 /// Photon count for a test: `release` in release builds, a tenth of it in debug builds.
