@@ -9,10 +9,12 @@
 //! the annulus' exact area π((i + 1)² − i²)dr². [`mcml_binned`] puts our run on that footing.
 //! It needs finite layers: a semi-infinite layer is written [`HALF_SPACE_DEPTH_MM`] thick.
 
+mod compare;
 mod output;
 mod process;
 mod reference;
 
+pub use compare::{Comparison, GROUP_EDGES, Row, compare, groups};
 pub use output::{McmlOutput, parse_mco};
 pub use process::{McmlProcess, run_mcml, thread_cpu_seconds};
 pub use reference::ReferenceData;
