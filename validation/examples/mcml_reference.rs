@@ -25,9 +25,10 @@ fn write_atomic(path: &Path, text: &str) -> anyhow::Result<()> {
 
 fn main() -> anyhow::Result<()> {
     let mut args = std::env::args().skip(1);
-    let binary = PathBuf::from(args.next().context(
-        "usage: mcml_reference PATH_TO_MCML [RUNS] [PHOTONS_PER_RUN]",
-    )?);
+    let binary = PathBuf::from(
+        args.next()
+            .context("usage: mcml_reference PATH_TO_MCML [RUNS] [PHOTONS_PER_RUN]")?,
+    );
     let runs: u32 = args.next().map(|s| s.parse()).transpose()?.unwrap_or(20);
     let photons: u64 = args
         .next()
@@ -74,7 +75,7 @@ fn main() -> anyhow::Result<()> {
         write_atomic(&out.join(format!("{}.mci", case.name)), &mci)?;
         write_atomic(&out.join(format!("{}.csv", case.name)), &data.to_csv(&header))?;
         bar.inc(1);
-        bar.println(format!(
+        bar.suspend(|| eprintln!(
             "{}: Rd {:.5} ± {:.5}, A {:.5}, Tt {:.2e}",
             case.name,
             data.diffuse_reflectance.mean,

@@ -31,6 +31,14 @@ fn median(mut v: Vec<f64>) -> f64 {
     }
 }
 
+/// Smallest and largest value.
+fn range(v: &[f64]) -> (f64, f64) {
+    v.iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &r| {
+            (l.min(r), h.max(r))
+        })
+}
+
 fn main() -> anyhow::Result<()> {
     let mut args = std::env::args().skip(1);
     let binary = PathBuf::from(
@@ -64,12 +72,18 @@ fn main() -> anyhow::Result<()> {
             output: format!("{name}.mco"),
             photons,
         }];
-        let mci = mcml::mci(&case.stack, &runs, &format!("side-by-side speed run, {name}"))?;
+        let mci = mcml::mci(
+            &case.stack,
+            &runs,
+            &format!("side-by-side speed run, {name}"),
+        )?;
         let mut ratios = Vec::new();
         for rep in 0..repeats {
             let dir = tempfile::tempdir()?;
             let theirs = mcml::run_mcml(&binary, &mci, &runs, dir.path())?;
-            let mcml_cpu = theirs.cpu_seconds.context("no child CPU time (Linux only)")?;
+            let mcml_cpu = theirs
+                .cpu_seconds
+                .context("no child CPU time (Linux only)")?;
             let opts = McOptions::new(photons, 2, 1 + rep as u64)?.with_grid(grid);
             let (ours, our_cpu) = pool.install(|| {
                 let t0 = thread_cpu_seconds();
@@ -80,7 +94,7 @@ fn main() -> anyhow::Result<()> {
             let (rate_mcml, rate_ours) = (photons as f64 / mcml_cpu, photons as f64 / our_cpu);
             ratios.push(rate_ours / rate_mcml);
             bar.inc(1);
-            bar.println(format!(
+            bar.suspend(|| eprintln!(
                 "{name} #{rep}: MCML {rate_mcml:.0} photons/CPU-s ({mcml_cpu:.2} s, R_d {:.5}), \
                  ours {rate_ours:.0} photons/CPU-s ({our_cpu:.2} s, R_d {:.5} ± {:.5}), ratio {:.2}",
                 theirs.outputs[0].diffuse_reflectance,
@@ -90,13 +104,13 @@ fn main() -> anyhow::Result<()> {
             ));
             summary.push((name, rate_mcml, rate_ours));
         }
-        let (lo, hi) = ratios
-            .iter()
-            .fold((f64::INFINITY, 0.0f64), |(l, h), &r| (l.min(r), h.max(r)));
-        bar.println(format!(
-            "{name}: ratio median {:.2} (range {lo:.2}–{hi:.2})",
-            median(ratios.clone())
-        ));
+        let (lo, hi) = range(&ratios);
+        bar.suspend(|| {
+            eprintln!(
+                "{name}: ratio median {:.2} (range {lo:.2}–{hi:.2})",
+                median(ratios.clone())
+            )
+        });
     }
     bar.finish_and_clear();
     println!(
@@ -106,9 +120,7 @@ fn main() -> anyhow::Result<()> {
     for name in CASES {
         let rows: Vec<_> = summary.iter().filter(|r| r.0 == name).collect();
         let ratios: Vec<f64> = rows.iter().map(|r| r.2 / r.1).collect();
-        let (lo, hi) = ratios
-            .iter()
-            .fold((f64::INFINITY, 0.0f64), |(l, h), &r| (l.min(r), h.max(r)));
+        let (lo, hi) = range(&ratios);
         println!(
             "| {} | {:.0} | {:.0} | {:.2}× ({lo:.2}–{hi:.2}) |",
             mcml::case(name)?.description,

@@ -102,7 +102,12 @@ pub fn compare(
     let grid = RadialGrid::new(DR_MM, NR)?;
     let results = (0..runs)
         .into_par_iter()
-        .map(|k| Ok(run(&case.stack, &McOptions::new(photons_per_run, 2, seed + k)?.with_grid(grid))))
+        .map(|k| {
+            Ok(run(
+                &case.stack,
+                &McOptions::new(photons_per_run, 2, seed + k)?.with_grid(grid),
+            ))
+        })
         .collect::<Result<Vec<McResult>, super::McmlError>>()?;
     let mut rows = Vec::new();
     let mut push = |quantity: String, ours: Estimate, mcml: Estimate, slack: f64| {
@@ -122,7 +127,12 @@ pub fn compare(
         reference.diffuse_reflectance,
         0.0,
     );
-    push("A".into(), ours(&|r| r.absorbed.mean), reference.absorbed, 0.0);
+    push(
+        "A".into(),
+        ours(&|r| r.absorbed.mean),
+        reference.absorbed,
+        0.0,
+    );
     for (l, m) in reference.absorbed_by_layer.iter().enumerate() {
         push(
             format!("A layer {l}"),
@@ -138,7 +148,9 @@ pub fn compare(
     let groups = groups(reference, (photons_per_run * runs) as f64, min_escapes);
     for g in &groups {
         let energy = |v: &dyn Fn(usize) -> f64| -> f64 {
-            g.clone().map(|i| v(i) * reference.annulus_area_mm2(i)).sum()
+            g.clone()
+                .map(|i| v(i) * reference.annulus_area_mm2(i))
+                .sum()
         };
         let var: f64 = g
             .clone()

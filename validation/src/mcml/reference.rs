@@ -98,11 +98,7 @@ impl ReferenceData {
         let _ = writeln!(s, "specular,,{:e},0", self.specular);
         let mut est = |name: &str, index: Option<usize>, e: &Estimate, digits: usize| {
             let i = index.map(|i| i.to_string()).unwrap_or_default();
-            let _ = writeln!(
-                s,
-                "{name},{i},{:.digits$e},{:.2e}",
-                e.mean, e.stderr
-            );
+            let _ = writeln!(s, "{name},{i},{:.digits$e},{:.2e}", e.mean, e.stderr);
         };
         est("rd", None, &self.diffuse_reflectance, 7);
         est("absorbed", None, &self.absorbed, 7);

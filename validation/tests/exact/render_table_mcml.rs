@@ -94,8 +94,7 @@ fn check(preset: Preset, nm: f64, case: &str) {
         &ProfileOptions::default(),
     )
     .unwrap();
-    let (err_diffusion, _) =
-        error_and_bound(&|r| diffusion.eval(r), diffusion.r_max_mm(), &mcml);
+    let (err_diffusion, _) = error_and_bound(&|r| diffusion.eval(r), diffusion.r_max_mm(), &mcml);
     assert!(
         err_diffusion > bound,
         "{case}: diffusion's error {:.1}% should exceed the bound {:.1}%",
@@ -105,13 +104,19 @@ fn check(preset: Preset, nm: f64, case: &str) {
 }
 
 #[test]
-#[cfg_attr(debug_assertions, ignore = "builds a renderer table: run with --release")]
+#[cfg_attr(
+    debug_assertions,
+    ignore = "builds a renderer table: run with --release"
+)]
 fn render_table_light_550_nm_matches_mcml() {
     check(Preset::Light, 550.0, "light-550");
 }
 
 #[test]
-#[cfg_attr(debug_assertions, ignore = "builds a renderer table: run with --release")]
+#[cfg_attr(
+    debug_assertions,
+    ignore = "builds a renderer table: run with --release"
+)]
 fn render_table_dark_450_nm_matches_mcml() {
     check(Preset::Dark, 450.0, "dark-450");
 }

@@ -64,7 +64,11 @@ fn check(name: &str, photons: u64, seed: u64) {
         c.our_transmittance,
         reference.transmittance.mean
     );
-    assert!(c.groups.len() >= 8, "{name}: only {} groups", c.groups.len());
+    assert!(
+        c.groups.len() >= 8,
+        "{name}: only {} groups",
+        c.groups.len()
+    );
     assert!(c.rows.len() <= 26, "{name}: {} comparisons", c.rows.len());
     eprintln!(
         "{name}: {} comparisons, max |z| {:.2}, mean z² {:.2}\n{}",
