@@ -36,7 +36,7 @@ fn main() -> anyhow::Result<()> {
         let case = mcml::case(&name)?;
         let reference =
             ReferenceData::parse(&std::fs::read_to_string(dir.join(format!("{name}.csv")))?)?;
-        let c = mcml::compare(&case, &reference, 40, photons / 40, 0xA6EE, 200.0)?;
+        let c = mcml::compare(&case, &reference, 40, photons / 40, 0xA6EE, 200.0, 5e-4)?;
         bar.inc(1);
         bar.suspend(|| {
             eprintln!("{name}:\n{}", c.table());
