@@ -86,38 +86,29 @@ pub fn cases() -> Result<Vec<Case>, McmlError> {
         1.0,
         1.0,
     )?;
-    Ok(vec![
-        Case {
-            name: "light-450",
-            description: "light skin, 450 nm",
-            stack: skin(Preset::Light, 450.0)?,
-        },
-        Case {
-            name: "light-550",
-            description: "light skin, 550 nm",
-            stack: skin(Preset::Light, 550.0)?,
-        },
-        Case {
-            name: "light-650",
-            description: "light skin, 650 nm",
-            stack: skin(Preset::Light, 650.0)?,
-        },
-        Case {
-            name: "dark-450",
-            description: "dark skin, 450 nm",
-            stack: skin(Preset::Dark, 450.0)?,
-        },
-        Case {
-            name: "dark-650",
-            description: "dark skin, 650 nm",
-            stack: skin(Preset::Dark, 650.0)?,
-        },
-        Case {
-            name: "half-space",
-            description: "half-space σa 0.01, σs' 1 mm⁻¹",
-            stack: finite(&half_space)?,
-        },
-    ])
+    let skins = [
+        ("light-450", "light skin, 450 nm", Preset::Light, 450.0),
+        ("light-550", "light skin, 550 nm", Preset::Light, 550.0),
+        ("light-650", "light skin, 650 nm", Preset::Light, 650.0),
+        ("dark-450", "dark skin, 450 nm", Preset::Dark, 450.0),
+        ("dark-650", "dark skin, 650 nm", Preset::Dark, 650.0),
+    ];
+    let mut cases = skins
+        .into_iter()
+        .map(|(name, description, preset, nm)| {
+            Ok(Case {
+                name,
+                description,
+                stack: skin(preset, nm)?,
+            })
+        })
+        .collect::<Result<Vec<_>, McmlError>>()?;
+    cases.push(Case {
+        name: "half-space",
+        description: "half-space σa 0.01, σs' 1 mm⁻¹",
+        stack: finite(&half_space)?,
+    });
+    Ok(cases)
 }
 
 /// The case named `name`.
@@ -220,4 +211,32 @@ pub fn mcml_binned(r: &McResult) -> Option<Vec<f64>> {
     let mut v = r.radial.reflectance_per_mm2.clone();
     v[n - 1] += r.radial.beyond_grid / g.annulus_area_mm2(n - 1);
     Some(v)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cases_are_finite_and_written_in_cm() {
+        let cases = cases().unwrap();
+        assert_eq!(cases.len(), 6);
+        for c in &cases {
+            let last = c.stack.layers().last().unwrap();
+            assert_eq!(last.thickness_mm(), Some(HALF_SPACE_DEPTH_MM));
+        }
+        let runs = [McmlRun {
+            output: "x.mco".into(),
+            photons: 10,
+        }];
+        let light = case("light-550").unwrap();
+        let text = mci(&light.stack, &runs, "a comment").unwrap();
+        // The epidermis, 0.25 mm = 2.5e-2 cm thick, σs 60.8 mm⁻¹ = 608 cm⁻¹; the dermis 10 cm.
+        assert!(text.contains(" 9e-1 2.5e-2\n"), "{text}");
+        assert!(text.contains(" 9e-1 1e1\n"), "{text}");
+        assert!(text.contains("x.mco A"));
+        assert!(text.contains("5e-3 1e-3\t# dz, dr (cm)"), "{text}");
+        assert!(mci(&light.stack, &runs, "σ").is_err());
+        assert!(case("nonsense").is_err());
+    }
 }
