@@ -136,7 +136,11 @@ mod tests {
         });
         assert!(r.is_err());
         assert!(!target.exists());
-        assert!(leftovers(&dir, &[]).is_empty(), "{:?}", leftovers(&dir, &[]));
+        assert!(
+            leftovers(&dir, &[]).is_empty(),
+            "{:?}",
+            leftovers(&dir, &[])
+        );
         write_bytes(&target, b"whole").unwrap();
         assert_eq!(fs::read(&target).unwrap(), b"whole");
         assert!(leftovers(&dir, &["a.txt"]).is_empty());
@@ -169,7 +173,13 @@ mod tests {
         fs::create_dir_all(&target).unwrap();
         let e = write_bytes(&target, b"x").unwrap_err();
         assert!(
-            matches!(e, AtomicWriteError::NotARegularFile { kind: "directory", .. }),
+            matches!(
+                e,
+                AtomicWriteError::NotARegularFile {
+                    kind: "directory",
+                    ..
+                }
+            ),
             "{e}"
         );
         assert!(target.is_dir());
@@ -186,7 +196,13 @@ mod tests {
         std::os::unix::fs::symlink(dir.join("real.txt"), &target).unwrap();
         let e = write_bytes(&target, b"x").unwrap_err();
         assert!(
-            matches!(e, AtomicWriteError::NotARegularFile { kind: "symlink", .. }),
+            matches!(
+                e,
+                AtomicWriteError::NotARegularFile {
+                    kind: "symlink",
+                    ..
+                }
+            ),
             "{e}"
         );
         assert_eq!(fs::read(dir.join("real.txt")).unwrap(), b"keep");

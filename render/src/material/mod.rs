@@ -27,13 +27,15 @@
 //! spatial detail (brows, lips, pores) without replacing the model's spectral colour; the product
 //! is clamped at 1.
 
-use crate::bssrdf::Subsurface;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths, SpectrumTable, linear_srgb_at_nm};
-use crate::texture::{Texture, luminance};
+use crate::texture::Texture;
 use brdf::{Frame, TorranceSparrow};
 use glam::{Vec2, Vec3};
-use skin_optics::SkinParams;
 use std::f32::consts::FRAC_1_PI;
+
+mod skin;
+
+pub use skin::{SKIN_TABLE_STEP_NM, SkinBuildError, SkinKnobs, SkinMaterial};
 
 /// An albedo texture used by a material.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -42,66 +44,6 @@ pub struct TextureRef {
     pub index: usize,
     /// Mean luminance of the texture (for relative modulation).
     pub mean_luminance: f32,
-}
-
-/// Skin: validated parameters, the surface lobe and the body reflectance table.
-#[derive(Debug, Clone)]
-pub struct SkinMaterial {
-    /// The skin's parameters.
-    pub params: SkinParams,
-    /// The oily surface layer.
-    pub surface: TorranceSparrow,
-    /// Total diffuse reflectance R_d(λ) per unit flux entering ([DJ05] multipole, two layers).
-    pub total_reflectance: SpectrumTable,
-    /// Optional albedo texture (relative luminance modulation).
-    pub albedo_texture: Option<TextureRef>,
-    /// T̄ = ∫ T(θ) 2 cosθ dcosθ, the cosine-weighted mean of the transmitted fraction.
-    pub mean_transmitted: f32,
-    /// The BSSRDF (issue 7); when present it replaces the Lambertian body term.
-    pub subsurface: Option<Subsurface>,
-}
-
-impl SkinMaterial {
-    /// Skin from its parameters, surface lobe and R_d(λ) table.
-    #[must_use]
-    pub fn new(
-        params: SkinParams,
-        surface: TorranceSparrow,
-        total_reflectance: SpectrumTable,
-        albedo_texture: Option<TextureRef>,
-    ) -> Self {
-        // Midpoint rule in μ = cosθ; T is smooth, 256 nodes are far below f32 noise.
-        let n = 256;
-        let mean_transmitted = (0..n)
-            .map(|i| {
-                let mu = (i as f32 + 0.5) / n as f32;
-                surface.transmitted_fraction(mu) * 2.0 * mu / n as f32
-            })
-            .sum();
-        Self {
-            params,
-            surface,
-            total_reflectance,
-            albedo_texture,
-            mean_transmitted,
-            subsurface: None,
-        }
-    }
-
-    /// The same skin shading its body with the BSSRDF `subsurface` instead of the Lambertian term.
-    #[must_use]
-    pub fn with_subsurface(mut self, subsurface: Subsurface) -> Self {
-        self.subsurface = Some(subsurface);
-        self
-    }
-
-    /// The albedo texture's relative luminance m(uv) (texture luminance / its mean; 1 without one).
-    #[must_use]
-    pub fn texture_factor(&self, uv: Vec2, textures: &[Texture]) -> f32 {
-        self.albedo_texture.map_or(1.0, |t| {
-            luminance(textures[t.index].lookup(uv)) / t.mean_luminance
-        })
-    }
 }
 
 /// Lambertian material with a spectral albedo, optionally times an sRGB texture.
@@ -320,7 +262,7 @@ mod tests {
 
     fn skin(rd: f32) -> Material {
         Material::Skin(SkinMaterial::new(
-            SkinParams::preset(skin_optics::Preset::Light),
+            skin_optics::SkinParams::preset(skin_optics::Preset::Light),
             TorranceSparrow::new(0.3, 0.25, 1.4).unwrap(),
             SpectrumTable::constant(rd),
             None,
