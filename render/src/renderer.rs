@@ -108,20 +108,15 @@ impl RenderOptions {
     }
 }
 
-/// Render options that passed [`RenderOptions::validate`]: only these reach [`render`].
-#[derive(Debug, Clone, PartialEq)]
+/// Render options that passed [`RenderOptions::validate`]: only these reach [`render`] (the
+/// default options are valid).
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct RenderSettings(RenderOptions);
 
 impl std::ops::Deref for RenderSettings {
     type Target = RenderOptions;
     fn deref(&self) -> &RenderOptions {
         &self.0
-    }
-}
-
-impl Default for RenderSettings {
-    fn default() -> Self {
-        Self(RenderOptions::default())
     }
 }
 

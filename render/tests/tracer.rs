@@ -1,4 +1,4 @@
-//! End-to-end checks of the path tracer against closed forms (issue 6): white furnace, Lambertian
+//! End-to-end checks of the path tracer against closed forms: white furnace, Lambertian
 //! plane under a distant light, D65 round trip to sRGB white, bad scenes, the default scene,
 //! and thread-count independence.
 

@@ -1,5 +1,5 @@
 //! Per-material radial profile tables for rendering: 2πr R(r) on one geometric radius grid per
-//! material, one row per tabulation wavelength, each with its CDF, in f32 (physics.md §8).
+//! material, one row per tabulation wavelength, each with its CDF, in f32 (docs/physics.md §8).
 //!
 //! The profiles themselves come from the owner, `multipole::SpectralProfiles` (`Method::Exact`:
 //! adding-doubling totals with layered Monte Carlo shapes, [`RENDER_SHAPE_ESCAPES`] every

@@ -1,7 +1,7 @@
 //! Materials and their BSDFs at a shading point: `Skin` (oily Torrance–Sparrow surface over a
 //! diffusing body) and `Diffuse` (Lambert) for backdrops.
 //!
-//! # Skin with subsurface scattering (issue 7, the default)
+//! # Skin with subsurface scattering (the default)
 //!
 //! When the material carries a [`Subsurface`] model, its BSDF is the surface lobe alone
 //! (`Lobes::SkinSurface`) and the body is rendered by the separable BSSRDF in the integrator
@@ -239,7 +239,7 @@ impl Bsdf<'_> {
             Lobes::Skin { surface, .. } if u_lobe < p => surface.sample(o, [u.x, u.y])?.wi,
             // The integrator already chose the surface branch (with probability p).
             Lobes::SkinSurface { surface, .. } => surface.sample(o, [u.x, u.y])?.wi,
-            _ => crate::light::cosine_hemisphere(u),
+            _ => crate::sampling::cosine_hemisphere(u),
         };
         if i.z <= 0.0 {
             return None;

@@ -6,7 +6,9 @@ use crate::builtin;
 use crate::camera::Camera;
 use crate::error::RenderError;
 use crate::geometry::Geometry;
-use crate::light::{EmissionShape, Environment, Light};
+use crate::light::{
+    DistantLight, EmissionShape, Environment, Light, PointLight, QuadLight, SphereLight, SpotLight,
+};
 use crate::material::{DiffuseMaterial, Material, SkinKnobs, SkinMaterial};
 use crate::mesh::{Placement, TriangleMesh};
 use crate::scene_file::{EnvironmentDesc, LightDesc, MeshDesc, SceneDesc, ShapeKind, SpectrumKind};
@@ -248,10 +250,10 @@ impl Loader<'_> {
                 spectrum,
                 temperature_k,
                 intensity,
-            } => Light::Point {
+            } => Light::Point(PointLight {
                 position_mm: self.vec3(&format!("{key}.position_mm"), *position_mm)?,
                 intensity: self.emission(key, *spectrum, *temperature_k, *intensity)?,
-            },
+            }),
             LightDesc::Spot {
                 position_mm,
                 look_at_mm,
@@ -276,13 +278,13 @@ impl Loader<'_> {
                         ),
                     ));
                 }
-                Light::Spot {
+                Light::Spot(SpotLight {
                     position_mm: p,
                     direction: dir.normalize(),
                     cos_inner: inner_deg.to_radians().cos(),
                     cos_outer: outer_deg.to_radians().cos(),
                     intensity: self.emission(key, *spectrum, *temperature_k, *intensity)?,
-                }
+                })
             }
             LightDesc::Distant {
                 direction,
@@ -294,10 +296,10 @@ impl Loader<'_> {
                 if d.length() <= 0.0 {
                     return Err(self.err(format!("{key}.direction"), "expected a non-zero vector"));
                 }
-                Light::Distant {
+                Light::Distant(DistantLight {
                     to_light: d.normalize(),
                     irradiance: self.emission(key, *spectrum, *temperature_k, *intensity)?,
-                }
+                })
             }
             LightDesc::Sphere {
                 center_mm,
@@ -305,11 +307,11 @@ impl Loader<'_> {
                 spectrum,
                 temperature_k,
                 intensity,
-            } => Light::Sphere {
+            } => Light::Sphere(SphereLight {
                 center_mm: self.vec3(&format!("{key}.center_mm"), *center_mm)?,
                 radius_mm: self.positive(&format!("{key}.radius_mm"), *radius_mm)?,
                 radiance: self.emission(key, *spectrum, *temperature_k, *intensity)?,
-            },
+            }),
             LightDesc::Quad {
                 center_mm,
                 look_at_mm,
@@ -331,12 +333,12 @@ impl Loader<'_> {
                 let up = n.cross(right);
                 // edge_u × edge_v = w h (right × up) = w h n: the emitting side faces look_at.
                 let (eu, ev) = (right * w, up * h);
-                Light::Quad {
+                Light::Quad(QuadLight {
                     corner_mm: c - eu * 0.5 - ev * 0.5,
                     edge_u_mm: eu,
                     edge_v_mm: ev,
                     radiance: self.emission(key, *spectrum, *temperature_k, *intensity)?,
-                }
+                })
             }
         })
     }
