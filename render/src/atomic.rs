@@ -166,46 +166,32 @@ mod tests {
         fs::remove_dir_all(&dir).unwrap();
     }
 
-    #[test]
-    fn a_directory_is_not_replaced() {
-        let dir = temp_dir("dir");
-        let target = dir.join("c.png");
-        fs::create_dir_all(&target).unwrap();
-        let e = write_bytes(&target, b"x").unwrap_err();
-        assert!(
-            matches!(
-                e,
-                AtomicWriteError::NotARegularFile {
-                    kind: "directory",
-                    ..
-                }
-            ),
-            "{e}"
-        );
-        assert!(target.is_dir());
-        fs::remove_dir_all(&dir).unwrap();
-    }
-
+    /// A directory, a symlink and a FIFO in the target's place are left as they are, with a typed
+    /// error naming what they are (the symlink's own target keeps its bytes).
     #[cfg(unix)]
     #[test]
-    fn a_symlink_is_not_replaced() {
-        let dir = temp_dir("link");
-        fs::create_dir_all(&dir).unwrap();
+    fn non_regular_targets_are_not_replaced() {
+        let dir = temp_dir("special");
+        fs::create_dir_all(dir.join("c.png")).unwrap();
         fs::write(dir.join("real.txt"), b"keep").unwrap();
-        let target = dir.join("link.txt");
-        std::os::unix::fs::symlink(dir.join("real.txt"), &target).unwrap();
-        let e = write_bytes(&target, b"x").unwrap_err();
-        assert!(
-            matches!(
-                e,
-                AtomicWriteError::NotARegularFile {
-                    kind: "symlink",
-                    ..
-                }
-            ),
-            "{e}"
-        );
+        std::os::unix::fs::symlink(dir.join("real.txt"), dir.join("link.txt")).unwrap();
+        let fifo = std::process::Command::new("mkfifo")
+            .arg(dir.join("pipe.csv"))
+            .status()
+            .is_ok_and(|s| s.success());
+        let mut cases = vec![("c.png", "directory"), ("link.txt", "symlink")];
+        if fifo {
+            cases.push(("pipe.csv", "FIFO, socket or device"));
+        }
+        for (name, want) in cases {
+            match write_bytes(&dir.join(name), b"x") {
+                Err(AtomicWriteError::NotARegularFile { kind, .. }) => assert_eq!(kind, want),
+                other => panic!("{name}: {other:?}"),
+            }
+        }
+        assert!(dir.join("c.png").is_dir());
         assert_eq!(fs::read(dir.join("real.txt")).unwrap(), b"keep");
+        assert!(leftovers(&dir, &["c.png", "real.txt", "link.txt", "pipe.csv"]).is_empty());
         fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -63,6 +63,9 @@ pub enum RenderError {
     /// An output could not be written whole (see [`crate::atomic`]).
     #[error(transparent)]
     Write(#[from] crate::atomic::AtomicWriteError),
+    /// A render option outside its range (see [`crate::renderer::RenderOptions::validate`]).
+    #[error(transparent)]
+    Settings(#[from] crate::renderer::SettingError),
     /// The render's worker threads could not be started.
     #[error("cannot start {threads:?} render threads: {message}")]
     Threads {

@@ -9,12 +9,12 @@
 //! (∝ ρ_dr(θ_o) against T(θ_o) R̄_tot) or the subsurface branch with 1 − p. The energy split is
 //! the same as below, so on a flat slab both forms render the same radiance.
 //!
-//! # Skin without subsurface scattering (`--no-subsurface`)
+//! # Skin without subsurface scattering (`SkinKnobs::no_subsurface`)
 //!
 //! Skin shades as its surface lobe ([TS67], `brdf::TorranceSparrow`, m = 0.3, ρ_s from the
-//! `SkinParams`, η = 1.4) plus a Lambertian body term built from the multipole model's total
-//! diffuse reflectance R_d(λ) (`multipole::skin::total_reflectance`, per unit flux entering),
-//! tabulated per material at scene load. The energy split is the lobe's own: the light the lobe does
+//! `SkinParams`, η = 1.4) plus a Lambertian body term built from the skin model's total
+//! diffuse reflectance R_d(λ) (`multipole::skin::total_reflectance` with the scene's method, per
+//! unit flux entering), tabulated per material at scene load by [`SkinMaterial::build`]. The energy split is the lobe's own: the light the lobe does
 //! not reflect, T(θ) = 1 − ρ_dr(θ) (`ts.transmitted_fraction`), enters; R_d of it comes back out,
 //! leaving with the same split. Reciprocal and energy conserving:
 //!
