@@ -11,7 +11,8 @@ use crate::texture::{Texture, luminance};
 use skin_optics::{Preset, SkinParams};
 use std::collections::{BTreeMap, HashMap};
 
-/// Materials in file order, their names (same order) and the textures they use.
+/// Materials in name order (as the file's table is read), their names (same order) and the textures
+/// they use.
 type Materials = (Vec<Material>, Vec<String>, Vec<Texture>);
 
 impl Loader<'_> {

@@ -20,6 +20,7 @@ use glam::Vec3;
 use load::Loader;
 use std::path::{Path, PathBuf};
 
+/// The choices made when a scene is loaded (today, the knobs of its skin materials).
 pub use crate::material::SkinKnobs as SceneOptions;
 
 /// What a ray hit first: a surface or an area light.
