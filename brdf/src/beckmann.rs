@@ -1,4 +1,4 @@
-//! Beckmann distribution of microfacet normals and its importance sampling ([TS67]; physics.md §7).
+//! Beckmann distribution of microfacet normals and its importance sampling ([TS67]; docs/physics.md §7).
 //!
 //! D(h) = exp(−tan²θh / m²) / (π m² cos⁴θh), with m the RMS slope of the surface. It is normalised
 //! over projected microfacet area: ∫ D(h) cosθh dω_h = 1 over the upper hemisphere (the substitution

@@ -342,7 +342,7 @@ mod tests {
     }
 
     #[test]
-    fn presets_match_physics_md() {
+    fn presets_match_documented_values() {
         let get = |p| {
             let s = SkinParams::preset(p);
             (

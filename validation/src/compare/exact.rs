@@ -1,7 +1,7 @@
 //! Study 5: `Method::Exact` (adding-doubling totals) beside `Method::Multipole`, both against the
 //! Monte Carlo: total diffuse reflectance over 400–700 nm for C_m ∈ {0, 0.01, 0.05, 0.1, 0.25, 0.5}
 //! (β_m 0.7, C_h 0.02), and the energy-weighted radial profile error of the light and dark presets
-//! at 450/550/650 nm (issue [exact], "Evidence").
+//! at 450/550/650 nm (docs/physics.md §9).
 
 use super::profiles::{PROFILE_WAVELENGTHS_NM, annulus_mean};
 use super::{Settings, Summary, progress, write_csv};
