@@ -1,4 +1,5 @@
-//! Photon rate of the layered Monte Carlo on the cases issue 4 quotes for the classic MCML:
+//! Photon rate of the layered Monte Carlo on the three cases BENCHMARKS.md compares with the classic
+//! MCML program ([WJZ95]):
 //! light preset at 550 nm (g = 0.9), very dark skin (C_m 0.5, β_m 0.9, C_h 0.07) at 550 nm, and a
 //! half-space with σa = 0.01, σs' = 1 mm⁻¹, g = 0.9, n = 1.4; on 1 and 2 rayon threads.
 //! Throughput is in photons (criterion reports elements/s).

@@ -1,4 +1,4 @@
-//! Radial profile error of `Method::Exact` against the layered Monte Carlo (issue [exact]: energy-weighted
+//! Radial profile error of `Method::Exact` against the layered Monte Carlo (target: energy-weighted
 //! error within 10%), for each `multipole::skin::ExactShape` and the plain multipole.
 //!
 //! Error = Σ_bins |E_model − E_mc| / R_mc, E = ∫ 2πr R dr over each MC annulus (per incident photon:

@@ -145,6 +145,20 @@ pub(crate) fn write_csv(path: &Path, header: &str, rows: &[String]) -> anyhow::R
         .with_context(|| format!("writing {}", path.display()))
 }
 
+/// A study's two outputs: `out/{name}.csv` (`header`, then `rows`) and the chart `out/{name}.png`
+/// of `panels`, `size` = (width, height) pixels.
+pub(crate) fn write_study(
+    out: &Path,
+    name: &str,
+    (header, rows): (&str, &[String]),
+    panels: &[render::plot::Panel],
+    (width, height): (u32, u32),
+) -> anyhow::Result<()> {
+    write_csv(&out.join(format!("{name}.csv")), header, rows)?;
+    render::plot::save_png(&out.join(format!("{name}.png")), panels, width, height)
+        .with_context(|| format!("writing {name}.png"))
+}
+
 /// One study: writes its charts and CSV into the folder and its worst errors into the summary.
 type Study = fn(&Settings, &Path, &mut Summary) -> anyhow::Result<()>;
 

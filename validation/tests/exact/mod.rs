@@ -1,8 +1,8 @@
 //! Adding-doubling (`Method::Exact`, via `multipole::skin::diffuse_reflectance`) against the layered
-//! Monte Carlo for the light, medium and dark presets at 550 nm (issue [exact], "Tests").
+//! Monte Carlo for the light, medium and dark presets at 550 nm (docs/physics.md §9–§11).
 //!
 //! Tolerance: 4 standard errors of the Monte Carlo plus 0.5% of its mean, the residual both exact
-//! methods are allowed (the independent runs of issue [exact] agree within 0.6%); diffusion misses
+//! methods are allowed (the independent exact-transport runs of [XT] agree within 0.6%); diffusion misses
 //! the dark preset by about +100%, so a method that fell back to it fails.
 
 use crate::montecarlo::photons;

@@ -1,5 +1,5 @@
-//! Issue [exact]'s profile target: the default `Method::Exact` profile (Monte Carlo shape, exact
-//! total) against an independent Monte Carlo run, energy-weighted error within 10%.
+//! The profile target of `Method::Exact` (docs/physics.md §9): the default profile (Monte Carlo
+//! shape, exact total) against an independent Monte Carlo run, energy-weighted error within 10%.
 //!
 //! Error = Σ_annuli |E_model − E_mc| / R_mc on the reference's uniform 0.02 mm annuli to 6 mm,
 //! E = ∫ 2πr R dr per annulus (model per incident photon: its per-entering profile × (1 − F_r(0))).

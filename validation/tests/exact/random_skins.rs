@@ -1,4 +1,4 @@
-//! Issue [exact]'s totals target over the whole parameter box: for random skins (C_m ∈ [0, 0.5],
+//! The totals target of `Method::Exact` over the whole parameter box: for random skins (C_m ∈ [0, 0.5],
 //! β_m ∈ [0, 1], C_h ∈ [0.001, 0.1]) and wavelengths in 400–700 nm, adding-doubling's observable
 //! diffuse reflectance is within 2% of the layered Monte Carlo, plus 3 of its standard errors.
 //!

@@ -1,5 +1,5 @@
-//! Agreement with independent exact-transport totals (issue 4's table: other Monte Carlo and
-//! adding-doubling runs of the same model; index 1.4, g = 0.9, σs = σs'/(1 − g)).
+//! Agreement with independent exact-transport totals ([XT]: other Monte Carlo and adding-doubling
+//! runs of the same model; index 1.4, g = 0.9, σs = σs'/(1 − g)).
 //!
 //! Tolerance: 4 standard errors of this run plus the reference's stated ±0.0008 (the skin rows) or
 //! its last printed digit (the half-space rows), so a 1% bias at these photon counts fails.
