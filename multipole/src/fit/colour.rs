@@ -288,7 +288,7 @@ mod tests {
         worst
     }
 
-    /// Issue 8: 200 random valid skins, colour → fit → colour within ΔE00 0.5 with the paper's
+    /// 200 random valid skins, colour → fit → colour within ΔE00 0.5 with the paper's
     /// diffusion model (measured worst 0.094).
     #[test]
     fn round_trip_of_200_random_skins_multipole() {
@@ -313,7 +313,7 @@ mod tests {
         let full = ColourModel::new(10.0, Method::Exact, base).unwrap();
         let fine48 = ColourModel::with_forward(
             10.0,
-            Forward::Exact(crate::adding_doubling::AddingDoublingOptions::new(48, 0.9).unwrap()),
+            Forward::Exact(crate::exact::adding_doubling::AddingDoublingOptions::new(48, 0.9).unwrap()),
             base,
         )
         .unwrap();
@@ -330,7 +330,7 @@ mod tests {
             let m = ColourModel::with_forward(
                 10.0,
                 Forward::Exact(
-                    crate::adding_doubling::AddingDoublingOptions::new(points, 0.9).unwrap(),
+                    crate::exact::adding_doubling::AddingDoublingOptions::new(points, 0.9).unwrap(),
                 ),
                 base,
             )

@@ -19,7 +19,7 @@
 use super::FitError;
 use super::nelder_mead::{Budget, minimize};
 use crate::Method;
-use crate::adding_doubling::{AddingDoublingOptions, skin_totals};
+use crate::exact::adding_doubling::{AddingDoublingOptions, skin_totals};
 use crate::error::MultipoleError;
 use crate::skin::diffuse_reflectance;
 use rayon::prelude::*;

@@ -2,13 +2,13 @@
 
 use super::photons;
 use brdf::fresnel::normal_incidence_reflectance;
-use validation::montecarlo::{Layer, LayerStack, McOptions, run};
+use validation::montecarlo::{Layer, LayeredMedium, McOptions, run};
 
 #[test]
 fn absorbing_clear_slab_transmits_beer_lambert() {
     // σs = 0, matched indices: the beam goes straight, T = e^(−σa d) (binomial noise).
     let (sigma_a, d) = (1.0, 0.7);
-    let stack = LayerStack::new(
+    let stack = LayeredMedium::new(
         vec![Layer::slab(sigma_a, 0.0, 0.0, 1.0, d).unwrap()],
         1.0,
         1.0,
@@ -30,7 +30,7 @@ fn absorbing_clear_slab_transmits_beer_lambert() {
 fn glass_slab_reflects_two_r_over_one_plus_r() {
     // A clear, non-absorbing slab of index 1.5 in air: incoherent multiple reflection gives
     // R = 2 R₁ / (1 + R₁) at normal incidence, R₁ = F_r(0).
-    let stack = LayerStack::new(
+    let stack = LayeredMedium::new(
         vec![Layer::slab(0.0, 0.0, 0.0, 1.5, 1.0).unwrap()],
         1.0,
         1.0,
@@ -54,7 +54,7 @@ fn glass_slab_reflects_two_r_over_one_plus_r() {
 fn non_absorbing_matched_slab_loses_no_energy() {
     // No absorption and matched indices: every photon leaves by the top or the bottom, with its
     // full weight (roulette never fires because the weight never falls).
-    let stack = LayerStack::new(
+    let stack = LayeredMedium::new(
         vec![
             Layer::slab(0.0, 5.0, 0.8, 1.0, 0.5).unwrap(),
             Layer::slab(0.0, 20.0, 0.0, 1.0, 1.0).unwrap(),
@@ -82,7 +82,7 @@ fn non_absorbing_matched_slab_loses_no_energy() {
 
 #[test]
 fn non_absorbing_mismatched_slab_loses_no_energy() {
-    let stack = LayerStack::new(
+    let stack = LayeredMedium::new(
         vec![Layer::slab(0.0, 10.0, 0.9, 1.4, 1.0).unwrap()],
         1.0,
         1.33,
@@ -97,7 +97,7 @@ fn non_absorbing_mismatched_slab_loses_no_energy() {
 fn van_de_hulst_slab() {
     // Albedo 0.9, g 0.75, optical thickness 2, matched indices: van de Hulst's tables give
     // R = 0.09739, T = 0.66096 ([WJZ95] Table 2 uses this case to check MCML).
-    let stack = LayerStack::new(
+    let stack = LayeredMedium::new(
         vec![Layer::slab(1.0, 9.0, 0.75, 1.0, 0.2).unwrap()],
         1.0,
         1.0,

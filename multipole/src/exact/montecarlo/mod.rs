@@ -19,11 +19,10 @@
 //! The module depends only on `skin-optics`, `brdf::fresnel`, `rand`/`rand_xoshiro`/`rand_distr`
 //! (the ziggurat exponential) and `rayon`: it lives in `multipole` because `Method::Exact` profiles use it; `validation` compares with it.
 
-mod stack;
 mod tally;
 mod transport;
 
-pub use stack::{DEFAULT_SKIN_G, Layer, LayerStack, MAX_COEFFICIENT_PER_MM, MAX_THICKNESS_MM};
+pub use crate::layered::{DEFAULT_G, Layer, LayeredMedium};
 pub use tally::{Estimate, McResult, RadialGrid, RadialProfile};
 pub use transport::{ROULETTE_SURVIVAL, ROULETTE_THRESHOLD};
 
@@ -117,13 +116,13 @@ impl McOptions {
 
 /// Trace the stack with the options on the current rayon pool.
 #[must_use]
-pub fn run(stack: &LayerStack, opts: &McOptions) -> McResult {
+pub fn run(stack: &LayeredMedium, opts: &McOptions) -> McResult {
     run_with_progress(stack, opts, |_| {})
 }
 
 /// As [`run`], calling `on_batch(photons_in_batch)` after each finished batch (for progress bars).
 pub fn run_with_progress(
-    stack: &LayerStack,
+    stack: &LayeredMedium,
     opts: &McOptions,
     on_batch: impl Fn(u64) + Sync,
 ) -> McResult {

@@ -9,7 +9,7 @@ mod sampling;
 #[cfg(test)]
 mod tests;
 
-use super::stack::LayerStack;
+use crate::layered::LayeredMedium;
 use super::tally::{BatchTally, RadialGrid};
 use brdf::fresnel::dielectric_reflectance;
 use rand_distr::{Distribution, Exp1};
@@ -46,7 +46,7 @@ pub(crate) struct Medium {
 }
 
 impl Medium {
-    pub fn new(stack: &LayerStack) -> Self {
+    pub fn new(stack: &LayeredMedium) -> Self {
         let layers = stack.layers();
         let mut z = 0.0;
         let mut slabs = Vec::with_capacity(layers.len());

@@ -1,4 +1,4 @@
-//! The inverse order-0 Hankel transform f(r) = (1/2π) ∫₀^∞ F(q) J0(qr) q dq (physics.md §5).
+//! The inverse order-0 Hankel transform f(r) = (1/2π) ∫₀^∞ F(q) J0(qr) q dq (docs/physics.md §5).
 //!
 //! Method (chosen for speed with a measured error; see `ProfileOptions` and `skin::profile_error`):
 //! only the *remainder* of a stack's spectrum is inverted numerically; the slowest-decaying part (the

@@ -1,5 +1,5 @@
 //! The radial profile table: R(r) on a geometric radius grid, its total, energy radii, and the CDF of
-//! 2πr R(r) for importance sampling r (physics.md §8). The renderer and validation both use it.
+//! 2πr R(r) for importance sampling r (docs/physics.md §8). The renderer and validation both use it.
 //!
 //! Between nodes, the sampling density p(r) = 2πr R(r) is linear in r (so the CDF is piecewise
 //! quadratic and inverted exactly); below the first radius it rises linearly from p(0) = 0.
