@@ -5,6 +5,7 @@ pub mod error;
 pub mod exact;
 pub mod fit;
 pub mod layered;
+pub mod sampling;
 pub mod skin;
 
 // The modules by their short names, so `multipole::slab::Slab`, `multipole::montecarlo::run`, ...
