@@ -39,6 +39,13 @@ impl Layer {
         n: f64,
         thickness_mm: Option<f64>,
     ) -> Result<Self, MultipoleError> {
+        if thickness_mm.is_none() && (sigma_a.is_nan() || sigma_a <= 0.0) {
+            return Err(MultipoleError::OutOfRange {
+                name: "absorption σa of a semi-infinite layer (mm⁻¹)",
+                value: sigma_a,
+                range: "(0, 1e4] mm⁻¹",
+            });
+        }
         let range = "[0, 1e4] mm⁻¹";
         check_range(
             "absorption σa (mm⁻¹)",
@@ -84,7 +91,7 @@ impl Layer {
         n: f64,
         thickness_mm: f64,
     ) -> Result<Self, MultipoleError> {
-        Self::with_scattering(sigma_a, sigma_s, sigma_s * (1.0 - g), g, n, Some(thickness_mm))
+        Self::checked(sigma_a, sigma_s, sigma_s * (1.0 - g), g, n, Some(thickness_mm))
     }
 
     /// A semi-infinite layer (only as the last of a stack). It needs σa > 0: without absorption a
@@ -95,25 +102,7 @@ impl Layer {
         g: f64,
         n: f64,
     ) -> Result<Self, MultipoleError> {
-        Self::with_scattering(sigma_a, sigma_s, sigma_s * (1.0 - g), g, n, None)
-    }
-
-    fn with_scattering(
-        sigma_a: f64,
-        sigma_s: f64,
-        sigma_s_prime: f64,
-        g: f64,
-        n: f64,
-        thickness_mm: Option<f64>,
-    ) -> Result<Self, MultipoleError> {
-        if thickness_mm.is_none() && (sigma_a.is_nan() || sigma_a <= 0.0) {
-            return Err(MultipoleError::OutOfRange {
-                name: "absorption σa of a semi-infinite layer (mm⁻¹)",
-                value: sigma_a,
-                range: "(0, 1e4] mm⁻¹",
-            });
-        }
-        Self::checked(sigma_a, sigma_s, sigma_s_prime, g, n, thickness_mm)
+        Self::checked(sigma_a, sigma_s, sigma_s * (1.0 - g), g, n, None)
     }
 
     /// A layer given by its reduced scattering σs' (mm⁻¹): σs = σs' / (1 − g).
@@ -127,7 +116,7 @@ impl Layer {
     ) -> Result<Self, MultipoleError> {
         check_range("anisotropy g", g, -0.999, 0.999, "[-0.999, 0.999]")?;
         let sigma_s = sigma_s_prime / (1.0 - g);
-        Self::with_scattering(sigma_a, sigma_s, sigma_s_prime, g, n, thickness_mm)
+        Self::checked(sigma_a, sigma_s, sigma_s_prime, g, n, thickness_mm)
     }
 
     /// Absorption coefficient σa, mm⁻¹.

@@ -1,4 +1,5 @@
-//! Adding-doubling: exact plane-parallel transport in layered slabs ([vdH80]; [Prahl95] for tissue).
+//! Adding-doubling: exact plane-parallel transport in layered slabs ([vdH80]; [Prahl95] for tissue;
+//! docs/physics.md §10). The medium is a [`LayeredMedium`] of one refractive index throughout.
 //!
 //! The radiative transfer equation for a stack of homogeneous layers, each with its own absorption σa,
 //! scattering σs (mm⁻¹), Henyey–Greenstein anisotropy g and thickness (the last may be semi-infinite),

@@ -345,20 +345,9 @@ mod tests {
         }
     }
 
-    /// Process CPU seconds (all threads) from /proc (Linux; NaN elsewhere).
+    /// Process CPU seconds (all threads).
     fn cpu_s() -> f64 {
-        let Ok(stat) = std::fs::read_to_string("/proc/self/stat") else {
-            return f64::NAN;
-        };
-        // Fields after the parenthesised command: utime and stime are the 12th and 13th (ticks of 10 ms).
-        let rest = stat.rsplit(')').next().unwrap_or("");
-        let f: Vec<f64> = rest
-            .split_whitespace()
-            .skip(11)
-            .take(2)
-            .filter_map(|v| v.parse().ok())
-            .collect();
-        f.iter().sum::<f64>() / 100.0
+        cpu_time::ProcessTime::now().as_duration().as_secs_f64()
     }
 
     /// Times and accuracy of exact colour fits for BENCHMARKS.md: the two-stage default against a

@@ -1,4 +1,5 @@
-//! Fitting the skin parameters C_m, β_m, C_h to a target colour or a measured reflectance spectrum:
+//! Fitting the skin parameters C_m, β_m, C_h to a target colour or a measured reflectance spectrum
+//! (docs/physics.md §12):
 //! the inverse of the spectral skin model ([DJ06]), with [`crate::skin::diffuse_reflectance`] as the
 //! forward model (the observable: per unit incident flux, specular excluded).
 //!

@@ -426,11 +426,8 @@ fn print_multipole_against_exact() {
 #[test]
 #[ignore = "prints on-CPU time per 31-λ skin set for BENCHMARKS.md (Linux; the machine is shared)"]
 fn print_cpu_time_per_spectrum() {
-    // Thread CPU time from /proc: on a loaded 2-core machine, wall-clock criterion figures overstate.
-    fn cpu_ns() -> Option<f64> {
-        let s = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
-        s.split_whitespace().next()?.parse().ok()
-    }
+    // Thread CPU time: on a loaded 2-core machine, wall-clock criterion figures overstate.
+    let cpu_ns = || cpu_time::ThreadTime::now().as_duration().as_nanos() as f64;
     let grid = WavelengthGrid::visible();
     println!("| points | light: CPU ms per 31 λ | dark: CPU ms per 31 λ |");
     for n in [8, 16, 24, 32] {
@@ -440,11 +437,11 @@ fn print_cpu_time_per_spectrum() {
             .map(|&p| {
                 let skin = SkinParams::preset(p);
                 let reps = 10;
-                let start = cpu_ns().unwrap_or(f64::NAN);
+                let start = cpu_ns();
                 for _ in 0..reps {
                     std::hint::black_box(skin_totals_spectrum(&skin, &grid, &o).expect("solves"));
                 }
-                let ms = (cpu_ns().unwrap_or(f64::NAN) - start) * 1e-6 / f64::from(reps);
+                let ms = (cpu_ns() - start) * 1e-6 / f64::from(reps);
                 format!("{ms:.1}")
             })
             .collect();

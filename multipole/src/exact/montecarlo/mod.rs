@@ -1,5 +1,6 @@
 //! Monte Carlo photon transport in plane-parallel layers, the reference the diffusion model is judged
-//! against: MCML ([WJZ95] Wang, Jacques & Zheng 1995) with a modern generator.
+//! against: MCML ([WJZ95] Wang, Jacques & Zheng 1995) with a modern generator (docs/physics.md §11).
+//! The medium is a [`LayeredMedium`].
 //!
 //! - Layers: σa, σs (mm⁻¹), Henyey–Greenstein g, index n, thickness (the last may be semi-infinite);
 //!   ambient indices above and below; exact unpolarised Fresnel at every index mismatch
