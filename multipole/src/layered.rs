@@ -91,7 +91,14 @@ impl Layer {
         n: f64,
         thickness_mm: f64,
     ) -> Result<Self, MultipoleError> {
-        Self::checked(sigma_a, sigma_s, sigma_s * (1.0 - g), g, n, Some(thickness_mm))
+        Self::checked(
+            sigma_a,
+            sigma_s,
+            sigma_s * (1.0 - g),
+            g,
+            n,
+            Some(thickness_mm),
+        )
     }
 
     /// A semi-infinite layer (only as the last of a stack). It needs σa > 0: without absorption a

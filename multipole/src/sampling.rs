@@ -46,11 +46,7 @@ pub fn invert<T: Float>(radii: &[T], p: &[T], cdf: &[T], target: T) -> T {
     let linear_tol = T::from(1e-14).unwrap_or_else(T::epsilon);
     let tiny = T::from(1e-300).unwrap_or_else(T::zero);
     let t = if a.abs() < linear_tol * p0.max(p1).max(tiny) / h {
-        if p0 > T::zero() {
-            need / p0
-        } else {
-            T::zero()
-        }
+        if p0 > T::zero() { need / p0 } else { T::zero() }
     } else {
         let disc = (p0 * p0 + two * two * a * need).max(T::zero());
         // Stable root of a t² + p0 t − need = 0.

@@ -3,8 +3,8 @@
 //! Real source at depth z_r = ℓ, virtual source at z_v = −(ℓ + 2 z_b) (z into the medium).
 
 use crate::diffusion::boundary::a_coefficient;
-use crate::error::{MultipoleError, check_range};
 use crate::diffusion::medium::{Medium, pole_energy_within, pole_kernel, pole_transform};
+use crate::error::{MultipoleError, check_range};
 use std::f64::consts::PI;
 
 /// A semi-infinite medium under a face of relative index η (= n_medium / n_outside).

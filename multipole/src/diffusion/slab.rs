@@ -31,8 +31,8 @@
 //! this crate blends only where the multipole itself is not valid.
 
 use crate::diffusion::boundary::a_coefficient;
-use crate::error::{MultipoleError, check_range};
 use crate::diffusion::medium::{Medium, pole_kernel, pole_transform};
+use crate::error::{MultipoleError, check_range};
 use std::f64::consts::PI;
 
 /// Number of dipole pairs in a multipole sum: the accuracy knob of [DJ05].

@@ -7,13 +7,13 @@
 //! trapezoid over the inverted remainder — reaches `energy_fraction` of the total.
 
 use crate::diffusion::dipole::Dipole;
-use crate::error::{MultipoleError, check_range};
 use crate::diffusion::hankel::{HankelTable, Pchip, frequency_cutoff};
 use crate::diffusion::medium::pole_energy_within;
 use crate::diffusion::profile::Profile;
-use crate::skin::ExactShape;
 use crate::diffusion::slab::Poles;
 use crate::diffusion::stack::{DiffusionLayer, Stack};
+use crate::error::{MultipoleError, check_range};
+use crate::skin::ExactShape;
 use std::f64::consts::PI;
 
 /// Smallest table radius, mm (docs/physics.md §8: from about 1e-3 mm).
@@ -149,7 +149,9 @@ impl Remainder {
     fn compute(stack: &Stack, opts: &ProfileOptions, window: f64) -> Self {
         let table = HankelTable::shared(opts.transform_nodes, opts.transform_radii);
         let radii: Vec<f64> = table.unit_radii().iter().map(|x| x * window).collect();
-        let values = if stack.layers().len() == 1 && matches!(stack.top(), DiffusionLayer::SemiInfinite(_)) {
+        let values = if stack.layers().len() == 1
+            && matches!(stack.top(), DiffusionLayer::SemiInfinite(_))
+        {
             // A lone dipole is entirely closed form: nothing to invert.
             vec![0.0; radii.len()]
         } else {
@@ -307,7 +309,11 @@ mod tests {
     fn skin_like(sa_epi: f64, sa_derm: f64) -> Stack {
         let epi = Slab::new(Medium::new(sa_epi, 5.3).unwrap(), 0.25, 1.4, 1.0).unwrap();
         let derm = Dipole::new(Medium::new(sa_derm, 5.3).unwrap(), 1.0).unwrap();
-        Stack::new(vec![DiffusionLayer::Slab(epi), DiffusionLayer::SemiInfinite(derm)]).unwrap()
+        Stack::new(vec![
+            DiffusionLayer::Slab(epi),
+            DiffusionLayer::SemiInfinite(derm),
+        ])
+        .unwrap()
     }
 
     #[test]

@@ -10,9 +10,9 @@
 
 use crate::diffusion::dipole::Dipole;
 use crate::diffusion::medium::Medium;
+use crate::diffusion::slab::{Poles, Slab};
 use crate::error::MultipoleError;
 use crate::layered::LayeredMedium;
-use crate::diffusion::slab::{Poles, Slab};
 
 /// One layer of a stack solved by diffusion: its multipole (finite) or dipole (semi-infinite)
 /// solution.
@@ -400,7 +400,11 @@ mod tests {
         fn build(sa1: f64, ss1: f64, d: f64, eta: f64, sa2: f64, ss2: f64) -> Stack {
             let top = Slab::new(Medium::new(sa1, ss1).unwrap(), d, eta, 1.0).unwrap();
             let bottom = Dipole::with_a(Medium::new(sa2, ss2).unwrap(), 1.0);
-            Stack::new(vec![DiffusionLayer::Slab(top), DiffusionLayer::SemiInfinite(bottom)]).unwrap()
+            Stack::new(vec![
+                DiffusionLayer::Slab(top),
+                DiffusionLayer::SemiInfinite(bottom),
+            ])
+            .unwrap()
         }
 
         proptest! {

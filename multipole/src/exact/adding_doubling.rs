@@ -270,7 +270,10 @@ pub fn skin_totals(
     lambda: Wavelength,
     options: &AddingDoublingOptions,
 ) -> Result<SlabTotals, MultipoleError> {
-    Ok(solve(&LayeredMedium::skin(skin, lambda, options.g)?, options)?)
+    Ok(solve(
+        &LayeredMedium::skin(skin, lambda, options.g)?,
+        options,
+    )?)
 }
 
 /// Exact total diffuse reflectance of the skin per unit flux *entering* it (the quantity diffusion's R_d

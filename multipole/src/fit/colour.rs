@@ -313,7 +313,9 @@ mod tests {
         let full = ColourModel::new(10.0, Method::Exact, base).unwrap();
         let fine48 = ColourModel::with_forward(
             10.0,
-            Forward::Exact(crate::exact::adding_doubling::AddingDoublingOptions::new(48, 0.9).unwrap()),
+            Forward::Exact(
+                crate::exact::adding_doubling::AddingDoublingOptions::new(48, 0.9).unwrap(),
+            ),
             base,
         )
         .unwrap();

@@ -19,8 +19,8 @@
 use super::FitError;
 use super::nelder_mead::{Budget, minimize};
 use crate::Method;
-use crate::exact::adding_doubling::{AddingDoublingOptions, skin_totals};
 use crate::error::MultipoleError;
+use crate::exact::adding_doubling::{AddingDoublingOptions, skin_totals};
 use crate::skin::diffuse_reflectance;
 use rayon::prelude::*;
 use skin_optics::{SkinParams, Wavelength};

@@ -2,9 +2,9 @@
 //! treatment, printed by `skin spectrum --explain` and `skin profile --explain` (docs/physics.md §9).
 
 use super::{ExactShape, Method, layer_scales, shape_photons, total_reflectance};
-use crate::error::MultipoleError;
 use crate::diffusion::medium::Medium;
 use crate::diffusion::slab::Poles;
+use crate::error::MultipoleError;
 use skin_optics::{SkinParams, Wavelength};
 use std::fmt;
 

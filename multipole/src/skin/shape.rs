@@ -3,15 +3,15 @@
 //! (exact transport, cached per material by whoever tabulates it, e.g. the renderer's tables).
 
 use super::{Method, stack, total_reflectance};
-use crate::exact::adding_doubling::{AddingDoublingOptions, LayerTotals, skin_layer_totals};
 use crate::diffusion::boundary::observable_reflectance;
-use crate::error::MultipoleError;
-use crate::exact::montecarlo::{self, McOptions, RadialGrid};
-use crate::layered::{DEFAULT_G, LayeredMedium};
 use crate::diffusion::profile::Profile;
 use crate::diffusion::slab::Poles;
 use crate::diffusion::spatial::{ProfileOptions, stack_profile};
 use crate::diffusion::stack::Response;
+use crate::error::MultipoleError;
+use crate::exact::adding_doubling::{AddingDoublingOptions, LayerTotals, skin_layer_totals};
+use crate::exact::montecarlo::{self, McOptions, RadialGrid};
+use crate::layered::{DEFAULT_G, LayeredMedium};
 use skin_optics::{SkinParams, Wavelength};
 
 /// Escaping photons per wavelength of the default Monte Carlo shape (the accuracy knob: the

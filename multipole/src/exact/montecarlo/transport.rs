@@ -9,8 +9,8 @@ mod sampling;
 #[cfg(test)]
 mod tests;
 
-use crate::layered::LayeredMedium;
 use super::tally::{BatchTally, RadialGrid};
+use crate::layered::LayeredMedium;
 use brdf::fresnel::dielectric_reflectance;
 use rand_distr::{Distribution, Exp1};
 use rand_xoshiro::Xoshiro256StarStar;
