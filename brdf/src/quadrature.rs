@@ -24,6 +24,9 @@ impl Rule {
 }
 
 /// Legendre polynomial P_n(x) and its derivative P_n'(x), by the three-term recurrence.
+///
+/// Inline: adding-doubling's phase-function expansion calls it in its per-layer loop.
+#[inline]
 #[must_use]
 pub fn legendre_with_derivative(n: usize, x: f64) -> (f64, f64) {
     if n == 0 {
