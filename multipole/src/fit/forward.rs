@@ -19,7 +19,6 @@
 use super::FitError;
 use super::nelder_mead::{Budget, minimize};
 use crate::Method;
-use crate::error::MultipoleError;
 use crate::exact::adding_doubling::{AddingDoublingOptions, skin_totals};
 use crate::skin::diffuse_reflectance;
 use rayon::prelude::*;
@@ -62,7 +61,7 @@ impl Forward {
             Forward::Method(m) => Ok(diffuse_reflectance(skin, lambda, *m)?),
             Forward::Exact(o) => skin_totals(skin, lambda, o)
                 .map(|t| t.diffuse_reflectance)
-                .map_err(|e| FitError::Model(MultipoleError::from(e))),
+                .map_err(FitError::Model),
         }
     }
 
