@@ -1,6 +1,6 @@
 //! Rays per on-CPU second of the BVH on the head mesh, one thread: closest hit and occlusion for
-//! coherent primary rays and incoherent random rays. Reads the thread's own CPU time from
-//! `/proc/thread-self/schedstat`, so the figure holds on a loaded machine (Linux only).
+//! coherent primary rays and incoherent random rays. Reads the thread's own CPU time
+//! (`cpu-time`), so the figure holds on a loaded machine.
 //!
 //! `cargo run --release -p render --example bvh_throughput`
 
@@ -14,13 +14,7 @@ use workload::{QUERIES, head_triangles, primary_rays, random_rays};
 
 /// On-CPU time of this thread, seconds.
 fn cpu_seconds() -> f64 {
-    let s = std::fs::read_to_string("/proc/thread-self/schedstat").expect("Linux schedstat");
-    let ns: f64 = s
-        .split_whitespace()
-        .next()
-        .and_then(|v| v.parse().ok())
-        .expect("number");
-    ns * 1e-9
+    cpu_time::ThreadTime::now().as_duration().as_secs_f64()
 }
 
 fn main() {

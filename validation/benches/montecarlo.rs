@@ -7,9 +7,9 @@
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use skin_optics::{Preset, SkinParams, Wavelength};
 use std::hint::black_box;
-use validation::montecarlo::{DEFAULT_SKIN_G, Layer, LayerStack, McOptions, run};
+use validation::montecarlo::{DEFAULT_G, Layer, LayeredMedium, McOptions, run};
 
-fn cases() -> Vec<(&'static str, LayerStack, u64)> {
+fn cases() -> Vec<(&'static str, LayeredMedium, u64)> {
     let l550 = Wavelength::new(550.0).expect("550 nm is in range");
     let light = SkinParams::preset(Preset::Light);
     let very_dark = SkinParams::new(0.5, 0.9, 0.07, 0.25).expect("valid fractions");
@@ -17,17 +17,17 @@ fn cases() -> Vec<(&'static str, LayerStack, u64)> {
     vec![
         (
             "light_550nm",
-            LayerStack::skin(&light, l550, DEFAULT_SKIN_G).expect("valid"),
+            LayeredMedium::skin(&light, l550, DEFAULT_G).expect("valid"),
             4_000,
         ),
         (
             "very_dark_550nm",
-            LayerStack::skin(&very_dark, l550, DEFAULT_SKIN_G).expect("valid"),
+            LayeredMedium::skin(&very_dark, l550, DEFAULT_G).expect("valid"),
             40_000,
         ),
         (
             "half_space_sa0.01",
-            LayerStack::new(vec![half], 1.0, 1.0).expect("valid"),
+            LayeredMedium::new(vec![half], 1.0, 1.0).expect("valid"),
             1_000,
         ),
     ]

@@ -5,7 +5,7 @@
 
 use super::profiles::{PROFILE_WAVELENGTHS_NM, annulus_mean};
 use super::{Settings, Summary, progress, write_csv, write_study};
-use crate::montecarlo::{self, DEFAULT_SKIN_G, LayerStack, McOptions, RadialGrid};
+use crate::montecarlo::{self, DEFAULT_G, LayeredMedium, McOptions, RadialGrid};
 use multipole::{Method, ProfileOptions};
 use render::plot::{LineChart, Panel, Series, SeriesStyle};
 use skin_optics::{Preset, SkinParams, Wavelength, WavelengthGrid};
@@ -50,7 +50,7 @@ fn spectra(settings: &Settings, out: &Path, summary: &mut Summary) -> anyhow::Re
         // Largest |error| beyond two standard errors of the MC: what noise cannot explain.
         let mut excess = [0.0f64; 2];
         for lambda in grid.iter() {
-            let stack = LayerStack::skin(&skin, lambda, DEFAULT_SKIN_G)?;
+            let stack = LayeredMedium::skin(&skin, lambda, DEFAULT_G)?;
             let expected = multipole::skin::diffuse_reflectance(&skin, lambda, Method::Exact)?;
             let photons = ((settings.exact_escapes as f64 / expected.max(1e-6)) as u64)
                 .clamp(settings.exact_photons, 100 * settings.exact_photons);
@@ -137,7 +137,7 @@ fn profiles(settings: &Settings, out: &Path, summary: &mut Summary) -> anyhow::R
         let skin = SkinParams::preset(preset);
         for (k, &nm) in PROFILE_WAVELENGTHS_NM.iter().enumerate() {
             let lambda = Wavelength::new(nm)?;
-            let stack = LayerStack::skin(&skin, lambda, DEFAULT_SKIN_G)?;
+            let stack = LayeredMedium::skin(&skin, lambda, DEFAULT_G)?;
             let opts = McOptions::new(settings.profile_photons, 16, settings.seed)?.with_grid(grid);
             let mc = montecarlo::run(&stack, &opts);
             let color = [[40, 80, 220], [40, 160, 60], [210, 40, 40]][k];

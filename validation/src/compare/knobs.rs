@@ -14,7 +14,7 @@ const SHAPE_ESCAPES: [u64; 5] = [250, 1_000, 4_000, 16_000, 64_000];
 
 use super::profiles::annulus_mean;
 use super::{Settings, Summary, progress, timed_mc, write_study};
-use crate::montecarlo::{self, DEFAULT_SKIN_G, LayerStack, McOptions, RadialGrid};
+use crate::montecarlo::{self, DEFAULT_G, LayeredMedium, McOptions, RadialGrid};
 use multipole::skin::ExactShape;
 use multipole::{Method, Poles, ProfileOptions};
 use render::plot::{LineChart, Panel, Series, SeriesStyle};
@@ -95,7 +95,7 @@ pub fn run(settings: &Settings, out: &Path, summary: &mut Summary) -> anyhow::Re
         bar.inc(1);
     }
     let exact = multipole::skin::diffuse_reflectance(&skin, lambda, Method::Exact)?;
-    let stack = LayerStack::skin(&skin, lambda, DEFAULT_SKIN_G)?;
+    let stack = LayeredMedium::skin(&skin, lambda, DEFAULT_G)?;
     let (mut mc_pts, mut se_pts) = (Vec::new(), Vec::new());
     for &n in &photon_counts {
         let (r, s) = timed_mc(&stack, &McOptions::new(n, 16, settings.seed)?);
@@ -200,7 +200,7 @@ fn shape_knob(
     bar: &indicatif::ProgressBar,
 ) -> anyhow::Result<Vec<(f64, f64)>> {
     let grid = RadialGrid::new(0.02, 300)?;
-    let stack = LayerStack::skin(skin, lambda, DEFAULT_SKIN_G)?;
+    let stack = LayeredMedium::skin(skin, lambda, DEFAULT_G)?;
     // A seed of its own: the reference must be independent of the shape's fixed seed.
     let opts = McOptions::new(settings.profile_photons, 16, settings.seed + 7)?.with_grid(grid);
     let mc = montecarlo::run(&stack, &opts);

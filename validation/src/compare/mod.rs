@@ -18,7 +18,7 @@ pub mod profiles;
 pub mod spectra;
 pub mod stability;
 
-use crate::montecarlo::{self, LayerStack, McOptions, McResult};
+use crate::montecarlo::{self, LayeredMedium, McOptions, McResult};
 use anyhow::Context;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::fmt::Write as _;
@@ -126,7 +126,7 @@ pub(crate) fn progress(total: u64, what: &str) -> ProgressBar {
 }
 
 /// One MC run, timed (seconds).
-pub(crate) fn timed_mc(stack: &LayerStack, opts: &McOptions) -> (McResult, f64) {
+pub(crate) fn timed_mc(stack: &LayeredMedium, opts: &McOptions) -> (McResult, f64) {
     let t = Instant::now();
     let r = montecarlo::run(stack, opts);
     (r, t.elapsed().as_secs_f64())

@@ -1,7 +1,7 @@
 //! Study 2: radial profiles R(r) of the light preset at 450, 550, 650 nm, multipole against MC.
 
 use super::{Settings, Summary, progress, write_study};
-use crate::montecarlo::{self, DEFAULT_SKIN_G, LayerStack, McOptions, RadialGrid};
+use crate::montecarlo::{self, DEFAULT_G, LayeredMedium, McOptions, RadialGrid};
 use multipole::boundary::observable_reflectance;
 use multipole::{Method, ProfileOptions};
 use render::plot::{LineChart, Panel, Series};
@@ -40,7 +40,7 @@ pub fn run(settings: &Settings, out: &Path, summary: &mut Summary) -> anyhow::Re
         let lambda = Wavelength::new(nm)?;
         let mp =
             multipole::skin::profile(&skin, lambda, Method::Multipole, &ProfileOptions::default())?;
-        let stack = LayerStack::skin(&skin, lambda, DEFAULT_SKIN_G)?;
+        let stack = LayeredMedium::skin(&skin, lambda, DEFAULT_G)?;
         let opts = McOptions::new(settings.profile_photons, 16, settings.seed)?.with_grid(grid);
         let mc = montecarlo::run(&stack, &opts);
         let (mut line, mut pts) = (Vec::new(), Vec::new());

@@ -1,7 +1,7 @@
 //! Study 1: observable diffuse reflectance over 400–700 nm for each preset, multipole against MC.
 
 use super::{Settings, Summary, progress, timed_mc, write_study};
-use crate::montecarlo::{DEFAULT_SKIN_G, LayerStack, McOptions};
+use crate::montecarlo::{DEFAULT_G, LayeredMedium, McOptions};
 use multipole::Method;
 use render::plot::{LineChart, Panel, Series};
 use skin_optics::{Preset, SkinParams, Wavelength, WavelengthGrid};
@@ -85,7 +85,7 @@ fn compare_one(
     settings: &Settings,
 ) -> anyhow::Result<(f64, (f64, f64), f64)> {
     let m = multipole::skin::diffuse_reflectance(skin, lambda, Method::Multipole)?;
-    let stack = LayerStack::skin(skin, lambda, DEFAULT_SKIN_G)?;
+    let stack = LayeredMedium::skin(skin, lambda, DEFAULT_G)?;
     let opts = McOptions::new(settings.spectrum_photons, 16, settings.seed)?;
     let (r, s) = timed_mc(&stack, &opts);
     Ok((

@@ -8,13 +8,13 @@
 use crate::montecarlo::photons;
 use multipole::Method;
 use skin_optics::{Preset, SkinParams, Wavelength};
-use validation::montecarlo::{DEFAULT_SKIN_G, LayerStack, McOptions, run};
+use validation::montecarlo::{DEFAULT_G, LayeredMedium, McOptions, run};
 
 fn check(preset: Preset, seed: u64) {
     let skin = SkinParams::preset(preset);
     let lambda = Wavelength::new(550.0).unwrap();
     let exact = multipole::skin::diffuse_reflectance(&skin, lambda, Method::Exact).unwrap();
-    let stack = LayerStack::skin(&skin, lambda, DEFAULT_SKIN_G).unwrap();
+    let stack = LayeredMedium::skin(&skin, lambda, DEFAULT_G).unwrap();
     let mc = run(&stack, &McOptions::new(photons(60_000), 20, seed).unwrap()).diffuse_reflectance;
     let tol = 4.0 * mc.stderr + 0.005 * mc.mean;
     assert!(

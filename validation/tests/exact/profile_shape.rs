@@ -9,7 +9,7 @@
 use multipole::skin::{Method, profile};
 use multipole::{Profile, ProfileOptions};
 use skin_optics::{Preset, SkinParams, Wavelength};
-use validation::montecarlo::{DEFAULT_SKIN_G, LayerStack, McOptions, McResult, RadialGrid, run};
+use validation::montecarlo::{DEFAULT_G, LayeredMedium, McOptions, McResult, RadialGrid, run};
 
 /// ∫ 2πr R(r) dr over [a, b] (mm) by the midpoint rule on 16 sub-intervals.
 fn annulus_energy(p: &Profile, a: f64, b: f64) -> f64 {
@@ -40,7 +40,7 @@ fn check(preset: Preset, nm: f64, photons: u64) {
     let skin = SkinParams::preset(preset);
     let lambda = Wavelength::new(nm).unwrap();
     let model = profile(&skin, lambda, Method::Exact, &ProfileOptions::default()).unwrap();
-    let stack = LayerStack::skin(&skin, lambda, DEFAULT_SKIN_G).unwrap();
+    let stack = LayeredMedium::skin(&skin, lambda, DEFAULT_G).unwrap();
     let grid = RadialGrid::new(0.02, 300).unwrap();
     let mc = run(
         &stack,

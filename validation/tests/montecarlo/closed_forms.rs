@@ -2,11 +2,11 @@
 
 use super::photons;
 use brdf::fresnel::normal_incidence_reflectance;
-use validation::montecarlo::{Layer, LayerStack, McOptions, McResult, run};
+use validation::montecarlo::{Layer, LayeredMedium, McOptions, McResult, run};
 
 /// `layer` alone between index 1 above and `n_below` below, traced with `photons` in `batches`.
 fn one_slab(layer: Layer, n_below: f64, photons: u64, batches: u32, seed: u64) -> McResult {
-    let stack = LayerStack::new(vec![layer], 1.0, n_below).unwrap();
+    let stack = LayeredMedium::new(vec![layer], 1.0, n_below).unwrap();
     run(&stack, &McOptions::new(photons, batches, seed).unwrap())
 }
 
@@ -60,7 +60,7 @@ fn glass_slab_reflects_two_r_over_one_plus_r() {
 fn non_absorbing_matched_slab_loses_no_energy() {
     // No absorption and matched indices: every photon leaves by the top or the bottom, with its
     // full weight (roulette never fires because the weight never falls).
-    let stack = LayerStack::new(
+    let stack = LayeredMedium::new(
         vec![
             Layer::slab(0.0, 5.0, 0.8, 1.0, 0.5).unwrap(),
             Layer::slab(0.0, 20.0, 0.0, 1.0, 1.0).unwrap(),

@@ -6,7 +6,7 @@
 
 use super::photons;
 use skin_optics::{Preset, SkinParams, Wavelength};
-use validation::montecarlo::{Layer, LayerStack, McOptions, McResult, run};
+use validation::montecarlo::{Layer, LayeredMedium, McOptions, McResult, run};
 
 fn check(r: &McResult, reference: f64, reference_uncertainty: f64, what: &str) {
     let rd = r.diffuse_reflectance;
@@ -21,7 +21,7 @@ fn check(r: &McResult, reference: f64, reference_uncertainty: f64, what: &str) {
 }
 
 fn light_skin(nm: f64, n: u64, seed: u64) -> McResult {
-    let stack = LayerStack::skin(
+    let stack = LayeredMedium::skin(
         &SkinParams::preset(Preset::Light),
         Wavelength::new(nm).unwrap(),
         0.9,
@@ -62,7 +62,7 @@ fn light_skin_650_nm() {
 
 fn half_space(sigma_a: f64, n: u64) -> McResult {
     let layer = Layer::from_reduced(sigma_a, 1.0, 0.9, 1.4, None).unwrap();
-    let stack = LayerStack::new(vec![layer], 1.0, 1.0).unwrap();
+    let stack = LayeredMedium::new(vec![layer], 1.0, 1.0).unwrap();
     run(&stack, &McOptions::new(photons(n), 20, 17).unwrap())
 }
 

@@ -1,4 +1,4 @@
-//! Stacking layers in the frequency domain (Kubelka–Munk with convolutions, [DJ05] §4; physics.md §6).
+//! Stacking layers in the frequency domain (Kubelka–Munk with convolutions, [DJ05] §4; docs/physics.md §6), built from a [`LayeredMedium`].
 //!
 //! Pointwise in spatial frequency q, for layer 1 over layer 2:
 //! R̂12↓ = R̂1↓ + T̂1↓ R̂2↓ T̂1↑ / (1 − R̂2↓ R̂1↑),  T̂12↓ = T̂1↓ T̂2↓ / (1 − R̂2↓ R̂1↑),
@@ -8,13 +8,16 @@
 //! indices below, the two directions differ strongly, and the symmetric shortcut (↓ for both)
 //! overestimates skin's red reflectance by about 16%. Any number of layers folds from the top.
 
-use crate::dipole::Dipole;
+use crate::diffusion::dipole::Dipole;
+use crate::diffusion::medium::Medium;
+use crate::diffusion::slab::{Poles, Slab};
 use crate::error::MultipoleError;
-use crate::slab::{Poles, Slab};
+use crate::layered::LayeredMedium;
 
-/// One layer of a stack.
+/// One layer of a stack solved by diffusion: its multipole (finite) or dipole (semi-infinite)
+/// solution.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Layer {
+pub enum DiffusionLayer {
     /// A finite slab (multipole).
     Slab(Slab),
     /// A semi-infinite medium (dipole); only the bottom layer may be semi-infinite.
@@ -51,6 +54,24 @@ impl Response {
         t_up: 1.0,
     };
 
+    /// A response from its components [R̂↓, T̂↓, R̂↑, T̂↑].
+    #[must_use]
+    pub fn from_components([r_down, t_down, r_up, t_up]: [f64; 4]) -> Self {
+        Self {
+            r_down,
+            t_down,
+            r_up,
+            t_up,
+        }
+    }
+
+    /// A semi-infinite layer's response: reflectance `r` both ways, nothing transmitted (lit from
+    /// below it is treated as its top-lit self, which no stack uses: nothing lies below it).
+    #[must_use]
+    pub fn half_space(r: f64) -> Self {
+        Self::from_components([r, 0.0, r, 0.0])
+    }
+
     /// Componentwise product: a response rescaled by per-component factors (`factors` holds the
     /// dimensionless multipliers of R̂↓, T̂↓, R̂↑, T̂↑).
     #[must_use]
@@ -76,31 +97,18 @@ impl Response {
     }
 }
 
-impl Layer {
+impl DiffusionLayer {
     /// Frequency response at `q` (rad/mm); a semi-infinite layer transmits nothing and, lit from below,
     /// is treated as its top-lit self (never used: it has no layer below).
     #[must_use]
     pub fn response(&self, q: f64, poles: Poles) -> Response {
         match self {
-            Layer::Slab(s) => {
+            DiffusionLayer::Slab(s) => {
                 let (r_down, t_down) = s.transform(q, poles);
                 let (r_up, t_up) = s.flipped().transform(q, poles);
-                Response {
-                    r_down,
-                    t_down,
-                    r_up,
-                    t_up,
-                }
+                Response::from_components([r_down, t_down, r_up, t_up])
             }
-            Layer::SemiInfinite(d) => {
-                let r = d.transform(q);
-                Response {
-                    r_down: r,
-                    t_down: 0.0,
-                    r_up: r,
-                    t_up: 0.0,
-                }
-            }
+            DiffusionLayer::SemiInfinite(d) => Response::half_space(d.transform(q)),
         }
     }
 
@@ -108,40 +116,24 @@ impl Layer {
     #[must_use]
     pub fn response_and_head(&self, q: f64, poles: Poles) -> (Response, f64) {
         match self {
-            Layer::Slab(s) => {
-                let ([r_down, t_down, r_up, t_up], head) = s.transform_both(q, poles);
-                (
-                    Response {
-                        r_down,
-                        t_down,
-                        r_up,
-                        t_up,
-                    },
-                    head,
-                )
+            DiffusionLayer::Slab(s) => {
+                let (components, head) = s.transform_both(q, poles);
+                (Response::from_components(components), head)
             }
-            Layer::SemiInfinite(d) => {
+            DiffusionLayer::SemiInfinite(d) => {
                 let r = d.transform(q);
-                (
-                    Response {
-                        r_down: r,
-                        t_down: 0.0,
-                        r_up: r,
-                        t_up: 0.0,
-                    },
-                    r,
-                )
+                (Response::half_space(r), r)
             }
         }
     }
 
     /// The slowest-decaying part of R̂↓ (the first source pair), whose inverse transform is closed form:
-    /// (value at q, value in space at r) are [`Layer::head_transform`] and [`Layer::head_reflectance_mm2`].
+    /// (value at q, value in space at r) are [`DiffusionLayer::head_transform`] and [`DiffusionLayer::head_reflectance_mm2`].
     #[must_use]
     pub fn head_transform(&self, q: f64) -> f64 {
         match self {
-            Layer::Slab(s) => s.head_transform(q),
-            Layer::SemiInfinite(d) => d.transform(q),
+            DiffusionLayer::Slab(s) => s.head_transform(q),
+            DiffusionLayer::SemiInfinite(d) => d.transform(q),
         }
     }
 
@@ -149,8 +141,8 @@ impl Layer {
     #[must_use]
     pub fn head_reflectance_mm2(&self, r_mm: f64) -> f64 {
         match self {
-            Layer::Slab(s) => s.head_reflectance_mm2(r_mm),
-            Layer::SemiInfinite(d) => d.reflectance_mm2(r_mm),
+            DiffusionLayer::Slab(s) => s.head_reflectance_mm2(r_mm),
+            DiffusionLayer::SemiInfinite(d) => d.reflectance_mm2(r_mm),
         }
     }
 
@@ -158,17 +150,17 @@ impl Layer {
     #[must_use]
     pub fn sigma_tr(&self) -> f64 {
         match self {
-            Layer::Slab(s) => s.medium().sigma_tr(),
-            Layer::SemiInfinite(d) => d.medium().sigma_tr(),
+            DiffusionLayer::Slab(s) => s.medium().sigma_tr(),
+            DiffusionLayer::SemiInfinite(d) => d.medium().sigma_tr(),
         }
     }
 
     /// The layer's medium.
     #[must_use]
-    pub fn medium(&self) -> &crate::medium::Medium {
+    pub fn medium(&self) -> &crate::diffusion::medium::Medium {
         match self {
-            Layer::Slab(s) => s.medium(),
-            Layer::SemiInfinite(d) => d.medium(),
+            DiffusionLayer::Slab(s) => s.medium(),
+            DiffusionLayer::SemiInfinite(d) => d.medium(),
         }
     }
 }
@@ -177,20 +169,20 @@ impl Layer {
 /// response (all 1 unless set by [`Stack::with_scales`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Stack {
-    layers: Vec<Layer>,
+    layers: Vec<DiffusionLayer>,
     scales: Vec<Response>,
 }
 
 impl Stack {
     /// Stack from layers listed top first; only the last may be semi-infinite; at least one layer.
-    pub fn new(layers: Vec<Layer>) -> Result<Self, MultipoleError> {
+    pub fn new(layers: Vec<DiffusionLayer>) -> Result<Self, MultipoleError> {
         if layers.is_empty() {
             return Err(MultipoleError::Stack("no layers"));
         }
         let n = layers.len();
         if layers[..n - 1]
             .iter()
-            .any(|l| matches!(l, Layer::SemiInfinite(_)))
+            .any(|l| matches!(l, DiffusionLayer::SemiInfinite(_)))
         {
             return Err(MultipoleError::Stack(
                 "only the bottom layer may be semi-infinite",
@@ -198,6 +190,31 @@ impl Stack {
         }
         let scales = vec![Response::IDENTITY_SCALE; n];
         Ok(Self { layers, scales })
+    }
+
+    /// The diffusion solution of `medium`: each layer a multipole slab, the last a dipole if
+    /// semi-infinite, with the boundary condition of each face from the relative index across it
+    /// (the layer's n over its neighbour's, or the ambient index at the outer faces; [DJ05] §3).
+    pub fn from_medium(medium: &LayeredMedium) -> Result<Self, MultipoleError> {
+        let layers = medium.layers();
+        let parts = layers
+            .iter()
+            .enumerate()
+            .map(|(i, l)| {
+                let above = if i == 0 {
+                    medium.n_above()
+                } else {
+                    layers[i - 1].n()
+                };
+                let below = layers.get(i + 1).map_or(medium.n_below(), |b| b.n());
+                let m = Medium::new(l.sigma_a(), l.sigma_s_prime())?;
+                Ok(match l.thickness_mm() {
+                    Some(d) => DiffusionLayer::Slab(Slab::new(m, d, l.n() / above, l.n() / below)?),
+                    None => DiffusionLayer::SemiInfinite(Dipole::new(m, l.n() / above)?),
+                })
+            })
+            .collect::<Result<Vec<_>, MultipoleError>>()?;
+        Self::new(parts)
     }
 
     /// The same stack with each layer's response R̂(q), T̂(q) multiplied by constant factors (one
@@ -244,7 +261,7 @@ impl Stack {
 
     /// The layers, top first.
     #[must_use]
-    pub fn layers(&self) -> &[Layer] {
+    pub fn layers(&self) -> &[DiffusionLayer] {
         &self.layers
     }
 
@@ -287,7 +304,7 @@ impl Stack {
 
     /// The top layer (closed-form head of the profile).
     #[must_use]
-    pub fn top(&self) -> &Layer {
+    pub fn top(&self) -> &DiffusionLayer {
         // `new` guarantees at least one layer.
         &self.layers[0]
     }
@@ -296,15 +313,14 @@ impl Stack {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::medium::Medium;
     use approx::assert_relative_eq;
 
-    fn epidermis_like(sa: f64, d: f64) -> Layer {
-        Layer::Slab(Slab::new(Medium::new(sa, 5.0).unwrap(), d, 1.4, 1.0).unwrap())
+    fn epidermis_like(sa: f64, d: f64) -> DiffusionLayer {
+        DiffusionLayer::Slab(Slab::new(Medium::new(sa, 5.0).unwrap(), d, 1.4, 1.0).unwrap())
     }
 
-    fn dermis_like(sa: f64) -> Layer {
-        Layer::SemiInfinite(Dipole::with_a(Medium::new(sa, 5.0).unwrap(), 1.0))
+    fn dermis_like(sa: f64) -> DiffusionLayer {
+        DiffusionLayer::SemiInfinite(Dipole::with_a(Medium::new(sa, 5.0).unwrap(), 1.0))
     }
 
     #[test]
@@ -342,7 +358,7 @@ mod tests {
         // so a loose 10% check: it catches a wrong direction or a missing inter-reflection term).
         let m = Medium::new(0.05, 3.0).unwrap();
         let whole = Slab::new(m, 2.0, 1.0, 1.0).unwrap();
-        let half = Layer::Slab(Slab::new(m, 1.0, 1.0, 1.0).unwrap());
+        let half = DiffusionLayer::Slab(Slab::new(m, 1.0, 1.0, 1.0).unwrap());
         let two = Stack::new(vec![half, half])
             .unwrap()
             .response(0.0, Poles::Exact);
@@ -384,7 +400,11 @@ mod tests {
         fn build(sa1: f64, ss1: f64, d: f64, eta: f64, sa2: f64, ss2: f64) -> Stack {
             let top = Slab::new(Medium::new(sa1, ss1).unwrap(), d, eta, 1.0).unwrap();
             let bottom = Dipole::with_a(Medium::new(sa2, ss2).unwrap(), 1.0);
-            Stack::new(vec![Layer::Slab(top), Layer::SemiInfinite(bottom)]).unwrap()
+            Stack::new(vec![
+                DiffusionLayer::Slab(top),
+                DiffusionLayer::SemiInfinite(bottom),
+            ])
+            .unwrap()
         }
 
         proptest! {

@@ -1,12 +1,13 @@
 //! The radial profile table: R(r) on a geometric radius grid, its total, energy radii, and the CDF of
-//! 2πr R(r) for importance sampling r (physics.md §8). The renderer and validation both use it.
+//! 2πr R(r) for importance sampling r (docs/physics.md §8). The renderer and validation both use it.
 //!
 //! Between nodes, the sampling density p(r) = 2πr R(r) is linear in r (so the CDF is piecewise
-//! quadratic and inverted exactly); below the first radius it rises linearly from p(0) = 0.
-//! [`Profile::sample_radius`] and [`Profile::pdf_radius`] are exactly consistent with each other;
+//! quadratic and inverted exactly, by [`crate::sampling`]); below the first radius it rises linearly
+//! from p(0) = 0. [`Profile::sample_radius`] and [`Profile::pdf_radius`] are exactly consistent;
 //! [`Profile::eval`] interpolates R log–log between nodes and is 0 beyond the last radius.
 
 use crate::error::MultipoleError;
+use crate::sampling;
 use std::f64::consts::PI;
 
 /// Radial diffuse reflectance table of one material at one wavelength.
@@ -15,6 +16,8 @@ pub struct Profile {
     radii_mm: Vec<f64>,
     reflectance_per_mm2: Vec<f64>,
     total: f64,
+    /// The sampling density p = 2πr R(r) at each node, mm⁻¹.
+    density: Vec<f64>,
     /// Cumulative ∫₀^{r_i} 2πr R dr at each node (trapezoid in the linear-p model).
     cdf: Vec<f64>,
     clamped: usize,
@@ -56,18 +59,17 @@ impl Profile {
                 "total must be finite and non-negative",
             ));
         }
-        let p = |i: usize| 2.0 * PI * radii_mm[i] * reflectance_per_mm2[i];
-        let mut cdf = Vec::with_capacity(radii_mm.len());
-        let mut acc = 0.5 * radii_mm[0] * p(0);
-        cdf.push(acc);
-        for i in 1..radii_mm.len() {
-            acc += 0.5 * (radii_mm[i] - radii_mm[i - 1]) * (p(i) + p(i - 1));
-            cdf.push(acc);
-        }
+        let density: Vec<f64> = radii_mm
+            .iter()
+            .zip(&reflectance_per_mm2)
+            .map(|(r, v)| 2.0 * PI * r * v)
+            .collect();
+        let cdf = sampling::cumulative(&radii_mm, &density);
         Ok(Self {
             radii_mm,
             reflectance_per_mm2,
             total,
+            density,
             cdf,
             clamped: 0,
         })
@@ -128,36 +130,9 @@ impl Profile {
         self.radius_for_energy(0.99)
     }
 
-    /// Density p at table index i, 2πr R(r) (mm⁻¹).
-    fn p(&self, i: usize) -> f64 {
-        2.0 * PI * self.radii_mm[i] * self.reflectance_per_mm2[i]
-    }
-
     /// Invert the cumulative energy: the radius where ∫₀^r 2πr' R dr' = `target`.
     fn radius_for_cumulative(&self, target: f64) -> f64 {
-        let n = self.radii_mm.len();
-        if target >= self.cdf[n - 1] {
-            return self.r_max_mm();
-        }
-        let i = self.cdf.partition_point(|&c| c < target);
-        let (r0, c0, p0) = if i == 0 {
-            (0.0, 0.0, 0.0)
-        } else {
-            (self.radii_mm[i - 1], self.cdf[i - 1], self.p(i - 1))
-        };
-        let (r1, p1) = (self.radii_mm[i], self.p(i));
-        let h = r1 - r0;
-        // Within the segment p(t) = p0 + (p1 − p0) t/h; solve p0 t + (p1 − p0) t²/(2h) = target − c0.
-        let need = (target - c0).max(0.0);
-        let a = 0.5 * (p1 - p0) / h;
-        let t = if a.abs() < 1e-14 * p0.max(p1).max(1e-300) / h {
-            if p0 > 0.0 { need / p0 } else { 0.0 }
-        } else {
-            let disc = (p0 * p0 + 4.0 * a * need).max(0.0);
-            // Stable root of a t² + p0 t − need = 0.
-            2.0 * need / (p0 + disc.sqrt())
-        };
-        r0 + t.clamp(0.0, h)
+        sampling::invert(&self.radii_mm, &self.density, &self.cdf, target)
     }
 
     /// A radius drawn with pdf ∝ 2πr R(r) on [0, r_max], from a uniform `u` in [0, 1), mm.
@@ -170,18 +145,10 @@ impl Profile {
     #[must_use]
     pub fn pdf_radius(&self, r_mm: f64) -> f64 {
         let norm = self.table_integral();
-        if r_mm.is_nan() || r_mm < 0.0 || r_mm > self.r_max_mm() || norm <= 0.0 {
+        if norm <= 0.0 {
             return 0.0;
         }
-        let i = self.radii_mm.partition_point(|&r| r < r_mm);
-        let p = if i == 0 {
-            self.p(0) * r_mm / self.radii_mm[0]
-        } else {
-            let (r0, r1) = (self.radii_mm[i - 1], self.radii_mm[i]);
-            let t = (r_mm - r0) / (r1 - r0);
-            self.p(i - 1) + t * (self.p(i) - self.p(i - 1))
-        };
-        p / norm
+        sampling::density(&self.radii_mm, &self.density, r_mm) / norm
     }
 
     /// R(r) at `r_mm`, mm⁻²: log–log interpolation between nodes (linear where a value is 0),

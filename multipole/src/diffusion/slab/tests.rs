@@ -1,18 +1,18 @@
 use super::*;
 use approx::assert_relative_eq;
 
-/// physics.md §4 check slab: σa = 0.1, σs' = 2, d = 1, η_top = 1.4, η_bottom = 1.
+/// docs/physics.md §4 check slab: σa = 0.1, σs' = 2, d = 1, η_top = 1.4, η_bottom = 1.
 ///
 /// The published numbers reproduce to 1e-6 only with A_bottom = 1.0032, the raw F_dr fit at η = 1
-/// (physics.md §2 notes F_dr(1) = 0.0016); with A = 1 exactly, as this crate uses for a matched face,
+/// (docs/physics.md §2 notes F_dr(1) = 0.0016); with A = 1 exactly, as this crate uses for a matched face,
 /// they move by ≈ 5e-4 relative (see `matched_face_a_one_is_close_to_check_values`).
 fn check_slab() -> Slab {
-    let f = crate::boundary::fresnel_diffuse_reflectance(1.0);
+    let f = crate::diffusion::boundary::fresnel_diffuse_reflectance(1.0);
     let a_fit_at_one = (1.0 + f) / (1.0 - f);
     Slab::with_a(
         Medium::new(0.1, 2.0).unwrap(),
         1.0,
-        crate::boundary::a_coefficient(1.4),
+        crate::diffusion::boundary::a_coefficient(1.4),
         a_fit_at_one,
     )
     .unwrap()
@@ -152,7 +152,7 @@ fn thick_slab_converges_to_the_dipole() {
 
 #[test]
 fn pole_count_converges_to_exact() {
-    // Low absorption: slow convergence, e^(−2 n σtr L) per physics.md §4.
+    // Low absorption: slow convergence, e^(−2 n σtr L) per docs/physics.md §4.
     let s = Slab::new(Medium::new(0.01, 2.0).unwrap(), 0.5, 1.4, 1.0).unwrap();
     let exact = s.transform(0.0, Poles::Exact);
     let err = |n: usize| {
@@ -201,10 +201,10 @@ fn thin_slabs_are_non_negative_and_conserve_energy() {
     // d = 0.05, 0.5 and 1 mean free paths (ℓ = 1/σt'), where the raw multipole goes negative.
     let m = Medium::new(0.1, 2.0).unwrap();
     let raw_negative = {
-        // The unclamped multipole of physics.md §4 (source at ℓ, no blend) at d = 0.05 mm: R_tot < 0.
+        // The unclamped multipole of docs/physics.md §4 (source at ℓ, no blend) at d = 0.05 mm: R_tot < 0.
         let (l, zb0, zbd, d) = (
             m.mean_free_path_mm(),
-            m.extrapolation_mm(crate::boundary::a_coefficient(1.4)),
+            m.extrapolation_mm(crate::diffusion::boundary::a_coefficient(1.4)),
             m.extrapolation_mm(1.0),
             0.05,
         );
@@ -212,8 +212,8 @@ fn thin_slabs_are_non_negative_and_conserve_energy() {
         (-5i64..=5)
             .map(|i| {
                 let (zr, zv) = (i as f64 * period + l, i as f64 * period - l - 2.0 * zb0);
-                crate::medium::pole_transform(zr, m.sigma_tr())
-                    - crate::medium::pole_transform(zv, m.sigma_tr())
+                crate::diffusion::medium::pole_transform(zr, m.sigma_tr())
+                    - crate::diffusion::medium::pole_transform(zv, m.sigma_tr())
             })
             .sum::<f64>()
             < 0.0
@@ -247,11 +247,12 @@ fn thin_slabs_are_non_negative_and_conserve_energy() {
         // Over a dermis, the profile that is passed on is finite and non-negative without clamping.
         let dermis = crate::Dipole::new(Medium::new(0.05, 2.0).unwrap(), 1.0).unwrap();
         let st = crate::Stack::new(vec![
-            crate::Layer::Slab(s),
-            crate::Layer::SemiInfinite(dermis),
+            crate::DiffusionLayer::Slab(s),
+            crate::DiffusionLayer::SemiInfinite(dermis),
         ])
         .unwrap();
-        let p = crate::spatial::stack_profile(&st, &crate::ProfileOptions::default()).unwrap();
+        let p = crate::diffusion::spatial::stack_profile(&st, &crate::ProfileOptions::default())
+            .unwrap();
         assert_eq!(p.clamped_samples(), 0, "{mfp} mfp");
         assert!(p.total() > 0.0 && p.total() < 1.0);
         // Spatial diffuse T plus the delta equals the transform's total.

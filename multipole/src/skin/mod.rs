@@ -1,14 +1,13 @@
 //! Two-layer skin ([DJ06]): an epidermis slab of the given thickness (index `skin.eta()` above it,
 //! matched below) over a semi-infinite dermis (dipole with A = 1), stacked in the frequency domain.
 
-use crate::boundary::observable_reflectance;
-use crate::dipole::Dipole;
+use crate::diffusion::boundary::observable_reflectance;
+use crate::diffusion::profile::Profile;
+use crate::diffusion::slab::Poles;
+use crate::diffusion::spatial::{ProfileOptions, reference_reflectance, stack_profile};
+use crate::diffusion::stack::Stack;
 use crate::error::MultipoleError;
-use crate::medium::Medium;
-use crate::profile::Profile;
-use crate::slab::{Poles, Slab};
-use crate::spatial::{ProfileOptions, reference_reflectance, stack_profile};
-use crate::stack::{Layer, Stack};
+use crate::layered::{DEFAULT_G, LayeredMedium};
 use rayon::prelude::*;
 use skin_optics::{SkinParams, Wavelength, WavelengthGrid};
 use std::fmt;
@@ -28,9 +27,9 @@ pub use shape::{
 #[non_exhaustive]
 pub enum Method {
     /// Exact plane-parallel transport by adding-doubling ([Prahl95], [vdH80]; HG g = 0.9,
-    /// σs = σs'/(1 − g), Fresnel boundaries; `crate::adding_doubling` with default options) for the
-    /// totals, which diffusion overestimates two- to threefold for dark skin. Profiles: diffusion layers
-    /// from the layered Monte Carlo scaled to the exact total ([`ExactShape::MonteCarlo`]). The default.
+    /// σs = σs'/(1 − g), Fresnel boundaries; `crate::exact::adding_doubling` with default options) for the
+    /// totals, which diffusion overestimates two- to threefold for dark skin. Profiles: the layered Monte
+    /// Carlo's radial shape scaled to the exact total ([`ExactShape::MonteCarlo`]). The default.
     #[default]
     Exact,
     /// Donner & Jensen's multipole diffusion with frequency-domain layer stacking ([DJ05], [DJ06]):
@@ -58,18 +57,11 @@ impl FromStr for Method {
     }
 }
 
-/// The layer stack of `skin` at `lambda`: epidermis slab (η_top = skin η, η_bottom = 1 so A = 1)
-/// over a semi-infinite dermis (A = 1: index matched to the epidermis).
+/// The diffusion stack of `skin` at `lambda`: [`LayeredMedium::skin`] solved by diffusion, an
+/// epidermis slab (η_top = skin η, η_bottom = 1 so A = 1) over a semi-infinite dermis (A = 1: index
+/// matched to the epidermis).
 pub fn stack(skin: &SkinParams, lambda: Wavelength) -> Result<Stack, MultipoleError> {
-    let c = skin.coefficients(lambda);
-    let epidermis = Slab::new(
-        Medium::from_coefficients(&c.epidermis)?,
-        skin.epidermis_thickness_mm(),
-        skin.eta(),
-        1.0,
-    )?;
-    let dermis = Dipole::new(Medium::from_coefficients(&c.dermis)?, 1.0)?;
-    Stack::new(vec![Layer::Slab(epidermis), Layer::SemiInfinite(dermis)])
+    Stack::from_medium(&LayeredMedium::skin(skin, lambda, DEFAULT_G)?)
 }
 
 /// The model's total diffuse reflectance R_d per unit flux *entering* the skin, dimensionless, in (0, 1).
@@ -79,10 +71,10 @@ pub fn total_reflectance(
     method: Method,
 ) -> Result<f64, MultipoleError> {
     match method {
-        Method::Exact => Ok(crate::adding_doubling::skin_total_reflectance(
+        Method::Exact => Ok(crate::exact::adding_doubling::skin_total_reflectance(
             skin,
             lambda,
-            &crate::adding_doubling::AddingDoublingOptions::default(),
+            &crate::exact::adding_doubling::AddingDoublingOptions::default(),
         )?),
         Method::Multipole => Ok(stack(skin, lambda)?.total_reflectance(Poles::Exact)),
     }
@@ -241,8 +233,8 @@ pub fn profile_error(
     let n = 400;
     let radii: Vec<f64> = (0..n)
         .map(|i| {
-            crate::spatial::R_MIN_MM
-                * (r_hi / crate::spatial::R_MIN_MM).powf(i as f64 / (n - 1) as f64)
+            crate::diffusion::spatial::R_MIN_MM
+                * (r_hi / crate::diffusion::spatial::R_MIN_MM).powf(i as f64 / (n - 1) as f64)
         })
         .collect();
     let exact = reference_reflectance(&st, Poles::Exact, &radii);

@@ -1,4 +1,10 @@
-//! The plane-parallel medium the Monte Carlo walks through: validated layers and ambient indices.
+//! The one description of a layered medium, shared by every transport method: each layer's σa,
+//! σs (and σs'), Henyey–Greenstein g, index n and thickness, with the ambient indices above and
+//! below. Diffusion ([`crate::Stack::from_medium`]), adding-doubling
+//! ([`crate::adding_doubling::solve`]) and the Monte Carlo ([`crate::montecarlo::run`]) all take a
+//! [`LayeredMedium`]; [`LayeredMedium::skin`] builds the two-layer skin from its parameters
+//! (docs/physics.md §1, §6). The default anisotropy, the σs'→σs conversion and the valid ranges
+//! live here and nowhere else.
 
 use crate::error::{MultipoleError, check_range};
 use skin_optics::{SkinParams, Wavelength};
@@ -8,14 +14,17 @@ pub const MAX_COEFFICIENT_PER_MM: f64 = 1.0e4;
 /// Largest accepted finite layer thickness, mm.
 pub const MAX_THICKNESS_MM: f64 = 1.0e3;
 
-/// Default Henyey–Greenstein anisotropy for skin (issue 4; typical of tissue): σs = σs' / (1 − g).
-pub const DEFAULT_SKIN_G: f64 = 0.9;
+/// Default Henyey–Greenstein anisotropy of skin layers, typical of tissue ([Prahl95]; the seed
+/// gives only σs'): σs = σs' / (1 − g).
+pub const DEFAULT_G: f64 = 0.9;
 
 /// One homogeneous layer: σa, σs (mm⁻¹), HG anisotropy g, index n, thickness (mm, or semi-infinite).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Layer {
     sigma_a: f64,
     sigma_s: f64,
+    /// σs(1 − g) as given or derived: kept so that a layer built from σs' returns it unrounded.
+    sigma_s_prime: f64,
     g: f64,
     n: f64,
     thickness_mm: Option<f64>,
@@ -25,10 +34,18 @@ impl Layer {
     fn checked(
         sigma_a: f64,
         sigma_s: f64,
+        sigma_s_prime: f64,
         g: f64,
         n: f64,
         thickness_mm: Option<f64>,
     ) -> Result<Self, MultipoleError> {
+        if thickness_mm.is_none() && (sigma_a.is_nan() || sigma_a <= 0.0) {
+            return Err(MultipoleError::OutOfRange {
+                name: "absorption σa of a semi-infinite layer (mm⁻¹)",
+                value: sigma_a,
+                range: "(0, 1e4] mm⁻¹",
+            });
+        }
         let range = "[0, 1e4] mm⁻¹";
         check_range(
             "absorption σa (mm⁻¹)",
@@ -58,6 +75,7 @@ impl Layer {
         Ok(Self {
             sigma_a,
             sigma_s,
+            sigma_s_prime,
             g,
             n,
             thickness_mm,
@@ -73,7 +91,14 @@ impl Layer {
         n: f64,
         thickness_mm: f64,
     ) -> Result<Self, MultipoleError> {
-        Self::checked(sigma_a, sigma_s, g, n, Some(thickness_mm))
+        Self::checked(
+            sigma_a,
+            sigma_s,
+            sigma_s * (1.0 - g),
+            g,
+            n,
+            Some(thickness_mm),
+        )
     }
 
     /// A semi-infinite layer (only as the last of a stack). It needs σa > 0: without absorption a
@@ -84,14 +109,7 @@ impl Layer {
         g: f64,
         n: f64,
     ) -> Result<Self, MultipoleError> {
-        if sigma_a.is_nan() || sigma_a <= 0.0 {
-            return Err(MultipoleError::OutOfRange {
-                name: "absorption σa of a semi-infinite layer (mm⁻¹)",
-                value: sigma_a,
-                range: "(0, 1e4] mm⁻¹",
-            });
-        }
-        Self::checked(sigma_a, sigma_s, g, n, None)
+        Self::checked(sigma_a, sigma_s, sigma_s * (1.0 - g), g, n, None)
     }
 
     /// A layer given by its reduced scattering σs' (mm⁻¹): σs = σs' / (1 − g).
@@ -105,10 +123,7 @@ impl Layer {
     ) -> Result<Self, MultipoleError> {
         check_range("anisotropy g", g, -0.999, 0.999, "[-0.999, 0.999]")?;
         let sigma_s = sigma_s_prime / (1.0 - g);
-        match thickness_mm {
-            Some(d) => Self::slab(sigma_a, sigma_s, g, n, d),
-            None => Self::semi_infinite(sigma_a, sigma_s, g, n),
-        }
+        Self::checked(sigma_a, sigma_s, sigma_s_prime, g, n, thickness_mm)
     }
 
     /// Absorption coefficient σa, mm⁻¹.
@@ -120,6 +135,11 @@ impl Layer {
     #[must_use]
     pub fn sigma_s(&self) -> f64 {
         self.sigma_s
+    }
+    /// Reduced scattering coefficient σs' = σs (1 − g), mm⁻¹ (what diffusion uses).
+    #[must_use]
+    pub fn sigma_s_prime(&self) -> f64 {
+        self.sigma_s_prime
     }
     /// Henyey–Greenstein anisotropy g (mean cosine of the scattering angle).
     #[must_use]
@@ -142,30 +162,41 @@ impl Layer {
         let t = self.sigma_a + self.sigma_s;
         if t > 0.0 { self.sigma_s / t } else { 0.0 }
     }
+    /// Optical thickness τ = (σa + σs) d, dimensionless (0 for a clear layer; infinite for a
+    /// semi-infinite one that attenuates).
+    #[must_use]
+    pub fn optical_thickness(&self) -> f64 {
+        let st = self.sigma_a + self.sigma_s;
+        if st == 0.0 {
+            0.0
+        } else {
+            st * self.thickness_mm.unwrap_or(f64::INFINITY)
+        }
+    }
 }
 
 /// Layers from the top (lit) face down, with the ambient indices above and below.
 #[derive(Debug, Clone, PartialEq)]
-pub struct LayerStack {
+pub struct LayeredMedium {
     layers: Vec<Layer>,
     n_above: f64,
     n_below: f64,
 }
 
-impl LayerStack {
+impl LayeredMedium {
     /// A stack of at least one layer; only the last may be semi-infinite (then `n_below` is unused).
     /// Ambient indices in [1, 3].
     pub fn new(layers: Vec<Layer>, n_above: f64, n_below: f64) -> Result<Self, MultipoleError> {
         check_range("ambient index above", n_above, 1.0, 3.0, "[1, 3]")?;
         check_range("ambient index below", n_below, 1.0, 3.0, "[1, 3]")?;
         if layers.is_empty() {
-            return Err(MultipoleError::McStack("no layers".into()));
+            return Err(MultipoleError::Layers("no layers".into()));
         }
         if let Some(i) = layers[..layers.len() - 1]
             .iter()
             .position(|l| l.thickness_mm.is_none())
         {
-            return Err(MultipoleError::McStack(format!(
+            return Err(MultipoleError::Layers(format!(
                 "layer {i} is semi-infinite but not the last of {}",
                 layers.len()
             )));
@@ -180,7 +211,7 @@ impl LayerStack {
     /// [DJ06] skin at one wavelength: an epidermis of the skin's thickness over a semi-infinite
     /// dermis, both of index `skin.eta()`, in air (n = 1). σa and σs' come from
     /// `SkinParams::coefficients` (eqs 1–6); σs = σs' / (1 − g) with HG anisotropy `g`
-    /// ([`DEFAULT_SKIN_G`] = 0.9 is the usual choice). The dermis is semi-infinite as in the model
+    /// ([`DEFAULT_G`] = 0.9 is the usual choice). The dermis is semi-infinite as in the model
     /// ([DJ05] stacks the epidermis slab on a dipole half-space).
     pub fn skin(skin: &SkinParams, lambda: Wavelength, g: f64) -> Result<Self, MultipoleError> {
         let c = skin.coefficients(lambda);
@@ -231,9 +262,9 @@ mod tests {
         assert!(Layer::semi_infinite(0.0, 1.0, 0.9, 1.4).is_err());
         let semi = Layer::semi_infinite(0.1, 1.0, 0.9, 1.4).unwrap();
         let slab = Layer::slab(0.1, 1.0, 0.9, 1.4, 1.0).unwrap();
-        assert!(LayerStack::new(vec![semi, slab], 1.0, 1.0).is_err());
-        assert!(LayerStack::new(vec![], 1.0, 1.0).is_err());
-        assert!(LayerStack::new(vec![slab, semi], 1.0, 1.0).is_ok());
+        assert!(LayeredMedium::new(vec![semi, slab], 1.0, 1.0).is_err());
+        assert!(LayeredMedium::new(vec![], 1.0, 1.0).is_err());
+        assert!(LayeredMedium::new(vec![slab, semi], 1.0, 1.0).is_ok());
     }
 
     #[test]

@@ -1,7 +1,9 @@
-//! Small dense square matrices (n ≤ 64) for adding-doubling: product, sum, and a linear solve.
+//! Small dense square matrices (n ≤ 64) for adding-doubling: products, sums, row and column
+//! scaling, LU solves with partial pivoting, and the Cholesky factorisation with its triangular
+//! solves that `modes` uses (the symmetric eigensolver is in `eigen`).
 //!
-//! Hand-written rather than a linear-algebra crate: the solver needs four operations on matrices of
-//! at most 64 × 64, and keeping them here keeps the hot loop visible and dependency-free.
+//! Hand-written rather than a linear-algebra crate: the matrices are at most 64 × 64, and keeping
+//! the kernels here keeps the hot loop visible and dependency-free.
 
 /// A dense square matrix of f64, row-major.
 #[derive(Debug, Clone, PartialEq)]

@@ -9,8 +9,8 @@ mod sampling;
 #[cfg(test)]
 mod tests;
 
-use super::stack::LayerStack;
 use super::tally::{BatchTally, RadialGrid};
+use crate::layered::LayeredMedium;
 use brdf::fresnel::dielectric_reflectance;
 use rand_distr::{Distribution, Exp1};
 use rand_xoshiro::Xoshiro256StarStar;
@@ -46,7 +46,7 @@ pub(crate) struct Medium {
 }
 
 impl Medium {
-    pub fn new(stack: &LayerStack) -> Self {
+    pub fn new(stack: &LayeredMedium) -> Self {
         let layers = stack.layers();
         let mut z = 0.0;
         let mut slabs = Vec::with_capacity(layers.len());

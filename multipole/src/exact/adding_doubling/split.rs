@@ -1,5 +1,5 @@
 //! Exact per-layer totals of the two-layer skin, for rescaling each diffusion layer before stacking
-//! (`crate::skin`, issue [exact]): the epidermis alone (air above, index matched below) seen from above
+//! (`crate::skin`): the epidermis alone (air above, index matched below) seen from above
 //! and from below, the semi-infinite dermis alone, and the whole stack, from one set of operators.
 //!
 //! Each layer's scalar is taken for the angular distribution that layer actually meets first in the
@@ -8,9 +8,9 @@
 
 use super::layer::Operator;
 use super::matrix::Mat;
-use super::{
-    AddingDoublingError, AddingDoublingOptions, build_layer, escape_through_top, skin_stack,
-};
+use super::{AddingDoublingError, AddingDoublingOptions, angles, build_layer, escape_through_top};
+use crate::error::MultipoleError;
+use crate::layered::LayeredMedium;
 use skin_optics::{SkinParams, Wavelength};
 
 /// Exact totals of each skin layer alone and of the stack (dimensionless, per unit flux entering
@@ -41,12 +41,13 @@ pub fn skin_layer_totals(
     skin: &SkinParams,
     lambda: Wavelength,
     options: &AddingDoublingOptions,
-) -> Result<LayerTotals, AddingDoublingError> {
-    let slab = skin_stack(skin, lambda, options)?;
-    let angles = slab.angles(options.quadrature_points());
+) -> Result<LayerTotals, MultipoleError> {
+    let medium = LayeredMedium::skin(skin, lambda, options.g())?;
+    let eta = skin.eta();
+    let angles = angles(&medium, eta, options.quadrature_points());
     let normal = angles.n() - 1;
-    let top = super::layer::interface(&angles, slab.eta, slab.n_above);
-    let layers = slab.layers();
+    let top = super::layer::interface(&angles, eta, medium.n_above());
+    let layers = medium.layers();
     let epidermis = build_layer(&angles, &layers[0])?;
     let dermis = build_layer(&angles, &layers[1])?;
     let entering = top.t_down[(normal, normal)];

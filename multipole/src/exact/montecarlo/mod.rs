@@ -1,5 +1,6 @@
 //! Monte Carlo photon transport in plane-parallel layers, the reference the diffusion model is judged
-//! against: MCML ([WJZ95] Wang, Jacques & Zheng 1995) with a modern generator.
+//! against: MCML ([WJZ95] Wang, Jacques & Zheng 1995) with a modern generator (docs/physics.md §11).
+//! The medium is a [`LayeredMedium`].
 //!
 //! - Layers: σa, σs (mm⁻¹), Henyey–Greenstein g, index n, thickness (the last may be semi-infinite);
 //!   ambient indices above and below; exact unpolarised Fresnel at every index mismatch
@@ -19,11 +20,10 @@
 //! The module depends only on `skin-optics`, `brdf::fresnel`, `rand`/`rand_xoshiro`/`rand_distr`
 //! (the ziggurat exponential) and `rayon`: it lives in `multipole` because `Method::Exact` profiles use it; `validation` compares with it.
 
-mod stack;
 mod tally;
 mod transport;
 
-pub use stack::{DEFAULT_SKIN_G, Layer, LayerStack, MAX_COEFFICIENT_PER_MM, MAX_THICKNESS_MM};
+pub use crate::layered::{DEFAULT_G, Layer, LayeredMedium};
 pub use tally::{Estimate, McResult, RadialGrid, RadialProfile};
 pub use transport::{ROULETTE_SURVIVAL, ROULETTE_THRESHOLD};
 
@@ -117,13 +117,13 @@ impl McOptions {
 
 /// Trace the stack with the options on the current rayon pool.
 #[must_use]
-pub fn run(stack: &LayerStack, opts: &McOptions) -> McResult {
+pub fn run(stack: &LayeredMedium, opts: &McOptions) -> McResult {
     run_with_progress(stack, opts, |_| {})
 }
 
 /// As [`run`], calling `on_batch(photons_in_batch)` after each finished batch (for progress bars).
 pub fn run_with_progress(
-    stack: &LayerStack,
+    stack: &LayeredMedium,
     opts: &McOptions,
     on_batch: impl Fn(u64) + Sync,
 ) -> McResult {

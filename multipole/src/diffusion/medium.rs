@@ -1,5 +1,5 @@
 //! A homogeneous scattering medium in the diffusion approximation: σa, σs' and the derived symbols
-//! of physics.md §2 ([JMLH01] §2, [DJ05] §2).
+//! of docs/physics.md §2 ([JMLH01] §2, [DJ05] §2).
 
 use crate::error::{MultipoleError, check_range};
 
@@ -124,7 +124,7 @@ pub fn pole_energy_within(z: f64, r: f64, sigma_tr: f64) -> f64 {
 }
 
 /// The 2D Fourier (order-0 Hankel) transform of the normalised pole kernel,
-/// ∫ 2πr kernel(z, r) J0(qr) dr / (2π) = sgn(z) e^(−|z| s), s = √(σtr² + q²) ([DJ05] §5; physics.md §5).
+/// ∫ 2πr kernel(z, r) J0(qr) dr / (2π) = sgn(z) e^(−|z| s), s = √(σtr² + q²) ([DJ05] §5; docs/physics.md §5).
 /// `sgn(0)` is +1: a source on the face transmits half its light as a delta.
 #[inline]
 #[must_use]

@@ -1,11 +1,11 @@
 //! Lanes change the order of draws, never the statistics.
 
 use super::*;
-use crate::montecarlo::tally::McResult;
-use crate::montecarlo::{Layer, batch_streams};
+use crate::exact::montecarlo::tally::McResult;
+use crate::exact::montecarlo::{Layer, batch_streams};
 
 /// Run `batches` × `per_batch` photons through `trace_lanes::<K>` with the module's batch streams.
-fn run_lanes<const K: usize>(stack: &LayerStack, seed: u64, per_batch: u64) -> McResult {
+fn run_lanes<const K: usize>(stack: &LayeredMedium, seed: u64, per_batch: u64) -> McResult {
     let medium = Medium::new(stack);
     let specular = medium.specular(stack.n_above());
     let grid = RadialGrid::default();
@@ -23,7 +23,7 @@ fn run_lanes<const K: usize>(stack: &LayerStack, seed: u64, per_batch: u64) -> M
 #[test]
 fn lanes_agree_with_one_photon_at_a_time() {
     // Two layers with a mismatch below (Fresnel both ways, transmission, absorption in each).
-    let stack = LayerStack::new(
+    let stack = LayeredMedium::new(
         vec![
             Layer::slab(1.0, 20.0, 0.8, 1.4, 0.2).unwrap(),
             Layer::slab(0.05, 10.0, 0.9, 1.4, 1.0).unwrap(),
@@ -62,19 +62,19 @@ fn lanes_agree_with_one_photon_at_a_time() {
 
 #[test]
 fn same_bits_on_one_and_two_threads() {
-    let stack = LayerStack::new(
+    let stack = LayeredMedium::new(
         vec![Layer::from_reduced(0.1, 1.0, 0.9, 1.4, None).unwrap()],
         1.0,
         1.0,
     )
     .unwrap();
-    let opts = crate::montecarlo::McOptions::new(2000, 8, 5).unwrap();
+    let opts = crate::exact::montecarlo::McOptions::new(2000, 8, 5).unwrap();
     let on = |threads| {
         rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
             .build()
             .unwrap()
-            .install(|| crate::montecarlo::run(&stack, &opts))
+            .install(|| crate::exact::montecarlo::run(&stack, &opts))
     };
     let (a, b) = (on(1), on(2));
     assert_eq!(a, b);

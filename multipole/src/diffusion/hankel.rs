@@ -1,4 +1,4 @@
-//! The inverse order-0 Hankel transform f(r) = (1/2π) ∫₀^∞ F(q) J0(qr) q dq (physics.md §5).
+//! The inverse order-0 Hankel transform f(r) = (1/2π) ∫₀^∞ F(q) J0(qr) q dq (docs/physics.md §5).
 //!
 //! Method (chosen for speed with a measured error; see `ProfileOptions` and `skin::profile_error`):
 //! only the *remainder* of a stack's spectrum is inverted numerically; the slowest-decaying part (the
@@ -28,40 +28,10 @@ pub struct HankelTable {
     kernel: Vec<f64>,
 }
 
-/// Gauss–Legendre nodes and weights on [−1, 1] (Newton on the Legendre recurrence, to 1e-15).
+/// Gauss–Legendre nodes and weights on [−1, 1] ([`brdf::quadrature::unit_gauss`], nodes descending).
 #[must_use]
 pub fn gauss_legendre(n: usize) -> (Vec<f64>, Vec<f64>) {
-    let mut x = vec![0.0; n];
-    let mut w = vec![0.0; n];
-    for i in 0..n {
-        let mut z = (PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
-        let mut dp = 1.0;
-        for _ in 0..100 {
-            let (mut p0, mut p1) = (1.0, z);
-            for k in 2..=n {
-                let p2 = ((2 * k - 1) as f64 * z * p1 - (k - 1) as f64 * p0) / k as f64;
-                p0 = p1;
-                p1 = p2;
-            }
-            let p = if n == 0 {
-                1.0
-            } else if n == 1 {
-                z
-            } else {
-                p1
-            };
-            let pm1 = if n == 1 { 1.0 } else { p0 };
-            dp = n as f64 * (z * p - pm1) / (z * z - 1.0);
-            let dz = p / dp;
-            z -= dz;
-            if dz.abs() < 1e-16 {
-                break;
-            }
-        }
-        x[i] = z;
-        w[i] = 2.0 / ((1.0 - z * z) * dp * dp);
-    }
-    (x, w)
+    brdf::quadrature::unit_gauss(n).into_iter().unzip()
 }
 
 impl HankelTable {

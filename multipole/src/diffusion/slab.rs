@@ -1,6 +1,6 @@
 //! The multipole: reflectance and transmittance of a slab of thickness d with independent boundary
-//! conditions on its lit (top) and far (bottom) faces ([DJ05] §3; physics.md §4), in space and in the
-//! frequency domain (physics.md §5), with the pole count as a knob.
+//! conditions on its lit (top) and far (bottom) faces ([DJ05] §3; docs/physics.md §4), in space and in the
+//! frequency domain (docs/physics.md §5), with the pole count as a knob.
 //!
 //! Poles: z_r,i = iL + z0 and z_v,i = iL − z0 − 2 z_b0 for i = −n…n, with period L = 2(d + z_b0 + z_bd).
 //! In the frequency domain every pole is sgn(z) e^(−|z| s), s = √(σtr² + q²); the sums over i are
@@ -8,7 +8,7 @@
 //!
 //! # Thin slabs
 //! The multipole puts its real source at z0 = ℓ = 1/σt'. When d < ℓ that source lies outside the slab
-//! and R or T turn negative (physics.md §4). This crate's documented behaviour:
+//! and R or T turn negative (docs/physics.md §4). This crate's documented behaviour:
 //! * a fraction w = min(1, σs' d) (the reduced scattering optical depth, ≈ the probability to scatter
 //!   at all) is diffused; the rest is transmitted as a delta at r = 0 attenuated by e^(−σa d), with no
 //!   reflection;
@@ -30,9 +30,9 @@
 //! Public code blends toward a transmitted delta below two mean free paths;
 //! this crate blends only where the multipole itself is not valid.
 
-use crate::boundary::a_coefficient;
+use crate::diffusion::boundary::a_coefficient;
+use crate::diffusion::medium::{Medium, pole_kernel, pole_transform};
 use crate::error::{MultipoleError, check_range};
-use crate::medium::{Medium, pole_kernel, pole_transform};
 use std::f64::consts::PI;
 
 /// Number of dipole pairs in a multipole sum: the accuracy knob of [DJ05].
@@ -226,7 +226,7 @@ impl Slab {
         sum
     }
 
-    /// Diffuse reflectance R(r) at `r_mm`, mm⁻² ([DJ05] eq. 8; physics.md §4).
+    /// Diffuse reflectance R(r) at `r_mm`, mm⁻² ([DJ05] eq. 8; docs/physics.md §4).
     #[must_use]
     pub fn reflectance_mm2(&self, r_mm: f64, poles: Poles) -> f64 {
         let s = self.medium.sigma_tr();
@@ -237,7 +237,7 @@ impl Slab {
         self.prefactor() / (4.0 * PI) * sum
     }
 
-    /// Diffuse transmittance T(r) at `r_mm` on the far face, mm⁻² ([DJ05] eq. 9; physics.md §4),
+    /// Diffuse transmittance T(r) at `r_mm` on the far face, mm⁻² ([DJ05] eq. 9; docs/physics.md §4),
     /// without the delta at r = 0 ([`Slab::transmitted_delta`]).
     #[must_use]
     pub fn transmittance_mm2(&self, r_mm: f64, poles: Poles) -> f64 {
@@ -269,7 +269,7 @@ impl Slab {
     }
 
     /// Order-0 Hankel transforms (R̂(q), T̂(q)) at spatial frequency `q` (rad/mm), dimensionless
-    /// (physics.md §5); T̂ includes the transmitted delta. At q = 0 these are the totals.
+    /// (docs/physics.md §5); T̂ includes the transmitted delta. At q = 0 these are the totals.
     #[must_use]
     pub fn transform(&self, q: f64, poles: Poles) -> (f64, f64) {
         let st = self.medium.sigma_tr();

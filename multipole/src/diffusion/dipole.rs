@@ -1,10 +1,10 @@
-//! The dipole: diffuse reflectance of a semi-infinite medium ([JMLH01]; physics.md §3).
+//! The dipole: diffuse reflectance of a semi-infinite medium ([JMLH01]; docs/physics.md §3).
 //!
 //! Real source at depth z_r = ℓ, virtual source at z_v = −(ℓ + 2 z_b) (z into the medium).
 
-use crate::boundary::a_coefficient;
+use crate::diffusion::boundary::a_coefficient;
+use crate::diffusion::medium::{Medium, pole_energy_within, pole_kernel, pole_transform};
 use crate::error::{MultipoleError, check_range};
-use crate::medium::{Medium, pole_energy_within, pole_kernel, pole_transform};
 use std::f64::consts::PI;
 
 /// A semi-infinite medium under a face of relative index η (= n_medium / n_outside).
@@ -68,7 +68,7 @@ impl Dipole {
             * (pole_kernel(self.z_r, r_mm, s) - pole_kernel(self.z_v, r_mm, s))
     }
 
-    /// Total diffuse reflectance, closed form, dimensionless (physics.md §3):
+    /// Total diffuse reflectance, closed form, dimensionless (docs/physics.md §3):
     /// (α'/2)(1 + e^(−(4/3) A √(3(1−α')))) e^(−√(3(1−α'))).
     #[must_use]
     pub fn total_reflectance(&self) -> f64 {
@@ -121,7 +121,7 @@ impl Dipole {
     }
 
     /// Order-0 Hankel transform R̂(q) at spatial frequency `q` (rad/mm), dimensionless
-    /// (physics.md §5): (α'/2)(e^(−z_r s) + e^(−|z_v| s)), s = √(σtr² + q²). R̂(0) = the closed-form total.
+    /// (docs/physics.md §5): (α'/2)(e^(−z_r s) + e^(−|z_v| s)), s = √(σtr² + q²). R̂(0) = the closed-form total.
     #[must_use]
     pub fn transform(&self, q: f64) -> f64 {
         let st = self.medium.sigma_tr();
@@ -142,7 +142,7 @@ mod tests {
 
     #[test]
     fn closed_form_totals_match_physics_md() {
-        // physics.md §3 check values, η = 1.4.
+        // docs/physics.md §3 check values, η = 1.4.
         for (sa, expect) in [(0.01, 0.61410), (0.1, 0.29767), (1.0, 0.07382)] {
             let d = dipole(sa, 1.0);
             assert_relative_eq!(d.total_reflectance(), expect, max_relative = 1e-4);
@@ -162,7 +162,8 @@ mod tests {
 
     #[test]
     fn integral_of_profile_matches_closed_form_total() {
-        // Trapezoid of 2π r² R(r) in ln r from 1e-5 mm to the 99.9999% radius: within 0.5% (issue 3).
+        // Trapezoid of 2π r² R(r) in ln r from 1e-5 mm to the 99.9999% radius: within 0.5%
+        // (the truncated tails and the trapezoid error are each far below that).
         for sa in [0.01, 0.1, 1.0] {
             let d = dipole(sa, 1.0);
             let r_hi = d.radius_for_energy(0.999_999);

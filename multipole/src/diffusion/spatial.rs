@@ -6,17 +6,17 @@
 //! decays fast in q. The outer radius is where the cumulative energy — closed form for the head,
 //! trapezoid over the inverted remainder — reaches `energy_fraction` of the total.
 
-use crate::dipole::Dipole;
+use crate::diffusion::dipole::Dipole;
+use crate::diffusion::hankel::{HankelTable, Pchip, frequency_cutoff};
+use crate::diffusion::medium::pole_energy_within;
+use crate::diffusion::profile::Profile;
+use crate::diffusion::slab::Poles;
+use crate::diffusion::stack::{DiffusionLayer, Stack};
 use crate::error::{MultipoleError, check_range};
-use crate::hankel::{HankelTable, Pchip, frequency_cutoff};
-use crate::medium::pole_energy_within;
-use crate::profile::Profile;
 use crate::skin::ExactShape;
-use crate::slab::Poles;
-use crate::stack::{Layer, Stack};
 use std::f64::consts::PI;
 
-/// Smallest table radius, mm (physics.md §8: from about 1e-3 mm).
+/// Smallest table radius, mm (docs/physics.md §8: from about 1e-3 mm).
 pub const R_MIN_MM: f64 = 1e-3;
 
 /// Knobs of a profile computation; every approximation here has one.
@@ -149,7 +149,9 @@ impl Remainder {
     fn compute(stack: &Stack, opts: &ProfileOptions, window: f64) -> Self {
         let table = HankelTable::shared(opts.transform_nodes, opts.transform_radii);
         let radii: Vec<f64> = table.unit_radii().iter().map(|x| x * window).collect();
-        let values = if stack.layers().len() == 1 && matches!(stack.top(), Layer::SemiInfinite(_)) {
+        let values = if stack.layers().len() == 1
+            && matches!(stack.top(), DiffusionLayer::SemiInfinite(_))
+        {
             // A lone dipole is entirely closed form: nothing to invert.
             vec![0.0; radii.len()]
         } else {
@@ -193,7 +195,7 @@ impl Remainder {
 fn head_cumulative(stack: &Stack, r: f64) -> f64 {
     stack.head_scale()
         * match stack.top() {
-            Layer::Slab(s) => {
+            DiffusionLayer::Slab(s) => {
                 let st = s.medium().sigma_tr();
                 let z0 = s.source_depth_mm();
                 let zv = -z0 - 2.0 * s.medium().extrapolation_mm(s.a_boundaries().0);
@@ -201,7 +203,7 @@ fn head_cumulative(stack: &Stack, r: f64) -> f64 {
                     * s.medium().albedo_prime()
                     * (pole_energy_within(z0, r, st) - pole_energy_within(zv, r, st))
             }
-            Layer::SemiInfinite(d) => d.reflectance_within(r),
+            DiffusionLayer::SemiInfinite(d) => d.reflectance_within(r),
         }
 }
 
@@ -280,7 +282,7 @@ pub fn reference_reflectance(stack: &Stack, poles: Poles, radii_mm: &[f64]) -> V
     let r_hi = radii_mm.iter().copied().fold(1.0, f64::max);
     let f = |q: f64| stack.reflectance_transform(q, poles) - stack.head_transform(q);
     let q_max = frequency_cutoff(f, 0.1 / r_hi, 1e5, 1e-14);
-    let (gx, gw) = crate::hankel::gauss_legendre(16);
+    let (gx, gw) = crate::diffusion::hankel::gauss_legendre(16);
     let h = PI / r_hi;
     let panels = (q_max / h).ceil() as usize;
     let mut nodes = Vec::with_capacity(panels * 16);
@@ -307,14 +309,18 @@ mod tests {
     fn skin_like(sa_epi: f64, sa_derm: f64) -> Stack {
         let epi = Slab::new(Medium::new(sa_epi, 5.3).unwrap(), 0.25, 1.4, 1.0).unwrap();
         let derm = Dipole::new(Medium::new(sa_derm, 5.3).unwrap(), 1.0).unwrap();
-        Stack::new(vec![Layer::Slab(epi), Layer::SemiInfinite(derm)]).unwrap()
+        Stack::new(vec![
+            DiffusionLayer::Slab(epi),
+            DiffusionLayer::SemiInfinite(derm),
+        ])
+        .unwrap()
     }
 
     #[test]
     fn lone_dipole_profile_is_the_closed_form() {
         let d = Dipole::new(Medium::new(0.1, 1.0).unwrap(), 1.4).unwrap();
         let p = stack_profile(
-            &Stack::new(vec![Layer::SemiInfinite(d)]).unwrap(),
+            &Stack::new(vec![DiffusionLayer::SemiInfinite(d)]).unwrap(),
             &ProfileOptions::default(),
         )
         .unwrap();

@@ -31,7 +31,7 @@ pub fn a_coefficient(eta: f64) -> f64 {
 }
 
 /// The observable diffuse reflectance per unit *incident* flux at normal incidence, specular excluded:
-/// (1 − F_r(0)) R_d, from the model's R_d per unit flux *entering* ([DJ06]; physics.md §1).
+/// (1 − F_r(0)) R_d, from the model's R_d per unit flux *entering* ([DJ06]; docs/physics.md §1).
 /// F_r(0) comes from the exact Fresnel law in `brdf::fresnel` (0.0278 at η = 1.4).
 #[must_use]
 pub fn observable_reflectance(model_total: f64, eta: f64) -> f64 {
@@ -45,14 +45,14 @@ mod tests {
 
     #[test]
     fn a_at_skin_index_matches_physics_md() {
-        // physics.md §2: A(1.4) = 3.2507.
+        // docs/physics.md §2: A(1.4) = 3.2507.
         assert_relative_eq!(a_coefficient(1.4), 3.2507, max_relative = 2e-5);
     }
 
     #[test]
     fn matched_face_has_a_exactly_one() {
         assert_eq!(a_coefficient(1.0), 1.0);
-        // The fit itself is slightly off at 1 (physics.md §2: 0.0016).
+        // The fit itself is slightly off at 1 (docs/physics.md §2: 0.0016).
         assert_relative_eq!(fresnel_diffuse_reflectance(1.0), 0.0016, epsilon = 1e-4);
     }
 
