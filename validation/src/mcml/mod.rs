@@ -1,6 +1,6 @@
 //! MCML 1.2 ([WJZ95] Wang, Jacques & Zheng 1995, the original C program) as an independent check of
 //! the layered Monte Carlo (`multipole::montecarlo`, docs/physics.md §11): the cases compared, their
-//! MCML input (`.mci`) written from the same [`LayerStack`] our code builds, MCML's ASCII output
+//! MCML input (`.mci`) written from the same [`LayeredMedium`] our code builds, MCML's ASCII output
 //! (`.mco`) read back, and the reference data committed under `validation/data/mcml/`.
 //!
 //! MCML works in cm and cm⁻¹, scores R_d(r) in annuli of width dr from r = 0 with the last annulus
@@ -19,7 +19,7 @@ pub use output::{McmlOutput, parse_mco};
 pub use process::{McmlProcess, run_mcml, thread_cpu_seconds};
 pub use reference::ReferenceData;
 
-use crate::montecarlo::{DEFAULT_SKIN_G, Layer, LayerStack, McResult, RadialGrid};
+use crate::montecarlo::{DEFAULT_G, Layer, LayeredMedium, McResult, RadialGrid};
 use multipole::MultipoleError;
 use skin_optics::{Preset, SkinParams, Wavelength};
 use std::fmt::Write as _;
@@ -66,23 +66,23 @@ pub struct Case {
     /// What it is, for tables.
     pub description: &'static str,
     /// The layers as MCML and our Monte Carlo both trace them.
-    pub stack: LayerStack,
+    pub stack: LayeredMedium,
 }
 
-/// The reference cases: [DJ06] skin (`LayerStack::skin`, g = 0.9, n = 1.4 in air) for the light
+/// The reference cases: [DJ06] skin (`LayeredMedium::skin`, g = 0.9, n = 1.4 in air) for the light
 /// preset at 450/550/650 nm and the dark preset at 450/650 nm, and a homogeneous half-space
 /// (σa 0.01, σs' 1 mm⁻¹, g 0.9, n 1.4), each dermis or half-space [`HALF_SPACE_DEPTH_MM`] deep.
 pub fn cases() -> Result<Vec<Case>, McmlError> {
-    let skin = |preset, nm| -> Result<LayerStack, McmlError> {
+    let skin = |preset, nm| -> Result<LayeredMedium, McmlError> {
         let lambda = Wavelength::new(nm).map_err(|e| McmlError::Output(e.to_string()))?;
-        Ok(finite(&LayerStack::skin(
+        Ok(finite(&LayeredMedium::skin(
             &SkinParams::preset(preset),
             lambda,
-            DEFAULT_SKIN_G,
+            DEFAULT_G,
         )?)?)
     };
-    let half_space = LayerStack::new(
-        vec![Layer::from_reduced(0.01, 1.0, DEFAULT_SKIN_G, 1.4, None)?],
+    let half_space = LayeredMedium::new(
+        vec![Layer::from_reduced(0.01, 1.0, DEFAULT_G, 1.4, None)?],
         1.0,
         1.0,
     )?;
@@ -121,7 +121,7 @@ pub fn case(name: &str) -> Result<Case, McmlError> {
 
 /// `stack` with a semi-infinite last layer made [`HALF_SPACE_DEPTH_MM`] thick (MCML has no
 /// semi-infinite layers).
-pub fn finite(stack: &LayerStack) -> Result<LayerStack, MultipoleError> {
+pub fn finite(stack: &LayeredMedium) -> Result<LayeredMedium, MultipoleError> {
     let layers = stack
         .layers()
         .iter()
@@ -135,7 +135,7 @@ pub fn finite(stack: &LayerStack) -> Result<LayerStack, MultipoleError> {
             )
         })
         .collect::<Result<Vec<_>, _>>()?;
-    LayerStack::new(layers, stack.n_above(), stack.n_below())
+    LayeredMedium::new(layers, stack.n_above(), stack.n_below())
 }
 
 /// One run of an `.mci` file: the output file MCML writes and the photons it traces.
@@ -151,7 +151,7 @@ pub struct McmlRun {
 /// [`DZ_MM`] × [`NZ`] depths, one exit angle), with `comment` lines (ASCII: MCML rejects other
 /// bytes) at the top. Lengths are written in cm and coefficients in cm⁻¹ (MCML's units), shortest
 /// round-trip decimals.
-pub fn mci(stack: &LayerStack, runs: &[McmlRun], comment: &str) -> Result<String, McmlError> {
+pub fn mci(stack: &LayeredMedium, runs: &[McmlRun], comment: &str) -> Result<String, McmlError> {
     if !comment.is_ascii() {
         return Err(McmlError::Output(format!(
             "MCML input comments must be ASCII: '{comment}'"
