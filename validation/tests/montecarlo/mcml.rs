@@ -37,8 +37,9 @@ const Z_MAX: f64 = 4.64;
 /// differ by up to 0.9% in the epidermis of light skin (ours higher: +0.24%, +0.72%, +0.88% at 450,
 /// 550, 650 nm, z = 2.6, 7.4, 9.9 with 10⁶ photons of ours, `cargo run --release -p validation
 /// --example mcml_agreement`), unresolved; adding-doubling's R_d there (0.4095, 0.4367, 0.6077)
-/// sides with ours (0.4099, 0.4365, 0.6075) rather than MCML's (0.4090, 0.4370, 0.6091). Dark skin
-/// and the half-space agree within their errors.
+/// sides with ours (0.4099, 0.4365, 0.6075) rather than MCML's (0.4090, 0.4370, 0.6091), as for
+/// the bias of MCML's `ran3` on two-layer totals (`determinism.rs`). Dark skin and the half-space
+/// agree within their errors.
 const LAYER_DISCREPANCY: f64 = 0.01;
 /// Least of our escaping photons (≈ weight sum) per compared group.
 const MIN_ESCAPES: f64 = 200.0;
