@@ -64,6 +64,10 @@ mod tests {
         assert!(shown.ends_with("… (10485760 characters)"), "{shown}");
         assert_eq!(Text("light").to_string(), "light");
         // Cut on a character boundary.
-        assert!(Text(&"é".repeat(100)).to_string().starts_with(&"é".repeat(40)));
+        assert!(
+            Text(&"é".repeat(100))
+                .to_string()
+                .starts_with(&"é".repeat(40))
+        );
     }
 }

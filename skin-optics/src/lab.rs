@@ -104,7 +104,9 @@ impl Lab {
     /// of jumping between ±90°. No colour with b* ≥ [`ITA_MIN_B`] is affected.
     #[must_use]
     pub fn ita_deg(self) -> f64 {
-        ((self.l - 50.0) / self.b.max(ITA_MIN_B)).atan().to_degrees()
+        ((self.l - 50.0) / self.b.max(ITA_MIN_B))
+            .atan()
+            .to_degrees()
     }
 
     /// The skin-colour category of [`Lab::ita_deg`].
