@@ -83,10 +83,7 @@ impl Texture {
             if h.chunk_count > MAX_EXR_CHUNKS {
                 return Err(image_err(
                     path,
-                    format!(
-                        "{} chunks, over the cap of {MAX_EXR_CHUNKS}",
-                        h.chunk_count
-                    ),
+                    format!("{} chunks, over the cap of {MAX_EXR_CHUNKS}", h.chunk_count),
                 ));
             }
         }
@@ -201,7 +198,10 @@ fn decode_jpeg(bytes: &[u8], path: &Path) -> Result<(usize, usize, Vec<u8>), Ren
         .decode()
         .map_err(|e| image_err(path, format!("JPEG: {e}")))?;
     if rgb.len() != width * height * 3 {
-        return Err(image_err(path, "JPEG decoded to the wrong number of pixels"));
+        return Err(image_err(
+            path,
+            "JPEG decoded to the wrong number of pixels",
+        ));
     }
     Ok((width, height, rgb))
 }
@@ -271,7 +271,10 @@ mod tests {
         let e = Texture::from_exr_bytes(&exr_bytes(0.5, 99_999, 99_999), Path::new("e.exr"))
             .unwrap_err()
             .to_string();
-        assert!(e.contains("100000×100000") && e.contains(&MAX_TEXELS.to_string()), "{e}");
+        assert!(
+            e.contains("100000×100000") && e.contains(&MAX_TEXELS.to_string()),
+            "{e}"
+        );
     }
 
     #[test]
@@ -295,7 +298,9 @@ mod tests {
 
     #[test]
     fn image_size_cap_is_named_in_the_error() {
-        let e = check_size(MAX_SIDE + 1, 1, Path::new("t.png")).unwrap_err().to_string();
+        let e = check_size(MAX_SIDE + 1, 1, Path::new("t.png"))
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("16384"), "{e}");
         assert!(check_size(8192, 4096, Path::new("t.png")).is_ok());
         assert!(check_size(8192, 4097, Path::new("t.png")).is_err());
