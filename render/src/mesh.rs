@@ -191,6 +191,7 @@ impl TriangleMesh {
                     if prim.mode() != gltf::mesh::Mode::Triangles {
                         continue;
                     }
+                    check_accessor_types(&prim, path)?;
                     // Counts declared by the accessors, checked before anything is read.
                     let vertices = prim
                         .get(&gltf::Semantic::Positions)
@@ -418,6 +419,56 @@ pub fn glb_container(json: &str, bin: &[u8]) -> Vec<u8> {
         out.resize(total, 0);
     }
     out
+}
+
+/// Refuse accessors whose component type or shape the glTF spec does not allow for their
+/// attribute (the `gltf` readers assume them and would panic otherwise).
+fn check_accessor_types(prim: &gltf::Primitive, path: &Path) -> Result<(), RenderError> {
+    use gltf::Semantic;
+    use gltf::accessor::{DataType, Dimensions};
+    let ok = |a: &gltf::Accessor, types: &[DataType], dims: Dimensions| {
+        types.contains(&a.data_type()) && a.dimensions() == dims
+    };
+    for (semantic, a) in prim.attributes() {
+        let fine = match semantic {
+            Semantic::Positions | Semantic::Normals => ok(&a, &[DataType::F32], Dimensions::Vec3),
+            Semantic::TexCoords(_) => ok(
+                &a,
+                &[DataType::F32, DataType::U8, DataType::U16],
+                Dimensions::Vec2,
+            ),
+            _ => true,
+        };
+        if !fine {
+            return Err(RenderError::Mesh {
+                path: path.to_path_buf(),
+                message: format!(
+                    "accessor {} of {semantic:?} has type {:?} {:?}, which glTF does not allow there",
+                    a.index(),
+                    a.data_type(),
+                    a.dimensions()
+                ),
+            });
+        }
+    }
+    if let Some(a) = prim.indices()
+        && !ok(
+            &a,
+            &[DataType::U8, DataType::U16, DataType::U32],
+            Dimensions::Scalar,
+        )
+    {
+        return Err(RenderError::Mesh {
+            path: path.to_path_buf(),
+            message: format!(
+                "index accessor {} has type {:?} {:?}; indices are unsigned scalars",
+                a.index(),
+                a.data_type(),
+                a.dimensions()
+            ),
+        });
+    }
+    Ok(())
 }
 
 /// Refuse more than [`MAX_VERTICES`] vertices or [`MAX_TRIANGLES`] triangles.

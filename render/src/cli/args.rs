@@ -45,7 +45,7 @@ pub fn parse_number(s: &str, range: &str) -> Result<f64, String> {
 /// Parse a whole number in [`lo`, `hi`]; `range` is how the help spells the interval.
 pub fn parse_whole(s: &str, lo: u64, hi: u64, range: &str) -> Result<u64, String> {
     let v = parse_number(s, range)?;
-    if !(v >= lo as f64 && v <= hi as f64 && v.fract() == 0.0) {
+    if !((lo as f64..=hi as f64).contains(&v) && v.fract() == 0.0) {
         return Err(format!("{} outside {range} (a whole number)", Num(v)));
     }
     Ok(v as u64)

@@ -69,7 +69,7 @@ fn parse_method(s: &str) -> Result<Method, String> {
 fn parse_step(s: &str) -> Result<f64, String> {
     let v = parse_number(s, "[0.01, 100] nm")?;
     // The lower bound is the finest wavelength grid the colour model accepts.
-    if !(v >= WavelengthGrid::MIN_STEP_NM && v <= 100.0) {
+    if !(WavelengthGrid::MIN_STEP_NM..=100.0).contains(&v) {
         return Err(format!("{} outside [0.01, 100] nm", Num(v)));
     }
     Ok(v)

@@ -131,3 +131,19 @@ fn obj_with_non_finite_texture_coordinates_is_refused() {
     let r = TriangleMesh::from_obj(obj, Path::new("t.obj"));
     assert!(r.is_err(), "{r:?}");
 }
+
+#[test]
+fn glb_with_float_indices_is_refused() {
+    // componentType 5126 (f32) for indices reached an `unreachable!()` in the gltf reader.
+    let bytes = glb(r#"[{"mesh":0}]"#, "[0]", [0, 1, 2], 3);
+    let json_len = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
+    let json = std::str::from_utf8(&bytes[20..20 + json_len]).unwrap();
+    let bin_start = 20 + json_len + 8;
+    let patched = json.replace(r#""componentType":5123"#, r#""componentType":5126"#);
+    let e = load(&glb_container(
+        patched.trim_end(),
+        &bytes[bin_start..bin_start + 42],
+    ))
+    .unwrap_err();
+    assert!(e.contains("indices are unsigned scalars"), "{e}");
+}
