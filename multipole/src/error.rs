@@ -7,7 +7,7 @@ use thiserror::Error;
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum MultipoleError {
     /// A physical parameter (coefficient, thickness, index, radius) is NaN, infinite or out of range.
-    #[error("{name} = {value} outside {range}")]
+    #[error("{name} = {} outside {range}", skin_optics::echo::Num(*.value))]
     OutOfRange {
         /// Parameter name with its symbol and unit, e.g. `"σa (mm⁻¹)"`.
         name: &'static str,
@@ -17,7 +17,7 @@ pub enum MultipoleError {
         range: &'static str,
     },
     /// A numerical knob (`ProfileOptions`) is out of range.
-    #[error("option {name} = {value} outside {range}")]
+    #[error("option {name} = {} outside {range}", skin_optics::echo::Num(*.value))]
     InvalidOption {
         /// Knob name, e.g. `"radial_samples"`.
         name: &'static str,

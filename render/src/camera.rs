@@ -1,6 +1,7 @@
 //! A perspective camera with an optional thin lens (depth of field), in scene millimetres.
 
 use crate::error::RenderError;
+use crate::geometry::{MAX_COORD_MM, unit_vector, within_scene};
 use glam::{Vec2, Vec3};
 
 /// A validated perspective camera.
@@ -34,24 +35,33 @@ impl Camera {
             value,
             range,
         };
+        for (name, p) in [
+            ("camera.position_mm", position_mm),
+            ("camera.look_at_mm", look_at_mm),
+        ] {
+            if !within_scene(p) {
+                return Err(bad(name, format!("{p}"), "points within ±1e9 mm"));
+            }
+        }
         let to = look_at_mm - position_mm;
-        if !to.is_finite() || to.length() <= 0.0 {
+        let Some(forward) = unit_vector(to) else {
             return Err(bad(
                 "camera.look_at_mm",
                 format!("{look_at_mm}"),
                 "a finite point different from camera.position_mm",
             ));
-        }
-        let forward = to.normalize();
-        let right = forward.cross(up);
-        if !right.is_finite() || right.length() < 1e-6 {
-            return Err(bad(
-                "camera.up",
-                format!("{up}"),
-                "a finite direction not parallel to the view",
-            ));
-        }
-        let right = right.normalize();
+        };
+        let right = unit_vector(up)
+            .map(|u| forward.cross(u))
+            .filter(|r| r.length() >= 1e-6)
+            .ok_or_else(|| {
+                bad(
+                    "camera.up",
+                    format!("{up}"),
+                    "a finite direction not parallel to the view",
+                )
+            })?
+            .normalize();
         if !(fov_deg > 0.0 && fov_deg < 180.0) {
             return Err(bad(
                 "camera.fov_deg",
@@ -67,11 +77,11 @@ impl Camera {
             ));
         }
         let focus = focus_distance_mm.unwrap_or(to.length());
-        if !(focus.is_finite() && focus > 0.0) {
+        if !(focus.is_finite() && focus > 0.0 && focus <= 2.0 * MAX_COORD_MM) {
             return Err(bad(
                 "camera.focus_distance_mm",
                 focus.to_string(),
-                "(0, ∞) mm",
+                "(0, 2e9] mm",
             ));
         }
         Ok(Self {
@@ -131,6 +141,49 @@ mod tests {
         // Top edge of a 90° vertical fov is 45° up.
         let (_, d) = c.generate_ray(Vec2::new(0.5, 0.0), 1.0, Vec2::ZERO);
         assert!((d.y - std::f32::consts::FRAC_1_SQRT_2).abs() < 1e-5, "{d}");
+    }
+
+    fn error_key(r: Result<Camera, RenderError>) -> &'static str {
+        match r {
+            Err(RenderError::Setting { name, .. }) => name,
+            other => panic!("expected a setting error, got {other:?}"),
+        }
+    }
+
+    #[test]
+    fn camera_position_that_overflows_is_blamed_on_the_position_not_up() {
+        let r = Camera::new(
+            Vec3::new(3e38, 0.0, 0.0),
+            Vec3::ZERO,
+            Vec3::Y,
+            40.0,
+            0.0,
+            None,
+        );
+        assert_eq!(error_key(r), "camera.position_mm");
+        let r = Camera::new(Vec3::Z, Vec3::splat(-3e38), Vec3::Y, 40.0, 0.0, None);
+        assert_eq!(error_key(r), "camera.look_at_mm");
+    }
+
+    #[test]
+    fn focus_distance_3e38_is_refused() {
+        let r = Camera::new(Vec3::Z * 100.0, Vec3::ZERO, Vec3::Y, 40.0, 5.0, Some(3e38));
+        assert_eq!(error_key(r), "camera.focus_distance_mm");
+    }
+
+    #[test]
+    fn an_up_vector_of_3e38_normalises() {
+        // Its squared length overflows f32; as a direction it is plain +Y.
+        let big = Camera::new(
+            Vec3::Z,
+            Vec3::ZERO,
+            Vec3::new(0.0, 3e38, 0.0),
+            40.0,
+            0.0,
+            None,
+        );
+        let unit = Camera::new(Vec3::Z, Vec3::ZERO, Vec3::Y, 40.0, 0.0, None);
+        assert_eq!(big.unwrap(), unit.unwrap());
     }
 
     #[test]

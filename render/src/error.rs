@@ -34,6 +34,16 @@ pub enum RenderError {
         /// The underlying I/O error.
         source: std::io::Error,
     },
+    /// An input file refused before reading: wrong extension, not a regular file, or over its cap.
+    #[error("{what} file {path}: {message}")]
+    Input {
+        /// What the file is for ("mesh", "texture", "environment map", "scene", "spectrum").
+        what: &'static str,
+        /// The path as given.
+        path: PathBuf,
+        /// Why it was refused, with the limit.
+        message: String,
+    },
     /// A mesh file could be read but not decoded.
     #[error("mesh {path}: {message}")]
     Mesh {

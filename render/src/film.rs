@@ -3,16 +3,30 @@
 
 use crate::atomic;
 use crate::error::RenderError;
-use crate::spectrum::xyz_to_linear_srgb;
+use std::collections::BTreeMap;
 use std::path::Path;
 
+/// `v` as f32, saturating at ±`f32::MAX` (a finite f64 may exceed f32's range).
+fn to_finite_f32(v: f64) -> f32 {
+    if v.is_nan() {
+        0.0
+    } else {
+        v.clamp(-f64::from(f32::MAX), f64::from(f32::MAX)) as f32
+    }
+}
+
 /// Accumulated CIE XYZ per pixel (row-major, top row first) and the samples per pixel in it.
+///
+/// A sample with a non-finite channel is dropped, not summed: it is counted (see
+/// [`Film::dropped_samples`]) and its pixel averages over the samples it kept.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Film {
     width: usize,
     height: usize,
     sum_xyz: Vec<[f64; 3]>,
     spp: u32,
+    /// Samples dropped per pixel, for the pixels that dropped any (normally none).
+    dropped: BTreeMap<usize, u32>,
 }
 
 impl Film {
@@ -24,6 +38,7 @@ impl Film {
             height,
             sum_xyz: vec![[0.0; 3]; width * height],
             spp: 0,
+            dropped: BTreeMap::new(),
         }
     }
 
@@ -39,28 +54,47 @@ impl Film {
         self.spp
     }
 
+    /// Non-finite samples dropped so far, over all pixels.
+    #[must_use]
+    pub fn dropped_samples(&self) -> u64 {
+        self.dropped.values().map(|&n| u64::from(n)).sum()
+    }
+
     /// Add one sample per pixel for the whole image: `pass[i]` is pixel i's XYZ estimate.
     pub fn add_pass(&mut self, pass: &[[f32; 3]]) {
         debug_assert_eq!(pass.len(), self.sum_xyz.len());
-        for (acc, v) in self.sum_xyz.iter_mut().zip(pass) {
-            for c in 0..3 {
-                acc[c] += f64::from(v[c]);
+        for (i, (acc, v)) in self.sum_xyz.iter_mut().zip(pass).enumerate() {
+            if v.iter().all(|c| c.is_finite()) {
+                for c in 0..3 {
+                    acc[c] += f64::from(v[c]);
+                }
+            } else {
+                *self.dropped.entry(i).or_insert(0) += 1;
             }
         }
         self.spp += 1;
     }
 
-    /// Mean XYZ of pixel (x, y).
-    #[must_use]
-    pub fn xyz(&self, x: usize, y: usize) -> [f32; 3] {
-        let n = f64::from(self.spp.max(1));
-        self.sum_xyz[y * self.width + x].map(|v| (v / n) as f32)
+    fn mean_xyz(&self, x: usize, y: usize) -> [f64; 3] {
+        let i = y * self.width + x;
+        let kept = self.spp - self.dropped.get(&i).copied().unwrap_or(0);
+        let n = f64::from(kept.max(1));
+        self.sum_xyz[i].map(|v| v / n)
     }
 
-    /// Mean linear sRGB of pixel (x, y) (unclamped).
+    /// Mean XYZ of pixel (x, y) (finite: beyond f32's range it saturates at `f32::MAX`).
+    #[must_use]
+    pub fn xyz(&self, x: usize, y: usize) -> [f32; 3] {
+        self.mean_xyz(x, y).map(to_finite_f32)
+    }
+
+    /// Mean linear sRGB of pixel (x, y) (unclamped, but finite).
     #[must_use]
     pub fn linear_srgb(&self, x: usize, y: usize) -> [f32; 3] {
-        xyz_to_linear_srgb(self.xyz(x, y))
+        skin_optics::color::Xyz(self.mean_xyz(x, y))
+            .to_linear_srgb()
+            .0
+            .map(to_finite_f32)
     }
 
     /// Write linear sRGB primaries as 32-bit float OpenEXR.
@@ -85,7 +119,8 @@ impl Film {
     /// 8-bit sRGB pixels after exposure (`2^exposure_stops`) and the filmic tone curve.
     #[must_use]
     pub fn to_srgb8(&self, exposure_stops: f32) -> Vec<u8> {
-        let scale = exposure_stops.exp2();
+        // Finite for any exposure, so a black pixel stays black (0 × ∞ would be NaN).
+        let scale = exposure_stops.exp2().min(f32::MAX);
         let mut out = Vec::with_capacity(self.width * self.height * 3);
         for y in 0..self.height {
             for x in 0..self.width {
@@ -119,10 +154,18 @@ impl Film {
 
 /// Filmic tone curve: Narkowicz's 2015 fit of the ACES reference rendering transform, clamped
 /// to [0, 1]. Linear near black, rolls highlights off smoothly (f(1) ≈ 0.80, f(∞) → 1).
+/// Above x = 1 the same rational function is evaluated divided through by x², so no square
+/// overflows: any x ≥ 0 up to +∞ maps into [0, 1].
 #[must_use]
 pub fn filmic(x: f32) -> f32 {
     let (a, b, c, d, e) = (2.51, 0.03, 2.43, 0.59, 0.14);
-    ((x * (a * x + b)) / (x * (c * x + d) + e)).clamp(0.0, 1.0)
+    let v = if x > 1.0 {
+        let r = 1.0 / x;
+        (a + b * r) / (c + r * (d + e * r))
+    } else {
+        (x * (a * x + b)) / (x * (c * x + d) + e)
+    };
+    if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) }
 }
 
 #[cfg(test)]
@@ -138,6 +181,55 @@ mod tests {
             prev = v;
         }
         assert_eq!(filmic(0.0), 0.0);
+    }
+
+    #[test]
+    fn tone_curve_does_not_overflow_bright_pixels_to_black() {
+        // x(ax + b) overflowed to ∞ above x ≈ 1e19 and ∞/∞ = NaN became 0 in the PNG.
+        for x in [10.0, 1e19, 1e30, f32::MAX, f32::INFINITY] {
+            assert!(filmic(x) > 0.99, "filmic({x}) = {}", filmic(x));
+        }
+        // Both branches agree at the switch point (one rational function).
+        assert!((filmic(1.0) - filmic(1.000_001)).abs() < 1e-5);
+        assert!((filmic(1.0) - 0.8038).abs() < 1e-3, "{}", filmic(1.0));
+    }
+
+    #[test]
+    fn exposure_100_and_1e30_stops_keep_bright_pixels_white_and_black_pixels_black() {
+        let mut film = Film::new(2, 1);
+        film.add_pass(&[xyz_white(), [0.0; 3]]);
+        for stops in [100.0, 1e30] {
+            let px = film.to_srgb8(stops);
+            assert_eq!(&px[..3], &[255, 255, 255], "{stops} stops");
+            assert_eq!(&px[3..], &[0, 0, 0], "{stops} stops");
+        }
+    }
+
+    #[test]
+    fn non_finite_samples_are_counted_and_dropped() {
+        let mut film = Film::new(3, 1);
+        let w = xyz_white();
+        film.add_pass(&[w, w, [f32::NAN, 0.0, 0.0]]);
+        film.add_pass(&[[f32::INFINITY; 3], w, w]);
+        film.add_pass(&[w, w, [0.0, f32::NEG_INFINITY, 0.0]]);
+        assert_eq!(film.dropped_samples(), 3);
+        // Each pixel averages the samples it kept: all white.
+        for x in 0..3 {
+            assert!((film.linear_srgb(x, 0)[0] - 1.0).abs() < 2e-3, "{x}");
+        }
+        // A pixel that kept nothing is black, not NaN.
+        let mut film = Film::new(1, 1);
+        film.add_pass(&[[f32::NAN; 3]]);
+        assert_eq!(film.linear_srgb(0, 0), [0.0; 3]);
+    }
+
+    #[test]
+    fn film_never_writes_a_non_finite_value() {
+        // Finite samples near f32::MAX turn into linear sRGB beyond f32's range: saturated.
+        let mut film = Film::new(1, 1);
+        film.add_pass(&[[f32::MAX, 0.0, f32::MAX]]);
+        assert!(film.linear_srgb(0, 0).iter().all(|v| v.is_finite()));
+        assert!(film.xyz(0, 0).iter().all(|v| v.is_finite()));
     }
 
     #[test]

@@ -5,6 +5,28 @@ use crate::accel::{Accel, TriHit, ray};
 use crate::mesh::TriangleMesh;
 use glam::{Vec2, Vec3};
 
+/// Largest coordinate magnitude anything in a scene may have, mm (1000 km): far beyond any
+/// scene, far below where f32 squares overflow (1.8e19) and the BVH build breaks down.
+pub const MAX_COORD_MM: f32 = 1e9;
+
+/// `v` scaled to unit length, or `None` when it is zero or not finite. Divides by the largest
+/// component first, so vectors whose squared length overflows f32 (components above 1.8e19)
+/// still normalise.
+#[must_use]
+pub fn unit_vector(v: Vec3) -> Option<Vec3> {
+    let m = v.abs().max_element();
+    if !(m.is_finite() && m > 0.0) {
+        return None;
+    }
+    (v / m).try_normalize()
+}
+
+/// Whether every component of `v` lies within ±[`MAX_COORD_MM`].
+#[must_use]
+pub fn within_scene(v: Vec3) -> bool {
+    v.is_finite() && v.abs().max_element() <= MAX_COORD_MM
+}
+
 /// A surface point hit by a ray.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SurfaceHit {
@@ -135,5 +157,25 @@ pub fn offset_origin(p: Vec3, ng: Vec3, d: Vec3) -> Vec3 {
         p + ng * eps
     } else {
         p - ng * eps
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn vectors_whose_squared_length_overflows_still_normalise() {
+        let d = unit_vector(Vec3::splat(3e38)).unwrap();
+        assert!((d - Vec3::splat(1.0 / 3f32.sqrt())).length() < 1e-6, "{d}");
+        assert_eq!(
+            unit_vector(Vec3::new(0.0, -f32::MAX, 0.0)),
+            Some(Vec3::NEG_Y)
+        );
+        assert_eq!(unit_vector(Vec3::ZERO), None);
+        assert_eq!(unit_vector(Vec3::new(f32::NAN, 1.0, 0.0)), None);
+        assert_eq!(unit_vector(Vec3::new(f32::INFINITY, 1.0, 0.0)), None);
+        assert!(within_scene(Vec3::splat(MAX_COORD_MM)));
+        assert!(!within_scene(Vec3::new(0.0, 0.0, 2e19)));
     }
 }

@@ -9,6 +9,7 @@ pub mod cli;
 pub mod error;
 pub mod film;
 pub mod geometry;
+pub mod input;
 pub mod integrator;
 pub mod light;
 pub mod material;

@@ -8,6 +8,13 @@ use crate::error::RenderError;
 use glam::{Affine3A, Mat3A, Quat, Vec2, Vec3, Vec3A};
 use std::path::Path;
 
+/// Most triangles one mesh file may hold (about 0.5 GB once the BVH is built).
+pub const MAX_TRIANGLES: usize = 4_000_000;
+/// Most vertices one mesh file may hold.
+pub const MAX_VERTICES: usize = 4_000_000;
+/// Deepest glTF node hierarchy accepted (parent → child steps from a scene root).
+pub const MAX_NODE_DEPTH: usize = 64;
+
 /// An indexed triangle mesh with per-vertex shading normals and optional texture coordinates.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TriangleMesh {
@@ -88,7 +95,7 @@ impl TriangleMesh {
         )
     }
 
-    /// Check indices are in range and every value finite.
+    /// Check the size caps, that indices are in range and every value finite.
     fn validate(self, path: &Path) -> Result<Self, RenderError> {
         let err = |message: String| RenderError::Mesh {
             path: path.to_path_buf(),
@@ -97,12 +104,16 @@ impl TriangleMesh {
         if self.indices.is_empty() {
             return Err(err("no triangles".into()));
         }
+        check_caps(self.positions.len(), self.indices.len(), path)?;
         let n = self.positions.len() as u32;
         if let Some(t) = self.indices.iter().find(|t| t.iter().any(|&i| i >= n)) {
             return Err(err(format!("triangle {t:?} indexes past {n} vertices")));
         }
         if self.positions.iter().any(|p| !p.is_finite()) {
             return Err(err("non-finite vertex position".into()));
+        }
+        if self.uvs.iter().flatten().any(|uv| !uv.is_finite()) {
+            return Err(err("non-finite texture coordinate".into()));
         }
         if let Some(uvs) = &self.uvs
             && uvs.len() != self.positions.len()
@@ -155,15 +166,42 @@ impl TriangleMesh {
             .default_scene()
             .or_else(|| gltf.scenes().next())
             .ok_or_else(|| err("no scene".into()))?;
-        let mut stack: Vec<(gltf::Node, glam::Mat4)> =
-            scene.nodes().map(|n| (n, glam::Mat4::IDENTITY)).collect();
-        while let Some((node, parent)) = stack.pop() {
+        // glTF nodes form trees (a node has at most one parent): each node is visited once, so a
+        // node that is its own ancestor or is shared by two parents is refused, not re-entered.
+        let mut visited = vec![false; gltf.nodes().len()];
+        let mut stack: Vec<(gltf::Node, glam::Mat4, usize)> = scene
+            .nodes()
+            .map(|n| (n, glam::Mat4::IDENTITY, 1))
+            .collect();
+        while let Some((node, parent, depth)) = stack.pop() {
+            if std::mem::replace(&mut visited[node.index()], true) {
+                return Err(err(format!(
+                    "node {} is reached twice (a node hierarchy must be a tree: no cycles, one parent per node)",
+                    node.index()
+                )));
+            }
+            if depth > MAX_NODE_DEPTH {
+                return Err(err(format!(
+                    "node hierarchy deeper than {MAX_NODE_DEPTH} levels"
+                )));
+            }
             let world = parent * glam::Mat4::from_cols_array_2d(&node.transform().matrix());
             if let Some(m) = node.mesh() {
                 for prim in m.primitives() {
                     if prim.mode() != gltf::mesh::Mode::Triangles {
                         continue;
                     }
+                    check_accessor_types(&prim, path)?;
+                    // Counts declared by the accessors, checked before anything is read.
+                    let vertices = prim
+                        .get(&gltf::Semantic::Positions)
+                        .map_or(0, |a| a.count());
+                    let corners = prim.indices().map_or(vertices, |a| a.count());
+                    check_caps(
+                        mesh.positions.len().saturating_add(vertices),
+                        mesh.indices.len().saturating_add(corners / 3),
+                        path,
+                    )?;
                     let reader = prim.reader(|b| match b.source() {
                         gltf::buffer::Source::Bin => blob,
                         gltf::buffer::Source::Uri(_) => None,
@@ -198,9 +236,9 @@ impl TriangleMesh {
                     );
                 }
             }
-            stack.extend(node.children().map(|c| (c, world)));
+            stack.extend(node.children().map(|c| (c, world, depth + 1)));
         }
-        mesh.with_normals().validate(path)
+        Ok(mesh.validate(path)?.with_normals())
     }
 
     /// Load a Wavefront OBJ from bytes (triangulated; materials ignored: the scene assigns them).
@@ -222,6 +260,11 @@ impl TriangleMesh {
         };
         for m in models {
             let m = m.mesh;
+            check_caps(
+                mesh.positions.len() + m.positions.len() / 3,
+                mesh.indices.len() + m.indices.len() / 3,
+                path,
+            )?;
             let base = mesh.positions.len() as u32;
             let count = m.positions.len() / 3;
             mesh.positions.extend(
@@ -250,7 +293,7 @@ impl TriangleMesh {
                     .map(|c| [c[0] + base, c[1] + base, c[2] + base]),
             );
         }
-        mesh.with_normals().validate(path)
+        Ok(mesh.validate(path)?.with_normals())
     }
 
     /// A unit sphere (radius 1, centred at the origin) from a subdivided icosahedron with
@@ -352,6 +395,105 @@ impl TriangleMesh {
         }
     }
 }
+
+/// Pack a glTF JSON document and its binary buffer into a GLB container (glTF 2.0 "GLB File
+/// Format Specification": 12-byte header, then JSON and BIN chunks padded to 4 bytes).
+#[must_use]
+pub fn glb_container(json: &str, bin: &[u8]) -> Vec<u8> {
+    let pad = |n: usize| n.div_ceil(4) * 4;
+    let (json_len, bin_len) = (pad(json.len()), pad(bin.len()));
+    let total = 12 + 8 + json_len + if bin.is_empty() { 0 } else { 8 + bin_len };
+    let mut out = Vec::with_capacity(total);
+    let word = |out: &mut Vec<u8>, v: usize| out.extend_from_slice(&(v as u32).to_le_bytes());
+    out.extend_from_slice(b"glTF");
+    word(&mut out, 2);
+    word(&mut out, total);
+    word(&mut out, json_len);
+    out.extend_from_slice(b"JSON");
+    out.extend_from_slice(json.as_bytes());
+    out.resize(20 + json_len, b' ');
+    if !bin.is_empty() {
+        word(&mut out, bin_len);
+        out.extend_from_slice(b"BIN\0");
+        out.extend_from_slice(bin);
+        out.resize(total, 0);
+    }
+    out
+}
+
+/// Refuse accessors whose component type or shape the glTF spec does not allow for their
+/// attribute (the `gltf` readers assume them and would panic otherwise).
+fn check_accessor_types(prim: &gltf::Primitive, path: &Path) -> Result<(), RenderError> {
+    use gltf::Semantic;
+    use gltf::accessor::{DataType, Dimensions};
+    let ok = |a: &gltf::Accessor, types: &[DataType], dims: Dimensions| {
+        types.contains(&a.data_type()) && a.dimensions() == dims
+    };
+    for (semantic, a) in prim.attributes() {
+        let fine = match semantic {
+            Semantic::Positions | Semantic::Normals => ok(&a, &[DataType::F32], Dimensions::Vec3),
+            Semantic::TexCoords(_) => ok(
+                &a,
+                &[DataType::F32, DataType::U8, DataType::U16],
+                Dimensions::Vec2,
+            ),
+            _ => true,
+        };
+        if !fine {
+            return Err(RenderError::Mesh {
+                path: path.to_path_buf(),
+                message: format!(
+                    "accessor {} of {semantic:?} has type {:?} {:?}, which glTF does not allow there",
+                    a.index(),
+                    a.data_type(),
+                    a.dimensions()
+                ),
+            });
+        }
+    }
+    if let Some(a) = prim.indices()
+        && !ok(
+            &a,
+            &[DataType::U8, DataType::U16, DataType::U32],
+            Dimensions::Scalar,
+        )
+    {
+        return Err(RenderError::Mesh {
+            path: path.to_path_buf(),
+            message: format!(
+                "index accessor {} has type {:?} {:?}; indices are unsigned scalars",
+                a.index(),
+                a.data_type(),
+                a.dimensions()
+            ),
+        });
+    }
+    Ok(())
+}
+
+/// Refuse more than [`MAX_VERTICES`] vertices or [`MAX_TRIANGLES`] triangles.
+fn check_caps(vertices: usize, triangles: usize, path: &Path) -> Result<(), RenderError> {
+    let err = |message: String| {
+        Err(RenderError::Mesh {
+            path: path.to_path_buf(),
+            message,
+        })
+    };
+    if vertices > MAX_VERTICES {
+        return err(format!(
+            "{vertices} vertices, more than the {MAX_VERTICES} a mesh may have"
+        ));
+    }
+    if triangles > MAX_TRIANGLES {
+        return err(format!(
+            "{triangles} triangles, more than the {MAX_TRIANGLES} a mesh may have"
+        ));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod glb_tests;
 
 #[cfg(test)]
 mod tests {

@@ -36,7 +36,113 @@
 //! ```
 
 use serde::Deserialize;
+use serde::de::{Deserializer, Error as _};
+use skin_optics::echo::Num;
 use std::collections::BTreeMap;
+
+/// Longest parser message kept, characters (the parser may quote a whole offending value).
+const MAX_MESSAGE_CHARS: usize = 200;
+
+/// Parse scene text into its description; a syntax or schema error comes back on one line,
+/// `line L, column C: message`.
+pub fn parse(text: &str) -> Result<SceneDesc, String> {
+    toml::from_str(text).map_err(|e: toml::de::Error| {
+        let mut message: String = e.message().split_whitespace().collect::<Vec<_>>().join(" ");
+        if let Some((cut, _)) = message.char_indices().nth(MAX_MESSAGE_CHARS) {
+            message.truncate(cut);
+            message.push('…');
+        }
+        match e.span() {
+            Some(span) => {
+                let before = &text[..span.start.min(text.len())];
+                let line = before.matches('\n').count() + 1;
+                let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+                format!("line {line}, column {column}: {message}")
+            }
+            None => message,
+        }
+    })
+}
+
+/// A number as f32: finite and within f32's range (TOML reads f64; 1e39 would become ∞).
+fn to_f32<E: serde::de::Error>(x: f64) -> Result<f32, E> {
+    if x.is_finite() && x.abs() <= f64::from(f32::MAX) {
+        Ok(x as f32)
+    } else {
+        Err(E::custom(format!(
+            "expected a finite number within ±3.4e38, got {}",
+            Num(x)
+        )))
+    }
+}
+
+/// Exactly `N` finite numbers (extra or missing elements are an error, not ignored).
+fn finite_array<'de, D: Deserializer<'de>, const N: usize>(d: D) -> Result<[f32; N], D::Error> {
+    let v: Vec<f64> = Vec::deserialize(d)?;
+    if v.len() != N {
+        return Err(D::Error::custom(format!(
+            "expected an array of {N} numbers, got {} elements",
+            v.len()
+        )));
+    }
+    let mut out = [0.0; N];
+    for (o, &x) in out.iter_mut().zip(&v) {
+        *o = to_f32(x)?;
+    }
+    Ok(out)
+}
+
+fn vec3<'de, D: Deserializer<'de>>(d: D) -> Result<[f32; 3], D::Error> {
+    finite_array::<D, 3>(d)
+}
+
+fn vec2<'de, D: Deserializer<'de>>(d: D) -> Result<[f32; 2], D::Error> {
+    finite_array::<D, 2>(d)
+}
+
+fn opt_vec3<'de, D: Deserializer<'de>>(d: D) -> Result<Option<[f32; 3]>, D::Error> {
+    vec3(d).map(Some)
+}
+
+fn finite<'de, D: Deserializer<'de>>(d: D) -> Result<f32, D::Error> {
+    to_f32(f64::deserialize(d)?)
+}
+
+fn opt_finite<'de, D: Deserializer<'de>>(d: D) -> Result<Option<f32>, D::Error> {
+    finite(d).map(Some)
+}
+
+fn opt_finite_f64<'de, D: Deserializer<'de>>(d: D) -> Result<Option<f64>, D::Error> {
+    let x = f64::deserialize(d)?;
+    if x.is_finite() {
+        Ok(Some(x))
+    } else {
+        Err(D::Error::custom(format!(
+            "expected a finite number, got {x}"
+        )))
+    }
+}
+
+/// `[nm, value]` pairs, each exactly two finite numbers.
+fn pairs<'de, D: Deserializer<'de>>(d: D) -> Result<Option<Vec<[f64; 2]>>, D::Error> {
+    let rows: Vec<Vec<f64>> = Vec::deserialize(d)?;
+    rows.iter()
+        .enumerate()
+        .map(|(i, r)| match r[..] {
+            [nm, v] if nm.is_finite() && v.is_finite() => Ok([nm, v]),
+            [_, _] => Err(D::Error::custom(format!(
+                "element {i}: expected finite [nm, value], got [{}, {}]",
+                Num(r[0]),
+                Num(r[1])
+            ))),
+            _ => Err(D::Error::custom(format!(
+                "element {i}: expected [nm, value], got {} numbers",
+                r.len()
+            ))),
+        })
+        .collect::<Result<Vec<_>, _>>()
+        .map(Some)
+}
 
 /// A whole scene file.
 #[derive(Debug, Deserialize)]
@@ -65,18 +171,22 @@ pub struct SceneDesc {
 #[serde(deny_unknown_fields)]
 pub struct CameraDesc {
     /// Eye position, mm.
+    #[serde(deserialize_with = "vec3")]
     pub position_mm: [f32; 3],
     /// Point looked at, mm.
+    #[serde(deserialize_with = "vec3")]
     pub look_at_mm: [f32; 3],
     /// Up hint (default +Y).
-    #[serde(default = "default_up")]
+    #[serde(default = "default_up", deserialize_with = "vec3")]
     pub up: [f32; 3],
     /// Vertical field of view, degrees.
+    #[serde(deserialize_with = "finite")]
     pub fov_deg: f32,
     /// Lens aperture diameter, mm (0 = pinhole).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "finite")]
     pub aperture_mm: f32,
     /// Distance of the plane in focus, mm (default: the look-at distance).
+    #[serde(default, deserialize_with = "opt_finite")]
     pub focus_distance_mm: Option<f32>,
 }
 
@@ -89,7 +199,7 @@ fn default_up() -> [f32; 3] {
 #[serde(deny_unknown_fields)]
 pub struct FilmDesc {
     /// Exposure of the PNG, stops (the EXR is unscaled).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "finite")]
     pub exposure_stops: f32,
 }
 
@@ -112,10 +222,12 @@ pub struct EnvironmentDesc {
     /// Spectrum of a constant environment (ignored with `exr`; default d65).
     pub spectrum: Option<SpectrumKind>,
     /// Blackbody temperature, K.
+    #[serde(default, deserialize_with = "opt_finite_f64")]
     pub temperature_k: Option<f64>,
     /// Lat-long linear-sRGB OpenEXR map.
     pub exr: Option<String>,
     /// Luminance of a constant environment, or the map's multiplier.
+    #[serde(deserialize_with = "finite")]
     pub intensity: f32,
 }
 
@@ -136,6 +248,7 @@ pub enum MaterialDesc {
         /// Oiliness ρ_s, [0, 1].
         oil: Option<f64>,
         /// Beckmann roughness m of the surface (default 0.3).
+        #[serde(default, deserialize_with = "opt_finite")]
         roughness: Option<f32>,
         /// sRGB albedo texture (JPEG/PNG).
         albedo_texture: Option<String>,
@@ -143,10 +256,13 @@ pub enum MaterialDesc {
     /// Lambertian.
     Diffuse {
         /// Constant albedo.
+        #[serde(default, deserialize_with = "opt_finite")]
         albedo: Option<f32>,
         /// sRGB-encoded albedo colour.
+        #[serde(default, deserialize_with = "opt_vec3")]
         albedo_srgb: Option<[f32; 3]>,
         /// Albedo samples `[nm, value]`, linearly interpolated.
+        #[serde(default, deserialize_with = "pairs")]
         albedo_spectrum: Option<Vec<[f64; 2]>>,
         /// sRGB albedo texture multiplying the albedo.
         albedo_texture: Option<String>,
@@ -174,16 +290,16 @@ pub struct MeshDesc {
     /// Material name.
     pub material: String,
     /// Millimetres per model unit (default 1).
-    #[serde(default = "one")]
+    #[serde(default = "one", deserialize_with = "finite")]
     pub units_mm: f32,
     /// Extra uniform scale (default 1).
-    #[serde(default = "one")]
+    #[serde(default = "one", deserialize_with = "finite")]
     pub scale: f32,
     /// Rotation about X, Y, Z, degrees (applied in that order).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "vec3")]
     pub rotate_deg: [f32; 3],
     /// Translation, mm.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "vec3")]
     pub translate_mm: [f32; 3],
     /// Use v → 1 − v for texture lookups (OpenGL-style UVs, e.g. the head scan).
     #[serde(default)]
@@ -201,68 +317,165 @@ pub enum LightDesc {
     /// Isotropic point light; intensity is radiant intensity (irradiance × mm²).
     Point {
         /// Position, mm.
+        #[serde(deserialize_with = "vec3")]
         position_mm: [f32; 3],
         /// Spectrum shape.
         spectrum: Option<SpectrumKind>,
         /// Blackbody temperature, K.
+        #[serde(default, deserialize_with = "opt_finite_f64")]
         temperature_k: Option<f64>,
         /// Luminous scale.
+        #[serde(deserialize_with = "finite")]
         intensity: f32,
     },
     /// Spot light.
     Spot {
         /// Position, mm.
+        #[serde(deserialize_with = "vec3")]
         position_mm: [f32; 3],
         /// Point on the cone axis, mm.
+        #[serde(deserialize_with = "vec3")]
         look_at_mm: [f32; 3],
         /// Full-intensity half angle, degrees.
+        #[serde(deserialize_with = "finite")]
         inner_deg: f32,
         /// Zero-intensity half angle, degrees.
+        #[serde(deserialize_with = "finite")]
         outer_deg: f32,
         /// Spectrum shape.
         spectrum: Option<SpectrumKind>,
         /// Blackbody temperature, K.
+        #[serde(default, deserialize_with = "opt_finite_f64")]
         temperature_k: Option<f64>,
         /// Luminous scale (on the axis).
+        #[serde(deserialize_with = "finite")]
         intensity: f32,
     },
     /// Distant (directional) light; intensity is the irradiance on a surface facing it.
     Distant {
         /// Direction towards the light.
+        #[serde(deserialize_with = "vec3")]
         direction: [f32; 3],
         /// Spectrum shape.
         spectrum: Option<SpectrumKind>,
         /// Blackbody temperature, K.
+        #[serde(default, deserialize_with = "opt_finite_f64")]
         temperature_k: Option<f64>,
         /// Irradiance (luminance units).
+        #[serde(deserialize_with = "finite")]
         intensity: f32,
     },
     /// Spherical area light; intensity is its radiance.
     Sphere {
         /// Centre, mm.
+        #[serde(deserialize_with = "vec3")]
         center_mm: [f32; 3],
         /// Radius, mm.
+        #[serde(deserialize_with = "finite")]
         radius_mm: f32,
         /// Spectrum shape.
         spectrum: Option<SpectrumKind>,
         /// Blackbody temperature, K.
+        #[serde(default, deserialize_with = "opt_finite_f64")]
         temperature_k: Option<f64>,
         /// Radiance (luminance units).
+        #[serde(deserialize_with = "finite")]
         intensity: f32,
     },
     /// Rectangular area light facing `look_at_mm`; intensity is its radiance.
     Quad {
         /// Centre, mm.
+        #[serde(deserialize_with = "vec3")]
         center_mm: [f32; 3],
         /// Point the emitting side faces, mm.
+        #[serde(deserialize_with = "vec3")]
         look_at_mm: [f32; 3],
         /// Width and height, mm.
+        #[serde(deserialize_with = "vec2")]
         size_mm: [f32; 2],
         /// Spectrum shape.
         spectrum: Option<SpectrumKind>,
         /// Blackbody temperature, K.
+        #[serde(default, deserialize_with = "opt_finite_f64")]
         temperature_k: Option<f64>,
         /// Radiance (luminance units).
+        #[serde(deserialize_with = "finite")]
         intensity: f32,
     },
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const CAMERA: &str =
+        "[camera]\nposition_mm = [0, 0, 300]\nlook_at_mm = [0, 0, 0]\nfov_deg = 30\n";
+
+    fn error_of(extra: &str) -> String {
+        parse(&format!("{CAMERA}{extra}")).unwrap_err()
+    }
+
+    #[test]
+    fn scene_built_here_parses() {
+        let d = parse(CAMERA).unwrap();
+        assert_eq!(d.camera.position_mm, [0.0, 0.0, 300.0]);
+    }
+
+    #[test]
+    fn extra_elements_in_coordinate_arrays_are_refused() {
+        let e = parse("[camera]\nposition_mm = [0, 0, 300, 77, \"junk\"]\nlook_at_mm = [0, 0, 0]\nfov_deg = 30\n")
+            .unwrap_err();
+        assert!(e.starts_with("line 2"), "{e}");
+        let e = parse(
+            "[camera]\nposition_mm = [0, 0, 300, 77]\nlook_at_mm = [0, 0, 0]\nfov_deg = 30\n",
+        )
+        .unwrap_err();
+        assert!(
+            e.contains("expected an array of 3 numbers, got 4 elements"),
+            "{e}"
+        );
+        let e = error_of(
+            "[[lights]]\ntype = \"quad\"\ncenter_mm = [0, 0, 0]\nlook_at_mm = [0, 0, 1]\nsize_mm = [1]\nintensity = 1\n",
+        );
+        assert!(e.contains("expected an array of 2 numbers, got 1"), "{e}");
+    }
+
+    #[test]
+    fn albedo_spectrum_with_inf_or_nan_wavelengths_is_refused() {
+        for bad in ["inf", "-inf", "nan"] {
+            let e = error_of(&format!(
+                "[materials.w]\ntype = \"diffuse\"\nalbedo_spectrum = [[400, 0.5], [{bad}, 0.5], [700, 0.5]]\n"
+            ));
+            assert!(
+                e.contains("element 1: expected finite [nm, value]"),
+                "{bad}: {e}"
+            );
+        }
+        let e = error_of("[materials.w]\ntype = \"diffuse\"\nalbedo_spectrum = [[400, 0.5, 3]]\n");
+        assert!(e.contains("got 3 numbers"), "{e}");
+    }
+
+    #[test]
+    fn numbers_beyond_f32_are_refused_not_read_as_infinity() {
+        let e =
+            error_of("[[lights]]\ntype = \"point\"\nposition_mm = [0, 1e39, 0]\nintensity = 1\n");
+        assert!(e.contains("got 1e39"), "{e}");
+        let e =
+            error_of("[[lights]]\ntype = \"point\"\nposition_mm = [0, 0, 0]\nintensity = inf\n");
+        assert!(e.contains("expected a finite number"), "{e}");
+    }
+
+    #[test]
+    fn toml_errors_are_one_line() {
+        let e = parse("[camera]\nposition_mm = [0, 0\n").unwrap_err();
+        assert!(!e.contains('\n') && e.starts_with("line "), "{e}");
+        let e = error_of("[film]\nexposure_stops = \"bright\"\n");
+        assert!(!e.contains('\n') && e.starts_with("line 6"), "{e}");
+        // A long offending value is cut.
+        let e = error_of(&format!(
+            "[materials.s]\ntype = \"skin\"\npreset = {}\n",
+            "9".repeat(100_000)
+        ));
+        assert!(e.len() < 300, "{} chars", e.len());
+    }
 }

@@ -6,6 +6,17 @@ use glam::Vec2;
 use skin_optics::color::srgb_decode;
 use std::path::Path;
 
+/// Widest or tallest image accepted, texels.
+pub const MAX_SIDE: usize = 16_384;
+/// Most texels an image may have (8192 × 4096: a 400 MB linear texture), checked against the
+/// size the file declares before anything is allocated.
+pub const MAX_TEXELS: usize = 8192 * 4096;
+/// Largest linear texel value of an EXR map: far above any sky (the sun is about 1e9 in display
+/// units), far enough below f32's 3.4e38 that scales and spectra built from it stay finite.
+pub const MAX_TEXEL: f32 = 1e20;
+/// Most chunks (scan-line blocks or tiles) an EXR file may declare (its offset table is read whole).
+pub const MAX_EXR_CHUNKS: usize = 1 << 22;
+
 /// A linear-RGB image (rows top to bottom).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Texture {
@@ -14,38 +25,68 @@ pub struct Texture {
     texels: Vec<[f32; 3]>,
 }
 
+fn image_err(path: &Path, message: impl Into<String>) -> RenderError {
+    RenderError::Image {
+        path: path.to_path_buf(),
+        message: message.into(),
+    }
+}
+
+/// Refuse a declared size over [`MAX_SIDE`] or [`MAX_TEXELS`].
+fn check_size(width: usize, height: usize, path: &Path) -> Result<(), RenderError> {
+    if width == 0 || height == 0 {
+        return Err(image_err(path, format!("empty image ({width}×{height})")));
+    }
+    if width > MAX_SIDE || height > MAX_SIDE || width.saturating_mul(height) > MAX_TEXELS {
+        return Err(image_err(
+            path,
+            format!(
+                "{width}×{height} texels, over the cap of {MAX_SIDE} per side and {MAX_TEXELS} in all"
+            ),
+        ));
+    }
+    Ok(())
+}
+
 impl Texture {
-    /// Decode an 8-bit sRGB JPEG or PNG and undo the sRGB transfer curve.
+    /// Decode an 8-bit sRGB JPEG or PNG and undo the sRGB transfer curve. The declared size is
+    /// checked before decoding; a JPEG whose data ends early is refused (strict decoding), not
+    /// padded with grey.
     pub fn from_srgb_bytes(bytes: &[u8], path: &Path) -> Result<Self, RenderError> {
-        let img = image::load_from_memory(bytes)
-            .map_err(|e| RenderError::Image {
-                path: path.to_path_buf(),
-                message: e.to_string(),
-            })?
-            .to_rgb8();
+        let (width, height, rgb) = if bytes.starts_with(&[0xFF, 0xD8]) {
+            decode_jpeg(bytes, path)?
+        } else {
+            decode_other(bytes, path)?
+        };
         let lut: Vec<f32> = (0..256)
             .map(|i| srgb_decode(f64::from(i) / 255.0) as f32)
             .collect();
-        let texels = img
-            .pixels()
-            .map(|p| {
-                [
-                    lut[p.0[0] as usize],
-                    lut[p.0[1] as usize],
-                    lut[p.0[2] as usize],
-                ]
-            })
+        let texels = rgb
+            .chunks_exact(3)
+            .map(|p| [lut[p[0] as usize], lut[p[1] as usize], lut[p[2] as usize]])
             .collect();
         Ok(Self {
-            width: img.width() as usize,
-            height: img.height() as usize,
+            width,
+            height,
             texels,
         })
     }
 
-    /// Decode a linear RGB(A) OpenEXR image (alpha ignored).
+    /// Decode a linear RGB(A) OpenEXR image (alpha ignored). The headers are read and the sizes
+    /// they declare checked first; texels must be finite, ≥ 0 and at most [`MAX_TEXEL`].
     pub fn from_exr_bytes(bytes: &[u8], path: &Path) -> Result<Self, RenderError> {
         use exr::prelude::*;
+        let meta = exr::meta::MetaData::read_from_buffered(std::io::Cursor::new(bytes), false)
+            .map_err(|e| image_err(path, e.to_string()))?;
+        for h in &meta.headers {
+            check_size(h.layer_size.0, h.layer_size.1, path)?;
+            if h.chunk_count > MAX_EXR_CHUNKS {
+                return Err(image_err(
+                    path,
+                    format!("{} chunks, over the cap of {MAX_EXR_CHUNKS}", h.chunk_count),
+                ));
+            }
+        }
         let img = read()
             .no_deep_data()
             .largest_resolution_level()
@@ -63,21 +104,21 @@ impl Texture {
             .first_valid_layer()
             .all_attributes()
             .from_buffered(std::io::Cursor::new(bytes))
-            .map_err(|e| RenderError::Image {
-                path: path.to_path_buf(),
-                message: e.to_string(),
-            })?;
+            .map_err(|e| image_err(path, e.to_string()))?;
         let tex = img.layer_data.channel_data.pixels;
-        if tex
+        if let Some(v) = tex
             .texels
             .iter()
             .flatten()
-            .any(|v| !v.is_finite() || *v < 0.0)
+            .find(|v| !(v.is_finite() && (0.0..=MAX_TEXEL).contains(*v)))
         {
-            return Err(RenderError::Image {
-                path: path.to_path_buf(),
-                message: "negative or non-finite texel".into(),
-            });
+            return Err(image_err(
+                path,
+                format!(
+                    "texel value {} outside [0, {MAX_TEXEL:e}]",
+                    skin_optics::echo::Num(f64::from(*v))
+                ),
+            ));
         }
         Ok(tex)
     }
@@ -135,6 +176,54 @@ impl Texture {
     }
 }
 
+/// A baseline or progressive JPEG as 8-bit RGB, decoded strictly (a truncated file is an error).
+fn decode_jpeg(bytes: &[u8], path: &Path) -> Result<(usize, usize, Vec<u8>), RenderError> {
+    use zune_core::bytestream::ZCursor;
+    use zune_core::colorspace::ColorSpace;
+    use zune_core::options::DecoderOptions;
+    let options = DecoderOptions::default()
+        .set_strict_mode(true)
+        .set_max_width(MAX_SIDE)
+        .set_max_height(MAX_SIDE)
+        .jpeg_set_out_colorspace(ColorSpace::RGB);
+    let mut decoder = zune_jpeg::JpegDecoder::new_with_options(ZCursor::new(bytes), options);
+    decoder
+        .decode_headers()
+        .map_err(|e| image_err(path, format!("JPEG: {e}")))?;
+    let (width, height) = decoder
+        .dimensions()
+        .ok_or_else(|| image_err(path, "JPEG without a frame header"))?;
+    check_size(width, height, path)?;
+    let rgb = decoder
+        .decode()
+        .map_err(|e| image_err(path, format!("JPEG: {e}")))?;
+    if rgb.len() != width * height * 3 {
+        return Err(image_err(
+            path,
+            "JPEG decoded to the wrong number of pixels",
+        ));
+    }
+    Ok((width, height, rgb))
+}
+
+/// A PNG (or another format `image` knows) as 8-bit RGB, its declared size checked first.
+fn decode_other(bytes: &[u8], path: &Path) -> Result<(usize, usize, Vec<u8>), RenderError> {
+    let reader = || {
+        image::ImageReader::new(std::io::Cursor::new(bytes))
+            .with_guessed_format()
+            .map_err(|e| image_err(path, e.to_string()))
+    };
+    let (w, h) = reader()?
+        .into_dimensions()
+        .map_err(|e| image_err(path, e.to_string()))?;
+    check_size(w as usize, h as usize, path)?;
+    let img = reader()?
+        .decode()
+        .map_err(|e| image_err(path, e.to_string()))?
+        .to_rgb8();
+    Ok((img.width() as usize, img.height() as usize, img.into_raw()))
+}
+
 /// Relative luminance of linear sRGB (the Y row of the IEC 61966-2-1 matrix).
 #[must_use]
 pub fn luminance(rgb: [f32; 3]) -> f32 {
@@ -150,6 +239,72 @@ mod tests {
         let t = Texture::from_texels(2, 1, vec![[0.0; 3], [1.0; 3]]);
         assert!((t.lookup(Vec2::new(0.5, 0.5))[0] - 0.5).abs() < 1e-6);
         assert!((t.lookup(Vec2::new(0.25, 0.5))[0]).abs() < 1e-6);
+    }
+
+    /// A small EXR written by the `exr` crate, then its data window patched to `x_max`, `y_max`.
+    fn exr_bytes(texel: f32, x_max: i32, y_max: i32) -> Vec<u8> {
+        use exr::prelude::*;
+        let mut bytes = Vec::new();
+        let img = Image::from_channels(
+            (2, 2),
+            SpecificChannels::rgb(|_: Vec2<usize>| (texel, texel, texel)),
+        );
+        img.write()
+            .to_buffered(std::io::Cursor::new(&mut bytes))
+            .unwrap();
+        let key = b"dataWindow\0box2i\0";
+        let at = bytes.windows(key.len()).position(|w| w == key).unwrap() + key.len() + 4;
+        bytes[at + 8..at + 12].copy_from_slice(&x_max.to_le_bytes());
+        bytes[at + 12..at + 16].copy_from_slice(&y_max.to_le_bytes());
+        bytes
+    }
+
+    #[test]
+    fn exr_built_here_loads() {
+        let t = Texture::from_exr_bytes(&exr_bytes(0.5, 1, 1), Path::new("e.exr")).unwrap();
+        assert_eq!(t.size(), (2, 2));
+        assert_eq!(t.mean(), [0.5; 3]);
+    }
+
+    #[test]
+    fn exr_header_declaring_100000_by_100000_is_refused_before_allocating() {
+        let e = Texture::from_exr_bytes(&exr_bytes(0.5, 99_999, 99_999), Path::new("e.exr"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("100000×100000") && e.contains(&MAX_TEXELS.to_string()),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn exr_texels_of_3e38_are_refused() {
+        let e = Texture::from_exr_bytes(&exr_bytes(3e38, 1, 1), Path::new("e.exr"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("outside [0, 1e20]"), "{e}");
+        assert!(Texture::from_exr_bytes(&exr_bytes(f32::NAN, 1, 1), Path::new("e.exr")).is_err());
+        assert!(Texture::from_exr_bytes(&exr_bytes(-1.0, 1, 1), Path::new("e.exr")).is_err());
+    }
+
+    #[test]
+    fn truncated_jpeg_texture_is_refused() {
+        let full = include_bytes!("../assets/Map-COL.jpg");
+        for keep in [full.len() / 2, full.len() - 100] {
+            let e = Texture::from_srgb_bytes(&full[..keep], Path::new("t.jpg"));
+            assert!(e.is_err(), "{keep} bytes of {} accepted", full.len());
+        }
+    }
+
+    #[test]
+    fn image_size_cap_is_named_in_the_error() {
+        let e = check_size(MAX_SIDE + 1, 1, Path::new("t.png"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("16384"), "{e}");
+        assert!(check_size(8192, 4096, Path::new("t.png")).is_ok());
+        assert!(check_size(8192, 4097, Path::new("t.png")).is_err());
+        assert!(check_size(0, 5, Path::new("t.png")).is_err());
     }
 
     #[test]

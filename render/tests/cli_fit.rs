@@ -214,11 +214,13 @@ fn bad_spectra_each_give_one_line_naming_the_line() {
     }
     let out = skin_fit(&["--spectrum", "/nonexistent/skin.csv"]);
     assert_eq!(out.status.code(), Some(1));
+    let err = stderr(&out);
     assert!(
-        stderr(&out).contains("cannot read spectrum"),
-        "{}",
-        stderr(&out)
+        err.contains("spectrum file /nonexistent/skin.csv cannot be read"),
+        "{err}"
     );
+    // The OS error is printed once, not once by the message and again as its source.
+    assert_eq!(err.matches("os error").count(), 1, "{err}");
 }
 
 #[test]

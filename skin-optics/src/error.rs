@@ -19,7 +19,7 @@ pub enum OpticsError {
         range: &'static str,
     },
     /// A parameter lies outside its closed valid interval.
-    #[error("{name} = {value} outside {range}")]
+    #[error("{name} = {} outside {range}", crate::echo::Num(*.value))]
     OutOfRange {
         /// Parameter name as the user knows it.
         name: &'static str,

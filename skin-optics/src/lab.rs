@@ -98,10 +98,15 @@ impl Lab {
         self.a.hypot(self.b)
     }
 
-    /// Individual Typology Angle ITA° = atan2(L* − 50, b*), degrees in (−180, 180] ([CGD91]).
+    /// Individual Typology Angle ITA° = arctan((L* − 50) / b*), degrees in [−90°, 90°] ([CGD91]),
+    /// with b* floored at [`ITA_MIN_B`]: the angle is undefined for achromatic colours (b* ≈ 0,
+    /// where its sign would follow rounding noise), so greys get a value continuous in L* instead
+    /// of jumping between ±90°. No colour with b* ≥ [`ITA_MIN_B`] is affected.
     #[must_use]
     pub fn ita_deg(self) -> f64 {
-        (self.l - 50.0).atan2(self.b).to_degrees()
+        ((self.l - 50.0) / self.b.max(ITA_MIN_B))
+            .atan()
+            .to_degrees()
     }
 
     /// The skin-colour category of [`Lab::ita_deg`].
@@ -209,6 +214,10 @@ pub fn delta_e_2000(c1: Lab, c2: Lab) -> f64 {
         .max(0.0)
         .sqrt()
 }
+
+/// Smallest b* the ITA° formula divides by (see [`Lab::ita_deg`]); skin is yellowish, b* well
+/// above it.
+pub const ITA_MIN_B: f64 = 1.0;
 
 /// Skin-colour category of the Individual Typology Angle ([CGD91]; the six classes of
 /// [DB06]). Each class includes its upper bound: light is 41° < ITA° ≤ 55°,
@@ -378,6 +387,29 @@ mod tests {
         assert!((lab(70.0, 10.0, 20.0).ita_deg() - 45.0).abs() < 1e-12);
         assert!((lab(50.0, 0.0, 15.0).ita_deg()).abs() < 1e-12);
         assert!((lab(30.0, 5.0, 20.0).ita_deg() + 45.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn ita_of_any_colour_lies_within_plus_minus_90_degrees() {
+        for l in [0.0, 10.0, 49.9, 50.0, 50.1, 90.0, 100.0] {
+            for b in [-100.0, -1.0, -1e-15, 0.0, 1e-15, 0.5, 1.0, 20.0] {
+                let ita = lab(l, 3.0, b).ita_deg();
+                assert!((-90.0..=90.0).contains(&ita), "L* {l} b* {b}: {ita}");
+            }
+        }
+    }
+
+    #[test]
+    fn nearly_equal_greys_share_an_ita_category() {
+        // #777777 (L* ≈ 50.04) and #767676 (L* ≈ 49.63) differ by 0.4 in L* and have b* ≈ 0 up
+        // to rounding; atan2 put them at +99.8° and −90.9°. With b* floored at 1 both are
+        // within atan(0.4) ≈ 22° of 0°: brown.
+        let a = Lab::from_srgb(Srgb::from_hex("#777777").unwrap());
+        let b = Lab::from_srgb(Srgb::from_hex("#767676").unwrap());
+        assert_eq!(a.ita_category(), b.ita_category(), "{a:?} {b:?}");
+        assert!((a.ita_deg() - b.ita_deg()).abs() < 25.0);
+        // A skin colour (b* ≫ 1) keeps the textbook value: L* = 50 + b* gives 45°.
+        assert!((lab(70.0, 10.0, 20.0).ita_deg() - 45.0).abs() < 1e-12);
     }
 
     #[test]

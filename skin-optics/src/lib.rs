@@ -5,6 +5,7 @@
 
 pub mod chromophores;
 pub mod color;
+pub mod echo;
 pub mod error;
 pub mod lab;
 pub mod params;

@@ -37,7 +37,7 @@ impl fmt::Display for Preset {
     }
 }
 
-/// Error for an unknown preset name.
+/// Error for an unknown preset name (the name as given, cut by [`crate::echo::text`]).
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 #[error("unknown skin preset '{0}' (valid: light, medium, dark)")]
 pub struct UnknownPreset(pub String);
@@ -49,7 +49,7 @@ impl FromStr for Preset {
             "light" => Ok(Preset::Light),
             "medium" => Ok(Preset::Medium),
             "dark" => Ok(Preset::Dark),
-            _ => Err(UnknownPreset(s.to_string())),
+            _ => Err(UnknownPreset(crate::echo::text(s))),
         }
     }
 }

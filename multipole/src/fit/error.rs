@@ -41,7 +41,7 @@ pub enum FitError {
         text: String,
     },
     /// A value outside its valid range (wavelength, reflectance or weight).
-    #[error("line {line}: {column} = {value} outside {range}")]
+    #[error("line {line}: {column} = {} outside {range}", skin_optics::echo::Num(*.value))]
     Value {
         /// Line number, 1-based.
         line: usize,
@@ -51,6 +51,16 @@ pub enum FitError {
         value: f64,
         /// Valid range, e.g. `[0, 1]`.
         range: &'static str,
+    },
+    /// More data points than a fit accepts.
+    #[error(
+        "{points} data points; a spectrum fit accepts at most {max} (one per 0.1 nm over 400-700 nm)"
+    )]
+    TooMuchData {
+        /// Data points found (counting stops one past the cap).
+        points: usize,
+        /// The cap, [`super::measured::MAX_POINTS`].
+        max: usize,
     },
     /// Wavelengths that do not strictly increase.
     #[error("line {line}: wavelength {lambda_nm} nm does not increase (previous {previous_nm} nm)")]
@@ -66,7 +76,7 @@ pub enum FitError {
     #[error("{0}")]
     NotEnoughData(String),
     /// A fit option outside its range.
-    #[error("fit option {name} = {value} outside {range}")]
+    #[error("fit option {name} = {} outside {range}", skin_optics::echo::Num(*.value))]
     Option {
         /// Option name, e.g. `"step_nm"`.
         name: &'static str,

@@ -9,6 +9,9 @@ pub const MIN_NM: f64 = 400.0;
 pub const MAX_NM: f64 = 700.0;
 /// Fewest data points a spectrum fit accepts: one per fitted parameter (C_m, β_m, C_h).
 pub const MIN_POINTS: usize = 3;
+/// Most data points a spectrum fit accepts: one per 0.1 nm over [`MIN_NM`, `MAX_NM`]. Each point
+/// costs a forward-model wavelength per evaluation, so this bounds the fit's run time.
+pub const MAX_POINTS: usize = 3001;
 
 /// Validated measured reflectance (the observable: per unit incident flux, specular excluded).
 #[derive(Debug, Clone, PartialEq)]
@@ -42,6 +45,12 @@ impl MeasuredSpectrum {
         lines: Option<&[usize]>,
     ) -> Result<Self, FitError> {
         let n = lambda_nm.len();
+        if n > MAX_POINTS {
+            return Err(FitError::TooMuchData {
+                points: n,
+                max: MAX_POINTS,
+            });
+        }
         let weights = weights.unwrap_or_else(|| vec![1.0; n]);
         if reflectance.len() != n || weights.len() != n {
             return Err(FitError::NotEnoughData(format!(
@@ -98,6 +107,8 @@ impl MeasuredSpectrum {
     pub fn parse_csv(text: &str) -> Result<Self, FitError> {
         let mut columns: Option<usize> = None;
         let (mut lambda, mut refl, mut weight, mut lines) = (vec![], vec![], vec![], vec![]);
+        // A UTF-8 byte-order mark (spreadsheet exports) is not part of the header.
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
         for (i, raw) in text.lines().enumerate() {
             let line = i + 1;
             let trimmed = raw.trim();
@@ -113,7 +124,7 @@ impl MeasuredSpectrum {
                     _ => {
                         return Err(FitError::Header {
                             line,
-                            found: trimmed.to_string(),
+                            found: skin_optics::echo::text(trimmed),
                         });
                     }
                 };
@@ -133,9 +144,15 @@ impl MeasuredSpectrum {
                     .ok_or_else(|| FitError::Number {
                         line,
                         column,
-                        text: text.to_string(),
+                        text: skin_optics::echo::text(text),
                     })
             };
+            if lambda.len() == MAX_POINTS {
+                return Err(FitError::TooMuchData {
+                    points: MAX_POINTS + 1,
+                    max: MAX_POINTS,
+                });
+            }
             lambda.push(number("lambda_nm", fields[0])?);
             refl.push(number("reflectance", fields[1])?);
             if expected == 3 {
@@ -168,6 +185,14 @@ impl MeasuredSpectrum {
     #[must_use]
     pub fn weights(&self) -> &[f64] {
         &self.weights
+    }
+
+    /// The weights divided by the largest, in [0, 1]: the same least-squares problem, but sums of
+    /// weighted squares neither overflow (weights near 1e308) nor underflow (subnormal weights).
+    #[must_use]
+    pub fn relative_weights(&self) -> Vec<f64> {
+        let max = self.weights.iter().copied().fold(0.0, f64::max);
+        self.weights.iter().map(|w| w / max).collect()
     }
 
     /// Number of data points.
@@ -276,8 +301,73 @@ mod tests {
             FitError::NotEnoughData(_)
         ));
         assert!(matches!(err("# nothing\n"), FitError::NotEnoughData(_)));
+        assert!(matches!(
+            MeasuredSpectrum::new(vec![500.0; MAX_POINTS + 1], vec![0.5; MAX_POINTS + 1], None),
+            Err(FitError::TooMuchData { .. })
+        ));
         // Messages are one line and carry the line number.
         let msg = err(&format!("{h}400,0.2\n500,1.2\n600,0.3\n")).to_string();
         assert_eq!(msg, "line 4: reflectance = 1.2 outside [0, 1]");
+    }
+}
+
+#[cfg(test)]
+mod hostile {
+    use super::*;
+
+    #[test]
+    fn csv_with_a_utf8_byte_order_mark_parses() {
+        let s = MeasuredSpectrum::parse_csv(
+            "\u{feff}lambda_nm,reflectance\n400,0.1\n500,0.2\n600,0.3\n",
+        )
+        .unwrap();
+        assert_eq!(s.len(), 3);
+    }
+
+    #[test]
+    fn spectrum_with_a_million_rows_is_refused_before_fitting() {
+        let mut csv = String::from("lambda_nm,reflectance\n");
+        for i in 0..1_000_000 {
+            csv.push_str(&format!("{},0.3\n", 400.0 + 300.0 * f64::from(i) / 1e6));
+        }
+        let e = MeasuredSpectrum::parse_csv(&csv).unwrap_err();
+        assert_eq!(
+            e,
+            FitError::TooMuchData {
+                points: MAX_POINTS + 1,
+                max: MAX_POINTS
+            }
+        );
+        assert!(e.to_string().contains("3001"), "{e}");
+    }
+
+    #[test]
+    fn degenerate_weights_become_relative_weights_of_one() {
+        // Weights of 1e308 overflow a weight sum, 1e-320 underflow the weighted squares: both
+        // must give the unweighted problem (every relative weight 1).
+        for w in [1e308, 1e-320, f64::MAX] {
+            let s = MeasuredSpectrum::new(
+                vec![400.0, 500.0, 600.0],
+                vec![0.1, 0.2, 0.3],
+                Some(vec![w; 3]),
+            )
+            .unwrap();
+            assert_eq!(s.relative_weights(), vec![1.0; 3], "{w}");
+        }
+        let s = MeasuredSpectrum::new(
+            vec![400.0, 500.0, 600.0],
+            vec![0.1, 0.2, 0.3],
+            Some(vec![2.0, 1.0, 0.5]),
+        )
+        .unwrap();
+        assert_eq!(s.relative_weights(), vec![1.0, 0.5, 0.25]);
+    }
+
+    #[test]
+    fn long_fields_are_echoed_cut() {
+        let junk = "x".repeat(10_000);
+        let e = MeasuredSpectrum::parse_csv(&format!("lambda_nm,reflectance\n400,{junk}\n"))
+            .unwrap_err();
+        assert!(e.to_string().len() < 200, "{e}");
     }
 }

@@ -44,7 +44,8 @@ pub fn fit_spectrum(
         .iter()
         .map(|&nm| Wavelength::new(nm))
         .collect::<Result<Vec<_>, _>>()?;
-    let weight_sum: f64 = measured.weights().iter().sum();
+    let weights = measured.relative_weights();
+    let weight_sum: f64 = weights.iter().sum();
     let full = Forward::Method(opts.method);
     let search_forward = Forward::search(opts.method, opts.search_quadrature_points);
     let search = search_forward.unwrap_or(full);
@@ -54,7 +55,7 @@ pub fn fit_spectrum(
         let ss: f64 = model
             .iter()
             .zip(measured.reflectance())
-            .zip(measured.weights())
+            .zip(&weights)
             .map(|((r_hat, r), w)| w * (r - r_hat).powi(2))
             .sum();
         (ss / weight_sum).sqrt()
@@ -167,6 +168,48 @@ mod tests {
     fn noisy_spectrum_fits_back_to_its_parameters() {
         for method in [Method::Exact, Method::Multipole] {
             noisy_spectrum_round_trip(method);
+        }
+    }
+
+    /// Weights all 1e308 (their sum overflows) or all 1e-320 (the weighted squares underflow) once
+    /// gave "RMS = 0" and a wrong skin; scaling every weight by one factor must change nothing.
+    #[test]
+    fn fit_with_weights_all_1e308_or_all_1e_320_equals_the_unweighted_fit() {
+        let opts = FitOptions {
+            method: Method::Multipole,
+            ..FitOptions::default()
+        };
+        let skin = with_chromophores(&opts.base, [0.1, 0.7, 0.03]).unwrap();
+        let lambda: Vec<f64> = (0..7).map(|i| 400.0 + 50.0 * f64::from(i)).collect();
+        // The model's own spectrum, perturbed so the best RMS is not zero.
+        let r: Vec<f64> = lambda
+            .iter()
+            .enumerate()
+            .map(|(i, &nm)| {
+                let clean = crate::skin::diffuse_reflectance(
+                    &skin,
+                    Wavelength::new(nm).unwrap(),
+                    opts.method,
+                )
+                .unwrap();
+                clean * if i % 2 == 0 { 1.02 } else { 0.98 }
+            })
+            .collect();
+        let fit = |w: Option<f64>| {
+            let weights = w.map(|w| vec![w; lambda.len()]);
+            fit_spectrum(
+                &MeasuredSpectrum::new(lambda.clone(), r.clone(), weights).unwrap(),
+                &opts,
+            )
+            .unwrap()
+        };
+        let plain = fit(None);
+        assert!(plain.rms > 1e-3, "{}", plain.rms);
+        for w in [1e308, 1e-320] {
+            let f = fit(Some(w));
+            // Relative weights are exactly 1, so the whole fit is bitwise the unweighted one.
+            assert_eq!(f.rms, plain.rms, "weights {w}");
+            assert_eq!(f.skin, plain.skin, "weights {w}");
         }
     }
 

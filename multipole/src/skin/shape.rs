@@ -149,14 +149,16 @@ fn rescale(table: &Profile, total: f64) -> Result<Profile, MultipoleError> {
 }
 
 /// Photons a Monte Carlo shape traces for `escapes` escaping photons at total reflectance `total`
-/// (per unit flux entering) of a skin of index `eta`.
+/// (per unit flux entering) of a skin of index `eta`: at least `escapes`, and beyond that at most
+/// [`MAX_SHAPE_PHOTONS`] (a request above the cap is traced as asked, one photon per escape).
 #[must_use]
 pub fn shape_photons(escapes: u64, total: f64, eta: f64) -> u64 {
+    let cap = MAX_SHAPE_PHOTONS.max(escapes);
     let escaping_fraction = observable_reflectance(total, eta);
-    if escaping_fraction <= 0.0 {
-        return MAX_SHAPE_PHOTONS;
+    if escaping_fraction.is_nan() || escaping_fraction <= 0.0 {
+        return cap;
     }
-    ((escapes as f64 / escaping_fraction).ceil() as u64).clamp(escapes, MAX_SHAPE_PHOTONS)
+    ((escapes as f64 / escaping_fraction).ceil() as u64).clamp(escapes, cap)
 }
 
 /// The Monte Carlo R(r) of `skin` at `lambda` on the shape grid (one value per annulus, its mean,

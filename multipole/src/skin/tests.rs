@@ -246,3 +246,15 @@ mod direction_tests {
         );
     }
 }
+
+#[test]
+fn shape_escapes_above_the_photon_cap_do_not_panic() {
+    // 2,000,001 escapes once made `clamp(escapes, MAX_SHAPE_PHOTONS)` panic (min > max). A request
+    // above the cap traces one photon per escape at least; below it, the cap still bounds dark skin.
+    let eta = SkinParams::preset(Preset::Light).eta();
+    let above = MAX_SHAPE_PHOTONS + 1;
+    assert_eq!(shape_photons(above, 0.5, eta), above);
+    assert_eq!(shape_photons(1_000_000_000, 0.0, eta), 1_000_000_000);
+    assert_eq!(shape_photons(4_000, 1e-9, eta), MAX_SHAPE_PHOTONS);
+    assert!(shape_photons(4_000, 0.5, eta) < MAX_SHAPE_PHOTONS);
+}

@@ -4,11 +4,13 @@
 //! Each value is computed directly by the deterministic f64 quadrature of
 //! [`brdf::TorranceSparrow::directional_albedo_quadrature`] (no table, no sampling), accurate to 1e-4.
 
+use crate::cli::args::Checked;
 use crate::plot::{LineChart, Panel, Series, save_png};
 use anyhow::Context;
 use brdf::fresnel::dielectric_reflectance;
 use brdf::{DEFAULT_ETA, DEFAULT_OILINESS, DEFAULT_ROUGHNESS, TorranceSparrow};
 use clap::Args;
+use skin_optics::echo::Text;
 use std::io::Write;
 use std::path::PathBuf;
 
@@ -20,13 +22,13 @@ const QUADRATURE_NODES: usize = 96;
 #[derive(Args, Debug, Clone)]
 pub struct BrdfArgs {
     /// Beckmann roughness m (RMS microfacet slope) of the skin surface, (0, 1]; the paper uses ≈ 0.3.
-    #[arg(long, value_name = "M", allow_negative_numbers = true, default_value_t = DEFAULT_ROUGHNESS, value_parser = parse_roughness)]
+    #[arg(long, value_name = "M", allow_hyphen_values = true, default_value_t = DEFAULT_ROUGHNESS, value_parser = Checked(parse_roughness))]
     pub roughness: f32,
     /// Oiliness ρ_s, the linear scale of the surface lobe, [0, 1] (0.25 in the paper's Figure 1).
-    #[arg(long, value_name = "RHO_S", allow_negative_numbers = true, default_value_t = DEFAULT_OILINESS, value_parser = parse_oil)]
+    #[arg(long, value_name = "RHO_S", allow_hyphen_values = true, default_value_t = DEFAULT_OILINESS, value_parser = Checked(parse_oil))]
     pub oil: f32,
     /// Relative refractive index η of the skin surface, [1, 3].
-    #[arg(long, value_name = "ETA", allow_negative_numbers = true, default_value_t = DEFAULT_ETA, value_parser = parse_eta)]
+    #[arg(long, value_name = "ETA", allow_hyphen_values = true, default_value_t = DEFAULT_ETA, value_parser = Checked(parse_eta))]
     pub eta: f32,
     /// Also draw the curve (with the smooth-surface limit ρ_s·F(θ) for comparison) to this PNG file.
     #[arg(long, value_name = "FILE.png")]
@@ -36,7 +38,7 @@ pub struct BrdfArgs {
 fn parse_number(s: &str) -> Result<f32, String> {
     s.trim()
         .parse::<f32>()
-        .map_err(|_| format!("'{s}' is not a number"))
+        .map_err(|_| format!("'{}' is not a number", Text(s)))
 }
 
 /// clap parser for `--roughness`: the range check is brdf's own.

@@ -2,12 +2,15 @@
 //! spectrum, from `multipole::fit`; prints the fit (with the forward model used), its colour, residual,
 //! CIELAB and ITA°, or JSON.
 
+use crate::cli::args::{Checked, parse_number};
 use anyhow::Context;
 use clap::{ArgGroup, Args};
 use multipole::Method;
 use multipole::fit::{BetaRange, FitOptions, MeasuredSpectrum, fit_colour, fit_spectrum};
 use skin_optics::SkinParams;
+use skin_optics::WavelengthGrid;
 use skin_optics::color::{Srgb, Xyz};
+use skin_optics::echo::{Num, Text};
 use skin_optics::lab::Lab;
 use std::path::PathBuf;
 
@@ -17,7 +20,7 @@ use std::path::PathBuf;
 pub struct FitArgs {
     /// Target colour, sRGB hex '#RRGGBB' (e.g. picked from a photograph), read as the skin's diffuse
     /// colour under D65.
-    #[arg(long, value_name = "HEX", value_parser = parse_hex)]
+    #[arg(long, value_name = "HEX", value_parser = Checked(parse_hex), allow_hyphen_values = true)]
     pub srgb: Option<Hex>,
     /// Measured diffuse reflectance, CSV with header `lambda_nm,reflectance` (optional third column
     /// `weight`), wavelengths increasing within 400-700 nm, '#' comment lines allowed.
@@ -27,10 +30,10 @@ pub struct FitArgs {
     /// cheap 8-point exact model, then corrected to the full one: about 1 s per colour) or `multipole`
     /// (the paper's diffusion: reproduces Donner & Jensen 2006, about 50 ms, but dark skin comes out too bright,
     /// so its melanin is fitted too high).
-    #[arg(long, value_name = "METHOD", default_value = "exact", value_parser = parse_method)]
+    #[arg(long, value_name = "METHOD", default_value = "exact", value_parser = Checked(parse_method), allow_hyphen_values = true)]
     pub method: Method,
-    /// Wavelength step of the model spectrum behind a colour, nm, in (0, 100].
-    #[arg(long = "step-nm", value_name = "NM", default_value_t = 10.0, value_parser = parse_step)]
+    /// Wavelength step of the model spectrum behind a colour, nm, in [0.01, 100].
+    #[arg(long = "step-nm", value_name = "NM", default_value_t = 10.0, value_parser = Checked(parse_step), allow_hyphen_values = true)]
     pub step_nm: f64,
     /// Print one JSON object instead of text.
     #[arg(long)]
@@ -47,8 +50,12 @@ pub struct Hex {
 }
 
 fn parse_hex(s: &str) -> Result<Hex, String> {
-    let srgb = Srgb::from_hex(s)
-        .ok_or_else(|| format!("'{s}' is not an sRGB colour (expected #RRGGBB, six hex digits)"))?;
+    let srgb = Srgb::from_hex(s).ok_or_else(|| {
+        format!(
+            "'{}' is not an sRGB colour (expected #RRGGBB, six hex digits)",
+            Text(s)
+        )
+    })?;
     Ok(Hex {
         text: srgb.to_hex(),
         srgb,
@@ -60,12 +67,10 @@ fn parse_method(s: &str) -> Result<Method, String> {
 }
 
 fn parse_step(s: &str) -> Result<f64, String> {
-    let v: f64 = s
-        .trim()
-        .parse()
-        .map_err(|_| format!("'{s}' is not a number (valid range (0, 100] nm)"))?;
-    if !(v > 0.0 && v <= 100.0) {
-        return Err(format!("{v} outside (0, 100] nm"));
+    let v = parse_number(s, "[0.01, 100] nm")?;
+    // The lower bound is the finest wavelength grid the colour model accepts.
+    if !(WavelengthGrid::MIN_STEP_NM..=100.0).contains(&v) {
+        return Err(format!("{} outside [0.01, 100] nm", Num(v)));
     }
     Ok(v)
 }
@@ -230,8 +235,7 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
         // clap's ArgGroup requires one of the two.
         anyhow::bail!("give --srgb '#RRGGBB' or --spectrum FILE.csv");
     };
-    let text = std::fs::read_to_string(path)
-        .with_context(|| format!("cannot read spectrum {}", path.display()))?;
+    let text = crate::input::SPECTRUM.read_text(path)?;
     let measured =
         MeasuredSpectrum::parse_csv(&text).with_context(|| path.display().to_string())?;
     let fit = fit_spectrum(&measured, &opts)?;

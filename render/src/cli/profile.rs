@@ -2,13 +2,14 @@
 //! (`r_mm,reflectance_per_mm2`), from `multipole::skin::profile`; optionally a log–log chart of the
 //! profiles at 450, 550 and 650 nm.
 
-use crate::cli::args::SkinArgs;
+use crate::cli::args::{Checked, SkinArgs};
 use crate::plot::{LineChart, Panel, Series, palette_color, save_png};
 use anyhow::Context;
 use clap::Args;
 use multipole::skin::{DEFAULT_SHAPE_ESCAPES, ExactShape, Method, profile};
 use multipole::{Profile, ProfileOptions};
 use skin_optics::Wavelength;
+use skin_optics::echo::{Num, Text};
 use std::io::{BufWriter, Write};
 use std::path::PathBuf;
 
@@ -19,21 +20,21 @@ pub struct ProfileArgs {
     #[command(flatten)]
     pub skin: SkinArgs,
     /// Wavelength, nm, in [250, 1000] (the model's data cover 400-700 nm best).
-    #[arg(long, value_name = "NM", value_parser = parse_lambda, allow_hyphen_values = true)]
+    #[arg(long, value_name = "NM", value_parser = Checked(parse_lambda), allow_hyphen_values = true)]
     pub lambda: f64,
     /// Outer radius of the table, mm, in [0.002, 10000]; default: the radius holding 99.9% of the energy.
-    #[arg(long = "r-max", value_name = "MM", value_parser = parse_r_max, allow_hyphen_values = true)]
+    #[arg(long = "r-max", value_name = "MM", value_parser = Checked(parse_r_max), allow_hyphen_values = true)]
     pub r_max: Option<f64>,
     /// Number of radii, geometric from 0.001 mm to the outer radius, in [2, 1000000].
-    #[arg(long, value_name = "N", default_value_t = 256, value_parser = parse_samples, allow_hyphen_values = true)]
+    #[arg(long, value_name = "N", default_value_t = 256, value_parser = Checked(parse_samples), allow_hyphen_values = true)]
     pub samples: usize,
     /// Profile method: exact (the default: adding-doubling total, shape from the layered Monte Carlo)
     /// or multipole (the paper's diffusion, too bright for dark skin).
-    #[arg(long, value_name = "METHOD", default_value_t = Method::default(), value_parser = parse_method)]
+    #[arg(long, value_name = "METHOD", default_value_t = Method::default(), value_parser = Checked(parse_method), allow_hyphen_values = true)]
     pub method: Method,
     /// Escaping photons of the exact profile's Monte Carlo shape, in [100, 1e9] (the accuracy knob:
     /// noise ∝ 1/√N; the photons traced are N divided by the skin's reflectance).
-    #[arg(long, value_name = "N", default_value_t = DEFAULT_SHAPE_ESCAPES, value_parser = parse_escapes)]
+    #[arg(long, value_name = "N", default_value_t = DEFAULT_SHAPE_ESCAPES, value_parser = Checked(parse_escapes), allow_hyphen_values = true)]
     pub escapes: u64,
     /// Print to stderr the treatment used and why (layer albedos, epidermis thickness in mean free
     /// paths, diffusion versus exact total, the exact profile's per-layer factors).
@@ -47,13 +48,13 @@ pub struct ProfileArgs {
 fn parse_number(s: &str, range: &str) -> Result<f64, String> {
     s.trim()
         .parse::<f64>()
-        .map_err(|_| format!("'{s}' is not a number (valid range {range})"))
+        .map_err(|_| format!("'{}' is not a number (valid range {range})", Text(s)))
 }
 
 fn parse_lambda(s: &str) -> Result<f64, String> {
     let v = parse_number(s, "[250, 1000] nm")?;
     if !(250.0..=1000.0).contains(&v) {
-        return Err(format!("{v} outside [250, 1000] nm"));
+        return Err(format!("{} outside [250, 1000] nm", Num(v)));
     }
     Ok(v)
 }
@@ -61,16 +62,18 @@ fn parse_lambda(s: &str) -> Result<f64, String> {
 fn parse_r_max(s: &str) -> Result<f64, String> {
     let v = parse_number(s, "[0.002, 10000] mm")?;
     if !(0.002..=1e4).contains(&v) {
-        return Err(format!("{v} outside [0.002, 10000] mm"));
+        return Err(format!("{} outside [0.002, 10000] mm", Num(v)));
     }
     Ok(v)
 }
 
 fn parse_samples(s: &str) -> Result<usize, String> {
-    let v: usize = s
-        .trim()
-        .parse()
-        .map_err(|_| format!("'{s}' is not a whole number (valid range [2, 1000000])"))?;
+    let v: usize = s.trim().parse().map_err(|_| {
+        format!(
+            "'{}' is not a whole number (valid range [2, 1000000])",
+            Text(s)
+        )
+    })?;
     if !(2..=1_000_000).contains(&v) {
         return Err(format!("{v} outside [2, 1000000]"));
     }
@@ -80,7 +83,7 @@ fn parse_samples(s: &str) -> Result<usize, String> {
 fn parse_escapes(s: &str) -> Result<u64, String> {
     let v = parse_number(s, "[100, 1e9]")?;
     if !(100.0..=1e9).contains(&v) || v.fract() != 0.0 {
-        return Err(format!("{v} outside [100, 1e9] (whole number)"));
+        return Err(format!("{} outside [100, 1e9] (whole number)", Num(v)));
     }
     Ok(v as u64)
 }

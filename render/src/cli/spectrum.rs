@@ -1,7 +1,7 @@
 //! `skin spectrum`: layer coefficients and the diffuse reflectance of a skin over a wavelength grid,
 //! as CSV on stdout; its sRGB colour under D65 on stderr; optionally a chart of the spectra.
 
-use crate::cli::args::SkinArgs;
+use crate::cli::args::{Checked, SkinArgs};
 use crate::plot::{LineChart, Panel, Series, save_png};
 use anyhow::Context;
 use clap::Args;
@@ -11,6 +11,7 @@ use skin_optics::chromophores::{
     pheomelanin_sigma_a,
 };
 use skin_optics::color::reflectance_to_xyz;
+use skin_optics::echo::{Num, Text};
 use skin_optics::{GridSpectrum, SkinParams, Wavelength, WavelengthGrid};
 use std::io::{self, Write};
 use std::path::{Path, PathBuf};
@@ -23,10 +24,10 @@ pub fn parse_wavelength_nm(s: &str) -> Result<f64, String> {
     let v: f64 = s
         .trim()
         .parse()
-        .map_err(|_| format!("'{s}' is not a number (valid range [250, 1000] nm)"))?;
+        .map_err(|_| format!("'{}' is not a number (valid range [250, 1000] nm)", Text(s)))?;
     Wavelength::new(v)
         .map(Wavelength::nm)
-        .map_err(|_| format!("{v} outside [250, 1000] nm"))
+        .map_err(|_| format!("{} outside [250, 1000] nm", Num(v)))
 }
 
 /// Parse a grid step in nm, [0.01, 750] (clap value parser).
@@ -34,9 +35,9 @@ pub fn parse_step_nm(s: &str) -> Result<f64, String> {
     let v: f64 = s
         .trim()
         .parse()
-        .map_err(|_| format!("'{s}' is not a number (valid range [0.01, 750] nm)"))?;
+        .map_err(|_| format!("'{}' is not a number (valid range [0.01, 750] nm)", Text(s)))?;
     if !v.is_finite() || !(WavelengthGrid::MIN_STEP_NM..=WavelengthGrid::MAX_STEP_NM).contains(&v) {
-        return Err(format!("{v} outside [0.01, 750] nm"));
+        return Err(format!("{} outside [0.01, 750] nm", Num(v)));
     }
     Ok(v)
 }
@@ -48,13 +49,13 @@ pub struct SpectrumArgs {
     #[command(flatten)]
     pub skin: SkinArgs,
     /// First wavelength, nm, [250, 1000].
-    #[arg(long, value_name = "NM", default_value_t = 400.0, value_parser = parse_wavelength_nm, allow_negative_numbers = true)]
+    #[arg(long, value_name = "NM", default_value_t = 400.0, value_parser = Checked(parse_wavelength_nm), allow_hyphen_values = true)]
     pub from: f64,
     /// Last wavelength, nm, [250, 1000] and ≥ --from (the grid stops at the last step not beyond it).
-    #[arg(long, value_name = "NM", default_value_t = 700.0, value_parser = parse_wavelength_nm, allow_negative_numbers = true)]
+    #[arg(long, value_name = "NM", default_value_t = 700.0, value_parser = Checked(parse_wavelength_nm), allow_hyphen_values = true)]
     pub to: f64,
     /// Wavelength step, nm, [0.01, 750].
-    #[arg(long, value_name = "NM", default_value_t = 10.0, value_parser = parse_step_nm, allow_negative_numbers = true)]
+    #[arg(long, value_name = "NM", default_value_t = 10.0, value_parser = Checked(parse_step_nm), allow_hyphen_values = true)]
     pub step: f64,
     /// Diffuse reflectance model: exact (adding-doubling transport, the default: right for every
     /// skin tone) or multipole (the paper's diffusion, [DJ05]; too bright for dark skin).

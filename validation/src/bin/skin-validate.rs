@@ -3,8 +3,9 @@
 use anyhow::Context;
 use clap::{Args, Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
-use render::cli::args::SkinArgs;
+use render::cli::args::{Checked, SkinArgs, parse_whole};
 use skin_optics::Wavelength;
+use skin_optics::echo::{Num, Text};
 use std::path::PathBuf;
 use std::time::Instant;
 use validation::montecarlo::{self, LayeredMedium, McOptions, McResult};
@@ -49,7 +50,7 @@ fn parse_lambda(s: &str) -> Result<f64, String> {
     let v: f64 = s
         .trim()
         .parse()
-        .map_err(|_| format!("'{s}' is not a number (valid range [250, 1000] nm)"))?;
+        .map_err(|_| format!("'{}' is not a number (valid range [250, 1000] nm)", Text(s)))?;
     Wavelength::new(v)
         .map(|w| w.nm())
         .map_err(|e| e.to_string())
@@ -57,14 +58,16 @@ fn parse_lambda(s: &str) -> Result<f64, String> {
 
 /// Parse a Henyey–Greenstein anisotropy, [-0.999, 0.999].
 fn parse_g(s: &str) -> Result<f64, String> {
-    let v: f64 = s
-        .trim()
-        .parse()
-        .map_err(|_| format!("'{s}' is not a number (valid range [-0.999, 0.999])"))?;
+    let v: f64 = s.trim().parse().map_err(|_| {
+        format!(
+            "'{}' is not a number (valid range [-0.999, 0.999])",
+            Text(s)
+        )
+    })?;
     if v.is_finite() && (-0.999..=0.999).contains(&v) {
         Ok(v)
     } else {
-        Err(format!("{v} outside [-0.999, 0.999]"))
+        Err(format!("{} outside [-0.999, 0.999]", Num(v)))
     }
 }
 
@@ -73,12 +76,22 @@ fn parse_photons(s: &str) -> Result<u64, String> {
     let v: f64 = s
         .trim()
         .parse()
-        .map_err(|_| format!("'{s}' is not a number (valid range [1, 1e12])"))?;
+        .map_err(|_| format!("'{}' is not a number (valid range [1, 1e12])", Text(s)))?;
     if v.is_finite() && (1.0..=1e12).contains(&v) && v.fract() == 0.0 {
         Ok(v as u64)
     } else {
-        Err(format!("{v} outside [1, 1e12] (a whole number)"))
+        Err(format!("{} outside [1, 1e12] (a whole number)", Num(v)))
     }
+}
+
+/// Parse a batch count, [2, 1e6].
+fn parse_batches(s: &str) -> Result<u32, String> {
+    parse_whole(s, 2, 1_000_000, "[2, 1e6]").map(|v| v as u32)
+}
+
+/// Parse a thread count, [1, 1024].
+fn parse_threads(s: &str) -> Result<u32, String> {
+    parse_whole(s, 1, 1024, "[1, 1024]").map(|v| v as u32)
 }
 
 #[derive(Args, Debug)]
@@ -86,22 +99,22 @@ struct McArgs {
     #[command(flatten)]
     skin: SkinArgs,
     /// Wavelength in nm, [250, 1000].
-    #[arg(long, value_name = "NM", value_parser = parse_lambda, default_value = "550")]
+    #[arg(long, value_name = "NM", value_parser = Checked(parse_lambda), default_value = "550", allow_hyphen_values = true)]
     lambda: f64,
     /// Photon histories (the accuracy knob: the standard error falls as 1/√N).
-    #[arg(long, value_name = "N", value_parser = parse_photons, default_value = "1000000")]
+    #[arg(long, value_name = "N", value_parser = Checked(parse_photons), default_value = "1000000", allow_hyphen_values = true)]
     photons: u64,
     /// Henyey–Greenstein anisotropy g; σs = σs' / (1 − g).
-    #[arg(long, value_name = "G", value_parser = parse_g, default_value = "0.9")]
+    #[arg(long, value_name = "G", value_parser = Checked(parse_g), default_value = "0.9", allow_hyphen_values = true)]
     g: f64,
     /// Generator seed: the same seed gives the same result on any number of threads.
     #[arg(long, value_name = "S", default_value_t = 1)]
     seed: u64,
     /// Independent batches for the standard errors, [2, 1e6].
-    #[arg(long, value_name = "B", default_value_t = 32, value_parser = clap::value_parser!(u32).range(2..=1_000_000))]
+    #[arg(long, value_name = "B", default_value_t = 32, value_parser = Checked(parse_batches), allow_hyphen_values = true)]
     batches: u32,
     /// Worker threads (default: all cores).
-    #[arg(long, value_name = "T", value_parser = clap::value_parser!(u32).range(1..=1024))]
+    #[arg(long, value_name = "T", value_parser = Checked(parse_threads), allow_hyphen_values = true)]
     threads: Option<u32>,
     /// Also write the radial profile R_d(r) as CSV (r_mm,reflectance_per_mm2,stderr).
     #[arg(long, value_name = "FILE.csv")]
@@ -116,7 +129,7 @@ fn main() {
         None => validation::compare::run_comparison(cli.quick, &cli.out),
     };
     if let Err(e) = result {
-        eprintln!("skin-validate: {e:#}");
+        eprintln!("skin-validate: {}", render::cli::one_line(&e));
         std::process::exit(1);
     }
 }

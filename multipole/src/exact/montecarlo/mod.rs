@@ -31,7 +31,7 @@ use crate::error::MultipoleError;
 use rand::SeedableRng;
 use rand_xoshiro::Xoshiro256StarStar;
 use rayon::prelude::*;
-use tally::BatchTally;
+use tally::{BatchTally, Combiner};
 use transport::{Medium, trace_batch};
 
 /// Run settings: photon count (the accuracy knob), batches for the standard errors, seed, grid.
@@ -121,6 +121,10 @@ pub fn run(stack: &LayeredMedium, opts: &McOptions) -> McResult {
     run_with_progress(stack, opts, |_| {})
 }
 
+/// Batches traced in parallel before they are folded into the result: bounds the tallies held at
+/// once (each holds one weight per annulus), whatever the batch count.
+const BATCHES_IN_FLIGHT: u32 = 256;
+
 /// As [`run`], calling `on_batch(photons_in_batch)` after each finished batch (for progress bars).
 pub fn run_with_progress(
     stack: &LayeredMedium,
@@ -133,27 +137,40 @@ pub fn run_with_progress(
     let per_batch = opts.photons_per_batch();
     let layers = stack.layers().len();
     let grid = opts.grid;
-    let tallies: Vec<BatchTally> = batch_streams(opts.seed, opts.batches)
-        .into_par_iter()
-        .map(|mut rng| {
-            let mut tally = BatchTally::new(layers, grid.bins());
-            trace_batch(&medium, grid, w0, per_batch, &mut rng, &mut tally);
-            on_batch(per_batch);
-            tally
-        })
-        .collect();
-    McResult::from_batches(&tallies, specular, grid)
+    let mut combined = Combiner::new(layers, grid);
+    let mut base = Xoshiro256StarStar::seed_from_u64(opts.seed);
+    let mut left = opts.batches;
+    while left > 0 {
+        let n = left.min(BATCHES_IN_FLIGHT);
+        left -= n;
+        let tallies: Vec<BatchTally> = next_streams(&mut base, n)
+            .into_par_iter()
+            .map(|mut rng| {
+                let mut tally = BatchTally::new(layers, grid.bins());
+                trace_batch(&medium, grid, w0, per_batch, &mut rng, &mut tally);
+                on_batch(per_batch);
+                tally
+            })
+            .collect();
+        tallies.iter().for_each(|t| combined.add(t));
+    }
+    combined.finish(specular)
 }
 
-/// One generator per batch: xoshiro256** seeded from `seed`, each stream 2¹²⁸ draws after the
-/// previous (`jump`), so batches never overlap.
-fn batch_streams(seed: u64, batches: u32) -> Vec<Xoshiro256StarStar> {
-    let mut base = Xoshiro256StarStar::seed_from_u64(seed);
-    (0..batches)
+/// The next `n` batch generators after `base`, each 2¹²⁸ draws after the previous (`jump`).
+fn next_streams(base: &mut Xoshiro256StarStar, n: u32) -> Vec<Xoshiro256StarStar> {
+    (0..n)
         .map(|_| {
             let rng = base.clone();
             base.jump();
             rng
         })
         .collect()
+}
+
+/// One generator per batch: xoshiro256** seeded from `seed`, each stream 2¹²⁸ draws after the
+/// previous (`jump`), so batches never overlap.
+#[cfg(test)]
+fn batch_streams(seed: u64, batches: u32) -> Vec<Xoshiro256StarStar> {
+    next_streams(&mut Xoshiro256StarStar::seed_from_u64(seed), batches)
 }

@@ -250,45 +250,112 @@ impl McResult {
     }
 
     /// Combine equally sized batch tallies, in batch order (bitwise independent of thread count).
+    #[cfg(test)]
     pub(crate) fn from_batches(tallies: &[BatchTally], specular: f64, grid: RadialGrid) -> Self {
-        let per = |f: fn(&BatchTally) -> f64| {
-            Estimate::from_batches(tallies.iter().map(move |t| f(t) / t.photons as f64))
-        };
-        let photons: u64 = tallies.iter().map(|t| t.photons).sum();
-        let np = photons as f64;
         let layers = tallies.first().map_or(0, |t| t.absorbed_by_layer.len());
-        let absorbed_by_layer = (0..layers)
-            .map(|l| tallies.iter().map(|t| t.absorbed_by_layer[l]).sum::<f64>() / np)
-            .collect();
-        let mut reflectance_per_mm2 = Vec::with_capacity(grid.bins());
-        let mut stderr = Vec::with_capacity(grid.bins());
-        for i in 0..grid.bins() {
-            let area = grid.annulus_area_mm2(i);
-            let e = Estimate::from_batches(
-                tallies
-                    .iter()
-                    .map(move |t| t.radial[i] / (t.photons as f64 * area)),
-            );
-            reflectance_per_mm2.push(e.mean);
-            stderr.push(e.stderr);
+        let mut acc = Combiner::new(layers, grid);
+        for t in tallies {
+            acc.add(t);
         }
+        acc.finish(specular)
+    }
+}
+
+/// Batch tallies folded in batch order as they finish, so memory does not grow with the batch
+/// count: per batch only its three scalar estimates are kept (24 bytes, for the two-pass standard
+/// errors of [`Estimate::from_batches`]); each annulus keeps a running sum for its mean and
+/// Welford's running sum of squared deviations for its standard error.
+pub(crate) struct Combiner {
+    grid: RadialGrid,
+    photons: u64,
+    batches: u32,
+    /// Per batch: diffuse reflectance, transmittance, absorbed, each per photon.
+    scalars: Vec<[f64; 3]>,
+    absorbed_by_layer: Vec<f64>,
+    roulette_balance: f64,
+    beyond_grid: f64,
+    interactions: f64,
+    /// Per annulus: Σ values, Welford's running mean and M2.
+    radial_sum: Vec<f64>,
+    radial_mean: Vec<f64>,
+    radial_m2: Vec<f64>,
+}
+
+impl Combiner {
+    pub fn new(layers: usize, grid: RadialGrid) -> Self {
+        let bins = grid.bins();
         Self {
-            photons,
-            batches: tallies.len() as u32,
-            diffuse_reflectance: per(|t| t.diffuse_reflectance),
+            grid,
+            photons: 0,
+            batches: 0,
+            scalars: Vec::new(),
+            absorbed_by_layer: vec![0.0; layers],
+            roulette_balance: 0.0,
+            beyond_grid: 0.0,
+            interactions: 0.0,
+            radial_sum: vec![0.0; bins],
+            radial_mean: vec![0.0; bins],
+            radial_m2: vec![0.0; bins],
+        }
+    }
+
+    /// Fold in the next batch (batches must come in batch order for reproducible bits).
+    pub fn add(&mut self, t: &BatchTally) {
+        let np = t.photons as f64;
+        self.photons += t.photons;
+        self.batches += 1;
+        self.scalars.push([
+            t.diffuse_reflectance / np,
+            t.transmittance / np,
+            t.absorbed() / np,
+        ]);
+        for (a, b) in self.absorbed_by_layer.iter_mut().zip(&t.absorbed_by_layer) {
+            *a += b;
+        }
+        self.roulette_balance += t.roulette_balance;
+        self.beyond_grid += t.beyond_grid;
+        self.interactions += t.interactions as f64;
+        let k = f64::from(self.batches);
+        for i in 0..self.grid.bins() {
+            let v = t.radial[i] / (np * self.grid.annulus_area_mm2(i));
+            self.radial_sum[i] += v;
+            let delta = v - self.radial_mean[i];
+            self.radial_mean[i] += delta / k;
+            self.radial_m2[i] += delta * (v - self.radial_mean[i]);
+        }
+    }
+
+    pub fn finish(self, specular: f64) -> McResult {
+        let np = self.photons as f64;
+        let n = f64::from(self.batches);
+        let per = |c: usize| Estimate::from_batches(self.scalars.iter().map(move |s| s[c]));
+        let stderr = self
+            .radial_m2
+            .iter()
+            .map(|m2| {
+                if self.batches > 1 {
+                    (m2 / ((n - 1.0) * n)).sqrt()
+                } else {
+                    f64::NAN
+                }
+            })
+            .collect();
+        McResult {
+            photons: self.photons,
+            batches: self.batches,
+            diffuse_reflectance: per(0),
             specular_reflectance: specular,
-            transmittance: per(|t| t.transmittance),
-            absorbed: per(BatchTally::absorbed),
-            absorbed_by_layer,
-            roulette_balance: tallies.iter().map(|t| t.roulette_balance).sum::<f64>() / np,
+            transmittance: per(1),
+            absorbed: per(2),
+            absorbed_by_layer: self.absorbed_by_layer.iter().map(|a| a / np).collect(),
+            roulette_balance: self.roulette_balance / np,
             radial: RadialProfile {
-                grid,
-                reflectance_per_mm2,
+                grid: self.grid,
+                reflectance_per_mm2: self.radial_sum.iter().map(|s| s / n).collect(),
                 stderr,
-                beyond_grid: tallies.iter().map(|t| t.beyond_grid).sum::<f64>() / np,
+                beyond_grid: self.beyond_grid / np,
             },
-            interactions_per_photon: tallies.iter().map(|t| t.interactions as f64).sum::<f64>()
-                / np,
+            interactions_per_photon: self.interactions / np,
         }
     }
 }
@@ -296,6 +363,25 @@ impl McResult {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn running_radial_errors_match_the_two_pass_formula() {
+        // Welford's update must give the same standard error as Σ(v − mean)² over stored values.
+        let grid = RadialGrid::new(1.0, 1).unwrap();
+        let area = grid.annulus_area_mm2(0);
+        let values = [0.3, 0.1, 0.7, 0.2, 0.5];
+        let mut c = Combiner::new(1, grid);
+        for v in values {
+            let mut t = BatchTally::new(1, 1);
+            t.photons = 10;
+            t.radial[0] = v * 10.0 * area;
+            c.add(&t);
+        }
+        let r = c.finish(0.0);
+        let want = Estimate::from_batches(values.into_iter());
+        assert!((r.radial.reflectance_per_mm2[0] - want.mean).abs() < 1e-15);
+        assert!((r.radial.stderr[0] - want.stderr).abs() < 1e-15);
+    }
 
     #[test]
     fn estimate_of_known_values() {
