@@ -21,6 +21,7 @@
 //! Symbols: `sigma_a` σa (mm⁻¹), `sigma_s` σs (mm⁻¹, not reduced), `g` HG anisotropy, `albedo` a = σs/σt,
 //! `tau` optical thickness σt·d, `eta` refractive index of the stack, `mu` μ = cos θ inside the stack.
 
+mod eigen;
 mod layer;
 mod matrix;
 mod modes;

@@ -15,6 +15,7 @@
 //! R̂ = (G₋ − G₊ E Γ E) N⁻¹, T̂ = (G₊ E − G₋ Γ E) N⁻¹, and for τ → ∞ simply R̂ = G₋ G₊⁻¹.
 //! Every exponential is a decaying one, so thick layers are as stable as thin ones.
 
+use super::eigen::symmetric_eigen;
 use super::layer::Angles;
 use super::matrix::{Mat, Singular};
 
@@ -46,7 +47,7 @@ pub(crate) fn layer_by_modes(
     });
     let l = p.cholesky()?;
     let s = l.transpose_mul_symmetric(&q.mul(&l));
-    let (k2, y) = s.symmetric_eigen()?;
+    let (k2, y) = symmetric_eigen(&s)?;
     let k2_max = k2.iter().fold(0.0f64, |m, v| m.max(*v));
     if k2
         .iter()
