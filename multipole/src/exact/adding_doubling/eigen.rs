@@ -1,6 +1,9 @@
 //! Symmetric eigendecomposition of a small dense matrix: Householder reduction to tridiagonal form,
 //! then the implicit QL algorithm with shifts (the EISPACK `tred2`/`tql2` pair, as in JAMA), eigenvectors
 //! accumulated. Backward stable: eigenvalues to about ε‖A‖, eigenvectors orthonormal to rounding.
+//!
+//! Hand-written rather than nalgebra's `SymmetricEigen`: with it (and the `matrix` kernels on nalgebra)
+//! the adding-doubling totals took 6–24% more CPU time; see `matrix` and BENCHMARKS.md.
 
 use super::matrix::{Mat, Singular};
 
