@@ -1,5 +1,6 @@
 #![doc = include_str!("../README.md")]
 
 pub mod compare;
+pub mod shape_error;
 /// The layered Monte Carlo (owned by `multipole`, which uses it for exact profile shapes).
 pub use multipole::montecarlo;

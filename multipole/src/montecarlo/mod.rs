@@ -26,6 +26,7 @@ mod transport;
 pub use stack::{DEFAULT_SKIN_G, Layer, LayerStack, MAX_COEFFICIENT_PER_MM, MAX_THICKNESS_MM};
 pub use tally::{Estimate, McResult, RadialGrid, RadialProfile};
 pub use transport::{ROULETTE_SURVIVAL, ROULETTE_THRESHOLD};
+pub(crate) use transport::white::{WhiteMedium, trace_white};
 
 use crate::error::MultipoleError;
 use rand::SeedableRng;
@@ -147,7 +148,7 @@ pub fn run_with_progress(
 
 /// One generator per batch: xoshiro256** seeded from `seed`, each stream 2¹²⁸ draws after the
 /// previous (`jump`), so batches never overlap.
-fn batch_streams(seed: u64, batches: u32) -> Vec<Xoshiro256StarStar> {
+pub(crate) fn batch_streams(seed: u64, batches: u32) -> Vec<Xoshiro256StarStar> {
     let mut base = Xoshiro256StarStar::seed_from_u64(seed);
     (0..batches)
         .map(|_| {

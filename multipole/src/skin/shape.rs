@@ -71,13 +71,18 @@ pub enum ExactShape {
         /// Escaping photons wanted (≥ 100).
         escapes: u64,
     },
+    /// The same exact transport read from the universal white-Monte-Carlo table
+    /// ([`super::ShapeTable`], built once per (g, n) and cached): milliseconds per spectral set,
+    /// no run-time photons. Covers every skin whose layers share σs (dermis scattering scale 1),
+    /// any index and epidermal scattering depth σs·d in [`super::TABLE_TAU_MIN`],
+    /// [`super::TABLE_TAU_MAX`]; elsewhere it falls back to `MonteCarlo` with
+    /// [`DEFAULT_SHAPE_ESCAPES`]. The default.
+    Table(super::ShapeTableOptions),
 }
 
 impl Default for ExactShape {
     fn default() -> Self {
-        Self::MonteCarlo {
-            escapes: DEFAULT_SHAPE_ESCAPES,
-        }
+        Self::Table(super::ShapeTableOptions::default())
     }
 }
 
@@ -129,6 +134,14 @@ pub fn exact_profile(
         }
         ExactShape::MonteCarlo { escapes } => {
             let total = total_reflectance(skin, lambda, Method::Exact)?;
+            return shape_profile(&monte_carlo_shape(skin, lambda, escapes, total)?, total);
+        }
+        ExactShape::Table(table_opts) => {
+            let total = total_reflectance(skin, lambda, Method::Exact)?;
+            if let Some(p) = table_profile(skin, lambda, &table_opts, total)? {
+                return Ok(p);
+            }
+            let escapes = DEFAULT_SHAPE_ESCAPES;
             return shape_profile(&monte_carlo_shape(skin, lambda, escapes, total)?, total);
         }
     };
@@ -208,10 +221,43 @@ pub fn shape_radii() -> Result<Vec<f64>, MultipoleError> {
         .collect())
 }
 
+/// The [`ExactShape::Table`] profile of `skin` at `lambda` scaled to `total`, or `None` where the
+/// table does not cover the skin (layers of different σs, or σs·d or σa/σs outside the table).
+pub fn table_profile(
+    skin: &SkinParams,
+    lambda: Wavelength,
+    opts: &super::ShapeTableOptions,
+    total: f64,
+) -> Result<Option<Profile>, MultipoleError> {
+    let c = skin.coefficients(lambda);
+    if c.epidermis.sigma_s_prime != c.dermis.sigma_s_prime {
+        return Ok(None);
+    }
+    let table = super::cached_table(DEFAULT_SKIN_G, skin.eta(), opts)?;
+    let sigma_s = c.epidermis.sigma_s_prime / (1.0 - DEFAULT_SKIN_G);
+    table.profile(
+        sigma_s,
+        c.epidermis.sigma_a,
+        c.dermis.sigma_a,
+        skin.epidermis_thickness_mm(),
+        total,
+    )
+}
+
 /// A profile of total `total` from a shape on [`shape_radii`], cut after the node where the
 /// cumulative energy reaches 99.9%: like the multipole tables, the table holds 99.9% of `total`.
 pub fn shape_profile(shape: &[f64], total: f64) -> Result<Profile, MultipoleError> {
-    let radii = shape_radii()?;
+    profile_from_shape(&shape_radii()?, shape, total)
+}
+
+/// A profile of total `total` from mean values `shape` (mm⁻²) at nodes `radii` (mm; the
+/// [`shape_radii`] convention), cut after the node where the cumulative energy reaches 99.9%.
+pub(super) fn profile_from_shape(
+    radii: &[f64],
+    shape: &[f64],
+    total: f64,
+) -> Result<Profile, MultipoleError> {
+    let radii = radii.to_vec();
     // Total 1 so that `radius_for_energy(f)` is the radius where the table's cumulative reaches f.
     let full = Profile::from_table(radii.clone(), shape.to_vec(), 1.0)?;
     let integral = full.table_integral();
