@@ -55,7 +55,7 @@ pub struct ShapeTableOptions {
 impl Default for ShapeTableOptions {
     fn default() -> Self {
         Self {
-            photons: 2_000_000,
+            photons: 500_000,
             depths_per_octave: 4,
             radial_per_decade: 16,
             path_per_decade: 8,

@@ -38,11 +38,11 @@ pub(crate) fn trace_white(
 ) -> u64 {
     let hg = HgSampler::new(medium.g);
     let eta_out = 1.0 / medium.n;
-    let mut above = vec![0.0; depths.len()];
+    let mut split = DepthSplit::new(depths);
     let mut dropped = 0;
     for _ in 0..photons {
         let mut p = Photon::launched(1.0);
-        above.fill(0.0);
+        split.clear();
         let mut path = 0.0;
         loop {
             let s: f64 = Exp1.sample(rng);
@@ -51,7 +51,7 @@ pub(crate) fn trace_white(
                 // Reaches the face. The unused depth is not carried: the exponential step is
                 // memoryless, so a fresh draw after a reflection has the same distribution.
                 let d = -p.z / p.uz;
-                add_above(&mut above, depths, p.z, 0.0, d);
+                split.add(p.z, 0.0, d);
                 path += d;
                 p.x += d * p.ux;
                 p.y += d * p.uy;
@@ -61,10 +61,10 @@ pub(crate) fn trace_white(
                     p.uz = -p.uz;
                     continue;
                 }
-                on_escape((p.x * p.x + p.y * p.y).sqrt(), path, &above);
+                on_escape((p.x * p.x + p.y * p.y).sqrt(), path, split.above());
                 break;
             }
-            add_above(&mut above, depths, p.z, z_new, s);
+            split.add(p.z, z_new, s);
             path += s;
             p.x += s * p.ux;
             p.y += s * p.uy;
@@ -79,15 +79,54 @@ pub(crate) fn trace_white(
     dropped
 }
 
-/// Add to `above[t]` the part of a straight segment of length `len` from depth `za` to `zb` that
-/// lies above `depths[t]` (the fraction of the depth range above it: z is linear along the segment).
-#[inline(always)]
-fn add_above(above: &mut [f64], depths: &[f64], za: f64, zb: f64, len: f64) {
-    let (lo, hi) = if za < zb { (za, zb) } else { (zb, za) };
-    // A horizontal segment gives ±∞ (all or nothing); `max` maps the 0·∞ NaN at τ = lo to 0.
-    let inv = 1.0 / (hi - lo);
-    for (a, &tau) in above.iter_mut().zip(depths) {
-        *a += len * ((tau - lo) * inv).max(0.0).min(1.0);
+/// The part of a path above each of a sorted ladder of depths, accumulated segment by segment in
+/// O(log depths) per segment: a segment wholly above the depths from index k on adds its length to
+/// `from[k]` (summed over k at the end); only the depths it straddles get a partial length.
+struct DepthSplit<'a> {
+    depths: &'a [f64],
+    from: Vec<f64>,
+    partial: Vec<f64>,
+    above: Vec<f64>,
+}
+
+impl<'a> DepthSplit<'a> {
+    fn new(depths: &'a [f64]) -> Self {
+        debug_assert!(depths.windows(2).all(|w| w[0] <= w[1]));
+        Self {
+            depths,
+            from: vec![0.0; depths.len() + 1],
+            partial: vec![0.0; depths.len()],
+            above: vec![0.0; depths.len()],
+        }
+    }
+
+    fn clear(&mut self) {
+        self.from.fill(0.0);
+        self.partial.fill(0.0);
+    }
+
+    /// A straight segment of length `len` from depth `za` to `zb`: z is linear along it, so the
+    /// part above depth τ is len × (τ − lo)/(hi − lo) clamped to [0, 1].
+    #[inline(always)]
+    fn add(&mut self, za: f64, zb: f64, len: f64) {
+        let (lo, hi) = if za < zb { (za, zb) } else { (zb, za) };
+        let first = self.depths.partition_point(|&t| t <= lo);
+        let full = first + self.depths[first..].partition_point(|&t| t < hi);
+        self.from[full] += len;
+        let inv = 1.0 / (hi - lo);
+        for t in first..full {
+            self.partial[t] += len * ((self.depths[t] - lo) * inv).clamp(0.0, 1.0);
+        }
+    }
+
+    /// The path above each depth so far.
+    fn above(&mut self) -> &[f64] {
+        let mut run = 0.0;
+        for t in 0..self.depths.len() {
+            run += self.from[t];
+            self.above[t] = run + self.partial[t];
+        }
+        &self.above
     }
 }
 
@@ -98,13 +137,18 @@ mod tests {
 
     #[test]
     fn segment_split_at_a_depth() {
-        let mut above = [0.0; 3];
-        add_above(&mut above, &[0.5, 1.0, 3.0], 0.0, 2.0, 4.0);
+        let mut split = DepthSplit::new(&[0.5, 1.0, 3.0]);
+        split.add(0.0, 2.0, 4.0);
         // z runs 0 → 2 over length 4: 1/4, 1/2 and all of it lie above depths 0.5, 1, 3.
-        assert_eq!(above, [1.0, 2.0, 4.0]);
-        let mut flat = [0.0; 2];
-        add_above(&mut flat, &[0.5, 2.0], 1.0, 1.0, 3.0);
-        assert_eq!(flat, [0.0, 3.0]);
+        assert_eq!(split.above(), [1.0, 2.0, 4.0]);
+        // Back up from 2 to 1.5 over length 1: above 3 only; then a horizontal move at z = 1
+        // (neither above nor below depth 1: the depth test is z < τ, so it counts below).
+        split.add(2.0, 1.5, 1.0);
+        split.add(1.0, 1.0, 3.0);
+        assert_eq!(split.above(), [1.0, 2.0, 8.0]);
+        split.clear();
+        split.add(0.7, 0.7, 2.0);
+        assert_eq!(split.above(), [0.0, 2.0, 2.0]);
     }
 
     #[test]
