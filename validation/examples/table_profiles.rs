@@ -39,7 +39,11 @@ struct Case {
 
 fn main() -> anyhow::Result<()> {
     let mut args = std::env::args().skip(1);
-    let mc_photons: u64 = args.next().map(|s| s.parse()).transpose()?.unwrap_or(1_000_000);
+    let mc_photons: u64 = args
+        .next()
+        .map(|s| s.parse())
+        .transpose()?
+        .unwrap_or(1_000_000);
     let out = args.next().unwrap_or_else(|| "out/table_knobs.csv".into());
     let grid = RadialGrid::new(0.02, 300)?;
     let mut cases = Vec::new();
@@ -67,31 +71,62 @@ fn main() -> anyhow::Result<()> {
         settings.push(("photons", ShapeTableOptions { photons, ..d }));
     }
     for depths_per_octave in [1, 2, 8] {
-        settings.push(("depths_per_octave", ShapeTableOptions { depths_per_octave, ..d }));
+        settings.push((
+            "depths_per_octave",
+            ShapeTableOptions {
+                depths_per_octave,
+                ..d
+            },
+        ));
     }
     for radial_per_decade in [8, 32] {
-        settings.push(("radial_per_decade", ShapeTableOptions { radial_per_decade, ..d }));
+        settings.push((
+            "radial_per_decade",
+            ShapeTableOptions {
+                radial_per_decade,
+                ..d
+            },
+        ));
     }
     for path_per_decade in [4, 16] {
-        settings.push(("path_per_decade", ShapeTableOptions { path_per_decade, ..d }));
+        settings.push((
+            "path_per_decade",
+            ShapeTableOptions {
+                path_per_decade,
+                ..d
+            },
+        ));
     }
     if let Some(dir) = std::path::Path::new(&out).parent() {
         std::fs::create_dir_all(dir)?;
     }
     let mut csv = std::fs::File::create(&out)?;
-    write!(csv, "knob,photons,depths_per_octave,radial_per_decade,path_per_decade,build_cpu_s,eval_ms")?;
+    write!(
+        csv,
+        "knob,photons,depths_per_octave,radial_per_decade,path_per_decade,build_cpu_s,eval_ms"
+    )?;
     for c in &cases {
         write!(csv, ",{}", c.name.replace(' ', "_"))?;
     }
     writeln!(csv, ",worst")?;
     println!(
         "| knob | photons | depths/oct | radial/dec | path/dec | build CPU-s | eval ms | {} | worst |",
-        cases.iter().map(|c| c.name.as_str()).collect::<Vec<_>>().join(" | ")
+        cases
+            .iter()
+            .map(|c| c.name.as_str())
+            .collect::<Vec<_>>()
+            .join(" | ")
     );
     println!("|{}", " --- |".repeat(8 + cases.len()));
     for (knob, o) in settings {
         let cpu0 = process_cpu_s();
-        let table = ShapeTable::build(DEFAULT_SKIN_G, 1.4, &o, rayon::current_num_threads(), |_| {})?;
+        let table = ShapeTable::build(
+            DEFAULT_SKIN_G,
+            1.4,
+            &o,
+            rayon::current_num_threads(),
+            |_| {},
+        )?;
         let build = process_cpu_s() - cpu0;
         let mut times = Vec::new();
         let mut errs = Vec::new();
@@ -121,7 +156,10 @@ fn main() -> anyhow::Result<()> {
             o.depths_per_octave,
             o.radial_per_decade,
             o.path_per_decade,
-            errs.iter().map(|e| format!("{:.2}%", 100.0 * e)).collect::<Vec<_>>().join(" | "),
+            errs.iter()
+                .map(|e| format!("{:.2}%", 100.0 * e))
+                .collect::<Vec<_>>()
+                .join(" | "),
             100.0 * worst
         );
     }
@@ -129,7 +167,10 @@ fn main() -> anyhow::Result<()> {
         .iter()
         .map(|c| format!("{}: {:.2}%", c.name, 100.0 * energy_error_noise(&c.mc)))
         .collect();
-    println!("reference noise (expected error of a perfect model): {}", noise.join(", "));
+    println!(
+        "reference noise (expected error of a perfect model): {}",
+        noise.join(", ")
+    );
     Ok(())
 }
 

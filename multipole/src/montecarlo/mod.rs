@@ -25,8 +25,8 @@ mod transport;
 
 pub use stack::{DEFAULT_SKIN_G, Layer, LayerStack, MAX_COEFFICIENT_PER_MM, MAX_THICKNESS_MM};
 pub use tally::{Estimate, McResult, RadialGrid, RadialProfile};
-pub use transport::{ROULETTE_SURVIVAL, ROULETTE_THRESHOLD};
 pub(crate) use transport::white::{WhiteMedium, trace_white};
+pub use transport::{ROULETTE_SURVIVAL, ROULETTE_THRESHOLD};
 
 use crate::error::MultipoleError;
 use rand::SeedableRng;

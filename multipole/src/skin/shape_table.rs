@@ -156,7 +156,10 @@ impl ShapeTable {
                     })
                 })
                 .collect();
-            workers.into_iter().map(|w| w.join()).collect::<Result<_, _>>()
+            workers
+                .into_iter()
+                .map(|w| w.join())
+                .collect::<Result<_, _>>()
         })
         .map_err(|_| MultipoleError::McStack("shape table worker panicked".into()))?;
         let mut table = table;
@@ -224,7 +227,9 @@ impl ShapeTable {
     #[must_use]
     pub fn shape(&self, alpha_top: f64, alpha_bottom: f64, tau: f64) -> Option<Vec<f64>> {
         let covered = |a: f64| a.is_finite() && a >= TABLE_MIN_ALPHA;
-        if !(covered(alpha_top) && covered(alpha_bottom) && (TABLE_TAU_MIN..=TABLE_TAU_MAX).contains(&tau))
+        if !(covered(alpha_top)
+            && covered(alpha_bottom)
+            && (TABLE_TAU_MIN..=TABLE_TAU_MAX).contains(&tau))
         {
             return None;
         }

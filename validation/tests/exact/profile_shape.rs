@@ -6,11 +6,11 @@
 //! The reference's own noise adds about Σ √(2/π) σ_annulus / R_mc, which is printed on failure; the
 //! diffusion shapes miss by 25–30% (light) and 60–75% (dark), so a fallback to them fails.
 
-use multipole::skin::{Method, profile};
 use multipole::ProfileOptions;
-use validation::shape_error::energy_error;
+use multipole::skin::{Method, profile};
 use skin_optics::{Preset, SkinParams, Wavelength};
 use validation::montecarlo::{DEFAULT_SKIN_G, LayerStack, McOptions, RadialGrid, run};
+use validation::shape_error::energy_error;
 
 fn check(preset: Preset, nm: f64, photons: u64) {
     let skin = SkinParams::preset(preset);

@@ -87,7 +87,10 @@ mod tests {
         for x in [0.0, 0.005, 0.01, 0.0137, 1.0, 77.0, 9_999.0] {
             let i = a.bin(x).unwrap();
             let (lo, hi) = a.edges(i);
-            assert!(lo <= x * (1.0 + 1e-12) && x < hi * (1.0 + 1e-12), "{x} in [{lo}, {hi})");
+            assert!(
+                lo <= x * (1.0 + 1e-12) && x < hi * (1.0 + 1e-12),
+                "{x} in [{lo}, {hi})"
+            );
         }
         assert_eq!(a.bin(2.0e4), None);
     }
@@ -111,7 +114,10 @@ mod tests {
                     .sum::<f64>()
                     / m as f64;
                 if alpha * hi < 10.0 {
-                    assert!((f64::from(f[i]) - brute).abs() <= 1e-6 * brute + 1e-7, "{alpha} {i}");
+                    assert!(
+                        (f64::from(f[i]) - brute).abs() <= 1e-6 * brute + 1e-7,
+                        "{alpha} {i}"
+                    );
                 }
             }
         }

@@ -16,7 +16,11 @@ const MAGIC: &[u8; 8] = b"SKINSHT1";
 /// `$HOME/.cache/skin`; `None` when none is set (tables then live only in memory).
 #[must_use]
 pub fn cache_dir() -> Option<PathBuf> {
-    let var = |k: &str| std::env::var_os(k).filter(|v| !v.is_empty()).map(PathBuf::from);
+    let var = |k: &str| {
+        std::env::var_os(k)
+            .filter(|v| !v.is_empty())
+            .map(PathBuf::from)
+    };
     var("SKIN_CACHE_DIR")
         .or_else(|| var("XDG_CACHE_HOME").map(|d| d.join("skin")))
         .or_else(|| var("HOME").map(|d| d.join(".cache").join("skin")))
