@@ -32,9 +32,10 @@ pub struct SceneOptions {
     /// Shade skin's body with the Lambertian stand-in instead of the BSSRDF (for comparisons;
     /// default false: subsurface scattering on).
     pub no_subsurface: bool,
-    /// Escaping photons per Monte Carlo profile shape (`Method::Exact`; default
-    /// [`crate::bssrdf::RENDER_SHAPE_ESCAPES`]).
-    pub shape_escapes: u64,
+    /// Escaping photons per Monte Carlo profile shape (`Method::Exact`), or `None` (the default)
+    /// for the shapes of the universal table (`multipole::skin::ExactShape::Table`: no run-time
+    /// photons, built once per machine and cached).
+    pub shape_escapes: Option<u64>,
 }
 
 impl Default for SceneOptions {
@@ -42,7 +43,7 @@ impl Default for SceneOptions {
         Self {
             method: multipole::Method::default(),
             no_subsurface: false,
-            shape_escapes: crate::bssrdf::RENDER_SHAPE_ESCAPES,
+            shape_escapes: None,
         }
     }
 }
@@ -509,9 +510,9 @@ impl Loader<'_> {
     /// directional term with the surface lobe's energy split.
     fn subsurface(&self, key: &str, skin: &SkinMaterial) -> Result<Subsurface, RenderError> {
         let mut opts = TableOptions::default();
-        opts.profile.exact_shape = multipole::skin::ExactShape::MonteCarlo {
-            escapes: self.opts.shape_escapes,
-        };
+        if let Some(escapes) = self.opts.shape_escapes {
+            opts.profile.exact_shape = multipole::skin::ExactShape::MonteCarlo { escapes };
+        }
         let table = ProfileTable::build(&skin.params, self.opts.method, &opts)
             .map_err(|e| self.err(key, format!("skin profiles: {e}")))?;
         let directional = Directional::new(skin.surface.clone(), EnergySplit::default());

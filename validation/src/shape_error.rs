@@ -5,16 +5,12 @@
 use multipole::Profile;
 use multipole::montecarlo::McResult;
 
-/// ∫ 2πr R(r) dr over [a, b] (mm) by the midpoint rule on 16 sub-intervals.
+/// ∫ 2πr R(r) dr over [a, b] (mm), exact in the profile's own model between its nodes
+/// (`Profile::energy_within_mm`): a quadrature of `eval` would miss peaks narrower than its step
+/// (dark skin reflects most of its light within 0.005 mm, inside the first 0.02 mm annulus).
 #[must_use]
 pub fn annulus_energy(p: &Profile, a: f64, b: f64) -> f64 {
-    let h = (b - a) / 16.0;
-    (0..16)
-        .map(|k| {
-            let r = a + (k as f64 + 0.5) * h;
-            2.0 * std::f64::consts::PI * r * p.eval(r) * h
-        })
-        .sum()
+    p.energy_within_mm(b) - p.energy_within_mm(a)
 }
 
 /// (energy-weighted error, expected contribution of the run's noise) of `p` against `mc`.
