@@ -44,12 +44,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 SpectralProfiles::new(&skin, &grid, method, &opts)?; // warm the shared tables
                 let (t, c) = (Instant::now(), thread_cpu_ns());
                 for _ in 0..n {
-                    std::hint::black_box(SpectralProfiles::new(
-                        &skin,
-                        &grid,
-                        method,
-                        &opts,
-                    )?);
+                    std::hint::black_box(SpectralProfiles::new(&skin, &grid, method, &opts)?);
                 }
                 let cpu = match (c, thread_cpu_ns()) {
                     (Some(a), Some(b)) => Some((b - a) as f64 / n as f64 / 1e6),

@@ -67,10 +67,10 @@ fn main() -> anyhow::Result<()> {
     }
     let d = ShapeTableOptions::default();
     let mut settings = vec![("default", d)];
-    for photons in [50_000, 200_000, 1_000_000, 2_000_000] {
+    for photons in [50_000, 200_000, 1_000_000] {
         settings.push(("photons", ShapeTableOptions { photons, ..d }));
     }
-    for depths_per_octave in [1, 2, 8] {
+    for depths_per_octave in [1, 2] {
         settings.push((
             "depths_per_octave",
             ShapeTableOptions {
@@ -88,7 +88,7 @@ fn main() -> anyhow::Result<()> {
             },
         ));
     }
-    for path_per_decade in [4, 16] {
+    for path_per_decade in [4] {
         settings.push((
             "path_per_decade",
             ShapeTableOptions {

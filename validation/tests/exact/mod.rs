@@ -42,3 +42,4 @@ fn exact_matches_monte_carlo_dark_550_nm() {
 
 mod profile_shape;
 mod random_skins;
+mod table_shapes;

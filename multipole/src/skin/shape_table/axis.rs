@@ -53,7 +53,8 @@ impl LogAxis {
     }
 
     /// Mean of e^(−αx) over each bin for x spread evenly in ln x within the bin (3-point
-    /// Gauss–Legendre in ln x; the first bin, x₀ small, at its middle).
+    /// Gauss–Legendre in ln x). The first bin counts as x = 0 (factor 1): it holds the many exact
+    /// zeros (paths that never reach a depth), and the rest are off by at most αx₀.
     pub(super) fn mean_exp(&self, alpha: f64) -> Vec<f32> {
         const NODES: [(f64, f64); 3] = [
             (-0.774_596_669_241_483_4, 5.0 / 18.0),
@@ -63,7 +64,7 @@ impl LogAxis {
         (0..self.bins)
             .map(|i| {
                 if i == 0 {
-                    return (-alpha * 0.5 * self.x0).exp() as f32;
+                    return 1.0;
                 }
                 let (lo, _) = self.edges(i);
                 let mid = lo.ln() + 0.5 * self.ln_q;
