@@ -8,7 +8,7 @@
 //! `cargo run --release -p validation --example table_profiles [MC_PHOTONS [OUT.csv]]`
 //! (default 10⁶ photons per reference, `out/table_knobs.csv`).
 
-use multipole::montecarlo::{DEFAULT_SKIN_G, LayerStack, McOptions, McResult, RadialGrid, run};
+use multipole::montecarlo::{DEFAULT_G, LayeredMedium, McOptions, McResult, RadialGrid, run};
 use multipole::skin::{Method, ShapeTable, ShapeTableOptions, total_reflectance};
 use skin_optics::{Preset, SkinParams, Wavelength};
 use std::io::Write;
@@ -52,11 +52,11 @@ fn main() -> anyhow::Result<()> {
             let skin = SkinParams::preset(preset);
             let lambda = Wavelength::new(nm)?;
             let c = skin.coefficients(lambda);
-            let stack = LayerStack::skin(&skin, lambda, DEFAULT_SKIN_G)?;
+            let stack = LayeredMedium::skin(&skin, lambda, DEFAULT_G)?;
             let mc = run(&stack, &McOptions::new(mc_photons, 32, 7)?.with_grid(grid));
             cases.push(Case {
                 name: format!("{} {nm}", preset.name()),
-                sigma_s: c.epidermis.sigma_s_prime / (1.0 - DEFAULT_SKIN_G),
+                sigma_s: c.epidermis.sigma_s_prime / (1.0 - DEFAULT_G),
                 sigma_a: (c.epidermis.sigma_a, c.dermis.sigma_a),
                 d_mm: skin.epidermis_thickness_mm(),
                 total: total_reflectance(&skin, lambda, Method::Exact)?,
@@ -120,13 +120,7 @@ fn main() -> anyhow::Result<()> {
     println!("|{}", " --- |".repeat(8 + cases.len()));
     for (knob, o) in settings {
         let cpu0 = process_cpu_s();
-        let table = ShapeTable::build(
-            DEFAULT_SKIN_G,
-            1.4,
-            &o,
-            rayon::current_num_threads(),
-            |_| {},
-        )?;
+        let table = ShapeTable::build(DEFAULT_G, 1.4, &o, rayon::current_num_threads(), |_| {})?;
         let build = process_cpu_s() - cpu0;
         let mut times = Vec::new();
         let mut errs = Vec::new();

@@ -11,9 +11,9 @@
 //! (`## Exact profile table`).
 
 use super::shape::profile_from_shape;
+use crate::diffusion::profile::Profile;
 use crate::error::MultipoleError;
-use crate::montecarlo::{WhiteMedium, batch_streams, trace_white};
-use crate::profile::Profile;
+use crate::exact::montecarlo::{WhiteMedium, batch_streams, trace_white};
 use std::sync::atomic::{AtomicU64, Ordering};
 
 mod axis;
@@ -161,7 +161,7 @@ impl ShapeTable {
                 .map(|w| w.join())
                 .collect::<Result<_, _>>()
         })
-        .map_err(|_| MultipoleError::McStack("shape table worker panicked".into()))?;
+        .map_err(|_| MultipoleError::Layers("shape table worker panicked".into()))?;
         let mut table = table;
         for part in partials {
             for (c, p) in table.counts.iter_mut().zip(part) {

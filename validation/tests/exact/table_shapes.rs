@@ -16,7 +16,7 @@ use multipole::skin::{ExactShape, Method, ShapeTableOptions, exact_profile, tota
 use proptest::prelude::*;
 use proptest::test_runner::RngSeed;
 use skin_optics::{SkinParams, Wavelength};
-use validation::montecarlo::{DEFAULT_SKIN_G, LayerStack, McOptions, RadialGrid, run};
+use validation::montecarlo::{DEFAULT_G, LayeredMedium, McOptions, RadialGrid, run};
 use validation::shape_error::energy_error;
 
 proptest! {
@@ -45,7 +45,7 @@ proptest! {
         prop_assert!((0.999 - 1e-9..=1.0 + 1e-9).contains(&held), "holds {}", held);
         let observable = multipole::skin::diffuse_reflectance(&skin, lambda, Method::Exact).expect("R");
         let photons = ((30_000.0 / observable) as u64).clamp(100_000, 2_000_000);
-        let stack = LayerStack::skin(&skin, lambda, DEFAULT_SKIN_G).expect("stack");
+        let stack = LayeredMedium::skin(&skin, lambda, DEFAULT_G).expect("stack");
         let grid = RadialGrid::new(0.02, 300).expect("grid");
         let mc = run(&stack, &McOptions::new(photons, 16, 99).expect("options").with_grid(grid));
         let (err, noise) = energy_error(&p, &mc);
