@@ -88,7 +88,7 @@ fn main() -> anyhow::Result<()> {
             },
         ));
     }
-    for path_per_decade in [4] {
+    for path_per_decade in [4, 16] {
         settings.push((
             "path_per_decade",
             ShapeTableOptions {

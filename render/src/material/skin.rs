@@ -22,10 +22,12 @@ use thiserror::Error;
 /// Wavelength step of the skin reflectance tables computed at load, nm (interpolated to 5 nm).
 pub const SKIN_TABLE_STEP_NM: f64 = 10.0;
 
-/// Knobs of every skin material of a scene, chosen once when it is loaded.
-#[derive(Debug, Clone, Copy)]
+/// Knobs of every skin material of a scene, chosen once when it is loaded (default: exact
+/// method, subsurface on, table shapes).
+#[derive(Debug, Clone, Copy, Default)]
 pub struct SkinKnobs {
-    /// How skin reflectance is computed (default exact: adding-doubling totals, exact shapes from the universal table).
+    /// How skin reflectance is computed (default exact: adding-doubling totals, exact shapes from
+    /// the universal table).
     pub method: multipole::Method,
     /// Shade skin's body with the Lambertian stand-in instead of the BSSRDF (for comparisons;
     /// default false: subsurface scattering on).
@@ -34,16 +36,6 @@ pub struct SkinKnobs {
     /// for the shapes of the universal table (`multipole::skin::ExactShape::Table`: no run-time
     /// photons, built once per machine and cached).
     pub shape_escapes: Option<u64>,
-}
-
-impl Default for SkinKnobs {
-    fn default() -> Self {
-        Self {
-            method: multipole::Method::default(),
-            no_subsurface: false,
-            shape_escapes: None,
-        }
-    }
 }
 
 /// Why a skin material could not be built.
