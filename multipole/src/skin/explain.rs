@@ -203,7 +203,7 @@ mod tests {
         assert!(
             text.contains("adding-doubling")
                 && text.contains("dermis R ×")
-                && text.contains("layered Monte Carlo"),
+                && text.contains("white Monte Carlo table"),
             "{text}"
         );
         // The final correction of the per-layer profile is small (the scalars ignore angles only).
