@@ -60,6 +60,27 @@ pub fn invert<T: Float>(radii: &[T], p: &[T], cdf: &[T], target: T) -> T {
     r0 + t.max(T::zero()).min(h)
 }
 
+/// ∫₀^r p dr (`r` in mm) in the linear model, between the node values of `cdf`: 0 at or below 0
+/// (and for NaN), the table's integral at or beyond the last radius.
+pub fn cumulative_at<T: Float>(radii: &[T], p: &[T], cdf: &[T], r: T) -> T {
+    let n = radii.len();
+    if r.is_nan() || r <= T::zero() {
+        return T::zero();
+    }
+    if r >= radii[n - 1] {
+        return cdf[n - 1];
+    }
+    let i = radii.partition_point(|&x| x < r);
+    let (r0, c0, p0) = if i == 0 {
+        (T::zero(), T::zero(), T::zero())
+    } else {
+        (radii[i - 1], cdf[i - 1], p[i - 1])
+    };
+    let (h, t) = (radii[i] - r0, r - r0);
+    let half = T::from(0.5).unwrap_or_else(T::zero);
+    c0 + p0 * t + half * (p[i] - p0) * t * t / h
+}
+
 /// The density p at `r` (mm): linear between nodes, linear from 0 below the first radius, 0 for
 /// NaN, negative `r` or beyond the last radius.
 pub fn density<T: Float>(radii: &[T], p: &[T], r: T) -> T {

@@ -53,8 +53,9 @@ fn prints_csv_with_the_requested_samples() {
     .unwrap();
     assert!((rows[63].0 - p.r_max_mm()).abs() <= 1e-6 * p.r_max_mm());
     for (r, v) in &rows {
-        let pv = p.eval(*r);
-        // r is printed to 7 digits: where R falls steeply that moves R(r) by up to ~1e-5.
+        // r is printed to 7 digits: where R falls steeply that moves R(r) by up to ~1e-5, and the
+        // last radius may round past the table's end (where eval is 0).
+        let pv = p.eval(r.min(p.r_max_mm()));
         assert!(
             (v - pv).abs() <= 1e-4 * pv.max(1e-300),
             "r {r}: {v} vs {pv}"
@@ -139,4 +140,59 @@ fn plot_writes_a_png() {
     let bytes = std::fs::read(&png).unwrap();
     assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n");
     std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn spectral_set_has_a_lambda_column_for_both_methods() {
+    for method in ["exact", "multipole"] {
+        let out = skin(&[
+            "--preset",
+            "light",
+            "--from",
+            "400",
+            "--to",
+            "700",
+            "--step",
+            "50",
+            "--samples",
+            "16",
+            "--method",
+            method,
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let text = String::from_utf8(out.stdout).unwrap();
+        let mut lines = text.lines();
+        assert_eq!(lines.next(), Some("lambda_nm,r_mm,reflectance_per_mm2"));
+        let rows: Vec<Vec<f64>> = lines
+            .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+            .collect();
+        // 400, 450, …, 700: 7 wavelengths × 16 radii, in wavelength order.
+        assert_eq!(rows.len(), 7 * 16);
+        for (k, chunk) in rows.chunks(16).enumerate() {
+            assert!(chunk.iter().all(|r| r[0] == 400.0 + 50.0 * k as f64));
+            assert!(chunk.iter().all(|r| r[2].is_finite() && r[2] >= 0.0));
+        }
+    }
+    // --lambda and --from exclude each other; --from needs --to.
+    assert!(
+        !skin(&[
+            "--preset", "light", "--lambda", "550", "--from", "400", "--to", "500"
+        ])
+        .status
+        .success()
+    );
+    assert!(
+        !skin(&["--preset", "light", "--from", "400"])
+            .status
+            .success()
+    );
+    assert!(
+        !skin(&["--preset", "light", "--from", "500", "--to", "400"])
+            .status
+            .success()
+    );
 }

@@ -2,5 +2,6 @@
 
 pub mod compare;
 pub mod mcml;
+pub mod shape_error;
 /// The layered Monte Carlo (owned by `multipole`, which uses it for exact profile shapes).
 pub use multipole::montecarlo;

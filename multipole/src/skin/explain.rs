@@ -85,6 +85,12 @@ impl fmt::Display for Explanation {
                     (Some(ExactShape::RescaledTotal), _) => {
                         f.write_str("; profile = multipole shape scaled to the exact total")?;
                     }
+                    (Some(ExactShape::Table(o)), _) => write!(
+                        f,
+                        "; profile shape = universal white Monte Carlo table ({} photons, exact transport; \
+                         a layered Monte Carlo shape where the table does not cover the skin), scaled to the exact total",
+                        o.photons
+                    )?,
                     _ => {}
                 }
                 if let Some((s, c)) = self.profile_scales {
@@ -197,7 +203,7 @@ mod tests {
         assert!(
             text.contains("adding-doubling")
                 && text.contains("dermis R ×")
-                && text.contains("layered Monte Carlo"),
+                && text.contains("white Monte Carlo table"),
             "{text}"
         );
         // The final correction of the per-layer profile is small (the scalars ignore angles only).

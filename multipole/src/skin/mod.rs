@@ -15,11 +15,16 @@ use std::str::FromStr;
 
 mod explain;
 mod shape;
+mod shape_table;
 pub use explain::{DIFFUSION_OK, Explanation, explain};
 pub use shape::{
     DEFAULT_SHAPE_ESCAPES, ExactShape, MAX_SHAPE_PHOTONS, SHAPE_BINS, SHAPE_R_MAX_MM, SHAPE_R0_MM,
-    SHAPE_SEED, exact_profile, layer_scales, monte_carlo_shape, shape_photons, shape_profile,
-    shape_radii,
+    SHAPE_SEED, exact_profile, layer_scales, medium_table_profile, monte_carlo_shape,
+    shape_photons, shape_profile, shape_radii, table_profile,
+};
+pub use shape_table::{
+    ShapeTable, ShapeTableOptions, TABLE_MAX_PATH, TABLE_MIN_ALPHA, TABLE_TAU_MAX, TABLE_TAU_MIN,
+    cache_dir, cached_table,
 };
 
 /// How the skin's diffuse reflectance is computed.

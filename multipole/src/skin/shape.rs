@@ -72,13 +72,18 @@ pub enum ExactShape {
         /// Escaping photons wanted (≥ 100).
         escapes: u64,
     },
+    /// The same exact transport read from the universal white-Monte-Carlo table
+    /// ([`super::ShapeTable`], built once per (g, n) and cached): milliseconds per spectral set,
+    /// no run-time photons. Covers every skin whose layers share σs (dermis scattering scale 1),
+    /// any index and epidermal scattering depth σs·d in [`super::TABLE_TAU_MIN`],
+    /// [`super::TABLE_TAU_MAX`]; elsewhere it falls back to `MonteCarlo` with
+    /// [`DEFAULT_SHAPE_ESCAPES`]. The default.
+    Table(super::ShapeTableOptions),
 }
 
 impl Default for ExactShape {
     fn default() -> Self {
-        Self::MonteCarlo {
-            escapes: DEFAULT_SHAPE_ESCAPES,
-        }
+        Self::Table(super::ShapeTableOptions::default())
     }
 }
 
@@ -130,6 +135,14 @@ pub fn exact_profile(
         }
         ExactShape::MonteCarlo { escapes } => {
             let total = total_reflectance(skin, lambda, Method::Exact)?;
+            return shape_profile(&monte_carlo_shape(skin, lambda, escapes, total)?, total);
+        }
+        ExactShape::Table(table_opts) => {
+            let total = total_reflectance(skin, lambda, Method::Exact)?;
+            if let Some(p) = table_profile(skin, lambda, &table_opts, total)? {
+                return Ok(p);
+            }
+            let escapes = DEFAULT_SHAPE_ESCAPES;
             return shape_profile(&monte_carlo_shape(skin, lambda, escapes, total)?, total);
         }
     };
@@ -211,10 +224,54 @@ pub fn shape_radii() -> Result<Vec<f64>, MultipoleError> {
         .collect())
 }
 
+/// The [`ExactShape::Table`] profile of `skin` at `lambda` scaled to `total`, or `None` where the
+/// table does not cover the skin.
+pub fn table_profile(
+    skin: &SkinParams,
+    lambda: Wavelength,
+    opts: &super::ShapeTableOptions,
+    total: f64,
+) -> Result<Option<Profile>, MultipoleError> {
+    medium_table_profile(&LayeredMedium::skin(skin, lambda, DEFAULT_G)?, opts, total)
+}
+
+/// The table profile of a two-layer `medium` scaled to `total`: `None` unless it is a slab over a
+/// half-space, in air, with one σs, g and n in both layers (a [DJ06] skin with dermis scattering
+/// scale 1, any g, n or thickness), σs·d and σa/σs inside the table.
+pub fn medium_table_profile(
+    medium: &LayeredMedium,
+    opts: &super::ShapeTableOptions,
+    total: f64,
+) -> Result<Option<Profile>, MultipoleError> {
+    let [top, bottom] = medium.layers() else {
+        return Ok(None);
+    };
+    let (Some(d_mm), None) = (top.thickness_mm(), bottom.thickness_mm()) else {
+        return Ok(None);
+    };
+    let same = top.sigma_s() == bottom.sigma_s() && top.g() == bottom.g() && top.n() == bottom.n();
+    if !same || medium.n_above() != 1.0 || top.sigma_s() <= 0.0 || !(0.0..=0.99).contains(&top.g())
+    {
+        return Ok(None);
+    }
+    let table = super::cached_table(top.g(), top.n(), opts)?;
+    table.profile(top.sigma_s(), top.sigma_a(), bottom.sigma_a(), d_mm, total)
+}
+
 /// A profile of total `total` from a shape on [`shape_radii`], cut after the node where the
 /// cumulative energy reaches 99.9%: like the multipole tables, the table holds 99.9% of `total`.
 pub fn shape_profile(shape: &[f64], total: f64) -> Result<Profile, MultipoleError> {
-    let radii = shape_radii()?;
+    profile_from_shape(&shape_radii()?, shape, total)
+}
+
+/// A profile of total `total` from mean values `shape` (mm⁻²) at nodes `radii` (mm; the
+/// [`shape_radii`] convention), cut after the node where the cumulative energy reaches 99.9%.
+pub(super) fn profile_from_shape(
+    radii: &[f64],
+    shape: &[f64],
+    total: f64,
+) -> Result<Profile, MultipoleError> {
+    let radii = radii.to_vec();
     // Total 1 so that `radius_for_energy(f)` is the radius where the table's cumulative reaches f.
     let full = Profile::from_table(radii.clone(), shape.to_vec(), 1.0)?;
     let integral = full.table_integral();

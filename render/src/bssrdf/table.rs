@@ -2,8 +2,8 @@
 //! material, one row per tabulation wavelength, each with its CDF, in f32 (docs/physics.md §8).
 //!
 //! The profiles themselves come from the owner, `multipole::SpectralProfiles` (`Method::Exact`:
-//! adding-doubling totals with layered Monte Carlo shapes, [`RENDER_SHAPE_ESCAPES`] every
-//! [`RENDER_SHAPE_STEP_NM`]; `Method::Multipole`: [DJ05] multipole with frequency-domain stacking,
+//! adding-doubling totals with the exact shapes of the universal table, or layered Monte Carlo
+//! shapes every [`RENDER_SHAPE_STEP_NM`]; `Method::Multipole`: [DJ05] multipole with frequency-domain stacking,
 //! [DJ06] two-layer skin); this module only re-tabulates them for speed and interpolates across
 //! wavelength for the hero wavelengths of a path.
 //!
@@ -20,7 +20,6 @@
 //! R_tot / ∫table so the table integrates to the model's total R_tot (exact, from q = 0): the 0.1%
 //! tail is redistributed over the table instead of being lost.
 
-use multipole::skin::ExactShape;
 use multipole::{Method, MultipoleError, Profile, ProfileOptions, SpectralProfiles, sampling};
 use skin_optics::{SkinParams, WavelengthGrid};
 use std::f32::consts::PI;
@@ -50,8 +49,9 @@ pub struct TableOptions {
     pub step_nm: f64,
     /// Radii of the common geometric grid (≥ 8).
     pub radii: usize,
-    /// Knobs of each profile: the multipole's, and the exact method's Monte Carlo shape
-    /// ([`RENDER_SHAPE_ESCAPES`] escapes every [`RENDER_SHAPE_STEP_NM`] by default).
+    /// Knobs of each profile: the multipole's, and the exact method's shape (default: the universal
+    /// table; a Monte Carlo shape, e.g. [`RENDER_SHAPE_ESCAPES`] escapes, is traced every
+    /// [`RENDER_SHAPE_STEP_NM`]).
     pub profile: ProfileOptions,
 }
 
@@ -63,9 +63,6 @@ impl Default for TableOptions {
             step_nm: 10.0,
             radii: 128,
             profile: ProfileOptions {
-                exact_shape: ExactShape::MonteCarlo {
-                    escapes: RENDER_SHAPE_ESCAPES,
-                },
                 shape_step_nm: RENDER_SHAPE_STEP_NM,
                 ..ProfileOptions::default()
             },

@@ -1,15 +1,16 @@
 //! `skin profile`: the radial diffuse reflectance profile R(r) of a skin at one wavelength, as CSV
-//! (`r_mm,reflectance_per_mm2`), from `multipole::skin::profile`; optionally a log–log chart of the
-//! profiles at 450, 550 and 650 nm.
+//! (`r_mm,reflectance_per_mm2`), from `multipole::skin::profile`, or the whole spectral set
+//! (`--from`/`--to`/`--step`: `lambda_nm,r_mm,reflectance_per_mm2`, from
+//! `multipole::SpectralProfiles`); optionally a log–log chart of the profiles at 450, 550 and 650 nm.
 
 use crate::cli::args::{Checked, SkinArgs};
 use crate::plot::{LineChart, Panel, Series, palette_color, save_png};
 use anyhow::Context;
 use clap::Args;
-use multipole::skin::{DEFAULT_SHAPE_ESCAPES, ExactShape, Method, profile};
-use multipole::{Profile, ProfileOptions};
-use skin_optics::Wavelength;
+use multipole::skin::{DEFAULT_SHAPE_ESCAPES, ExactShape, Method, ShapeTableOptions, profile};
+use multipole::{Profile, ProfileOptions, SpectralProfiles};
 use skin_optics::echo::{Num, Text};
+use skin_optics::{Wavelength, WavelengthGrid};
 use std::io::{BufWriter, Write};
 use std::path::PathBuf;
 
@@ -20,8 +21,22 @@ pub struct ProfileArgs {
     #[command(flatten)]
     pub skin: SkinArgs,
     /// Wavelength, nm, in [250, 1000] (the model's data cover 400-700 nm best).
-    #[arg(long, value_name = "NM", value_parser = Checked(parse_lambda), allow_hyphen_values = true)]
-    pub lambda: f64,
+    #[arg(long, value_name = "NM", value_parser = Checked(parse_lambda), allow_hyphen_values = true,
+          required_unless_present = "from", conflicts_with = "from")]
+    pub lambda: Option<f64>,
+    /// First wavelength of a spectral set, nm, in [250, 1000] (with --to): every row then starts
+    /// with its `lambda_nm`.
+    #[arg(long, value_name = "NM", value_parser = Checked(parse_lambda), allow_hyphen_values = true,
+          requires = "to")]
+    pub from: Option<f64>,
+    /// Last wavelength of the spectral set, nm, in [250, 1000], ≥ --from.
+    #[arg(long, value_name = "NM", value_parser = Checked(parse_lambda), allow_hyphen_values = true,
+          requires = "from")]
+    pub to: Option<f64>,
+    /// Step of the spectral set, nm, in [0.01, 750] (default 10).
+    #[arg(long, value_name = "NM", default_value_t = 10.0, value_parser = Checked(parse_step),
+          allow_hyphen_values = true)]
+    pub step: f64,
     /// Outer radius of the table, mm, in [0.002, 10000]; default: the radius holding 99.9% of the energy.
     #[arg(long = "r-max", value_name = "MM", value_parser = Checked(parse_r_max), allow_hyphen_values = true)]
     pub r_max: Option<f64>,
@@ -32,8 +47,13 @@ pub struct ProfileArgs {
     /// or multipole (the paper's diffusion, too bright for dark skin).
     #[arg(long, value_name = "METHOD", default_value_t = Method::default(), value_parser = Checked(parse_method), allow_hyphen_values = true)]
     pub method: Method,
-    /// Escaping photons of the exact profile's Monte Carlo shape, in [100, 1e9] (the accuracy knob:
-    /// noise ∝ 1/√N; the photons traced are N divided by the skin's reflectance).
+    /// Shape of the exact profile: `table` (the default: the universal white Monte Carlo table,
+    /// built once and cached) or `monte-carlo` (a layered Monte Carlo run per wavelength, --escapes).
+    #[arg(long, value_name = "SHAPE", default_value = "table", value_parser = ["table", "monte-carlo"])]
+    pub shape: String,
+    /// Escaping photons of the exact profile's Monte Carlo shape (`--shape monte-carlo`), in
+    /// [100, 1e9] (the accuracy knob: noise ∝ 1/√N; the photons traced are N divided by the skin's
+    /// reflectance).
     #[arg(long, value_name = "N", default_value_t = DEFAULT_SHAPE_ESCAPES, value_parser = Checked(parse_escapes), allow_hyphen_values = true)]
     pub escapes: u64,
     /// Print to stderr the treatment used and why (layer albedos, epidermis thickness in mean free
@@ -55,6 +75,14 @@ fn parse_lambda(s: &str) -> Result<f64, String> {
     let v = parse_number(s, "[250, 1000] nm")?;
     if !(250.0..=1000.0).contains(&v) {
         return Err(format!("{} outside [250, 1000] nm", Num(v)));
+    }
+    Ok(v)
+}
+
+fn parse_step(s: &str) -> Result<f64, String> {
+    let v = parse_number(s, "[0.01, 750] nm")?;
+    if !(0.01..=750.0).contains(&v) {
+        return Err(format!("{v} outside [0.01, 750] nm"));
     }
     Ok(v)
 }
@@ -120,12 +148,19 @@ pub fn run(args: &ProfileArgs) -> anyhow::Result<()> {
     let opts = ProfileOptions {
         radial_samples: args.samples,
         r_max_mm: args.r_max,
-        exact_shape: ExactShape::MonteCarlo {
-            escapes: args.escapes,
+        exact_shape: if args.shape == "monte-carlo" {
+            ExactShape::MonteCarlo {
+                escapes: args.escapes,
+            }
+        } else {
+            ExactShape::Table(ShapeTableOptions::default())
         },
         ..ProfileOptions::default()
     };
-    let lambda = Wavelength::new(args.lambda).context("--lambda")?;
+    let (Some(nm), None) = (args.lambda, args.from) else {
+        return run_spectral(args, &skin, &opts);
+    };
+    let lambda = Wavelength::new(nm).context("--lambda")?;
     let prof = on_requested_radii(profile(&skin, lambda, args.method, &opts)?, &opts)?;
     if args.explain {
         eprintln!(
@@ -148,14 +183,54 @@ pub fn run(args: &ProfileArgs) -> anyhow::Result<()> {
         prof.r_max_mm(),
         args.method
     );
+    plot(args, &skin, &opts)
+}
+
+/// The spectral set `--from`..`--to` every `--step` nm: one CSV row per (λ, r).
+fn run_spectral(
+    args: &ProfileArgs,
+    skin: &skin_optics::SkinParams,
+    opts: &ProfileOptions,
+) -> anyhow::Result<()> {
+    let (Some(from), Some(to)) = (args.from, args.to) else {
+        anyhow::bail!("give --lambda, or --from and --to");
+    };
+    let grid = WavelengthGrid::new(from, to, args.step).context("--from/--to/--step")?;
+    let set = SpectralProfiles::new(skin, &grid, args.method, opts)?;
+    let stdout = std::io::stdout();
+    let mut out = BufWriter::new(stdout.lock());
+    writeln!(out, "lambda_nm,r_mm,reflectance_per_mm2")?;
+    for (i, p) in set.profiles().iter().enumerate() {
+        let p = on_requested_radii(p.clone(), opts)?;
+        let nm = grid.wavelength(i).nm();
+        for (r, v) in p.radii_mm().iter().zip(p.reflectance_per_mm2()) {
+            writeln!(out, "{nm},{r:.6e},{v:.6e}")?;
+        }
+    }
+    out.flush()?;
+    eprintln!(
+        "{} wavelengths {from}-{to} nm every {} nm, method {}",
+        grid.len(),
+        grid.step_nm(),
+        args.method
+    );
+    plot(args, skin, opts)
+}
+
+/// `--plot`: the profiles at 450, 550 and 650 nm on log axes.
+fn plot(
+    args: &ProfileArgs,
+    skin: &skin_optics::SkinParams,
+    opts: &ProfileOptions,
+) -> anyhow::Result<()> {
     if let Some(path) = &args.plot {
         let mut chart = LineChart::new("Diffuse reflectance profile R(r)", "r (mm)", "R(r) (mm⁻²)")
             .log_x()
             .log_y();
         for (i, nm) in [450.0, 550.0, 650.0].into_iter().enumerate() {
             let p = on_requested_radii(
-                profile(&skin, Wavelength::new(nm)?, args.method, &opts)?,
-                &opts,
+                profile(skin, Wavelength::new(nm)?, args.method, opts)?,
+                opts,
             )?;
             let points = p
                 .radii_mm()

@@ -22,27 +22,20 @@ use thiserror::Error;
 /// Wavelength step of the skin reflectance tables computed at load, nm (interpolated to 5 nm).
 pub const SKIN_TABLE_STEP_NM: f64 = 10.0;
 
-/// Knobs of every skin material of a scene, chosen once when it is loaded.
-#[derive(Debug, Clone, Copy)]
+/// Knobs of every skin material of a scene, chosen once when it is loaded (default: exact
+/// method, subsurface on, table shapes).
+#[derive(Debug, Clone, Copy, Default)]
 pub struct SkinKnobs {
-    /// How skin reflectance is computed (default exact: adding-doubling totals, Monte Carlo shapes).
+    /// How skin reflectance is computed (default exact: adding-doubling totals, exact shapes from
+    /// the universal table).
     pub method: multipole::Method,
     /// Shade skin's body with the Lambertian stand-in instead of the BSSRDF (for comparisons;
     /// default false: subsurface scattering on).
     pub no_subsurface: bool,
-    /// Escaping photons per Monte Carlo profile shape (`Method::Exact`; default
-    /// [`crate::bssrdf::RENDER_SHAPE_ESCAPES`]).
-    pub shape_escapes: u64,
-}
-
-impl Default for SkinKnobs {
-    fn default() -> Self {
-        Self {
-            method: multipole::Method::default(),
-            no_subsurface: false,
-            shape_escapes: crate::bssrdf::RENDER_SHAPE_ESCAPES,
-        }
-    }
+    /// Escaping photons per Monte Carlo profile shape (`Method::Exact`), or `None` (the default)
+    /// for the shapes of the universal table (`multipole::skin::ExactShape::Table`: no run-time
+    /// photons, built once per machine and cached).
+    pub shape_escapes: Option<u64>,
 }
 
 /// Why a skin material could not be built.
@@ -105,9 +98,9 @@ impl SkinMaterial {
             return Ok(Self::new(params, surface, totals, albedo_texture));
         }
         let mut opts = TableOptions::default();
-        opts.profile.exact_shape = multipole::skin::ExactShape::MonteCarlo {
-            escapes: knobs.shape_escapes,
-        };
+        if let Some(escapes) = knobs.shape_escapes {
+            opts.profile.exact_shape = multipole::skin::ExactShape::MonteCarlo { escapes };
+        }
         let table =
             ProfileTable::build(&params, knobs.method, &opts).map_err(SkinBuildError::Profiles)?;
         if let Some(bad) = (0..table.wavelengths())

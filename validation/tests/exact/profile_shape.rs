@@ -6,35 +6,11 @@
 //! The reference's own noise adds about Σ √(2/π) σ_annulus / R_mc, which is printed on failure; the
 //! diffusion shapes miss by 25–30% (light) and 60–75% (dark), so a fallback to them fails.
 
+use multipole::ProfileOptions;
 use multipole::skin::{Method, profile};
-use multipole::{Profile, ProfileOptions};
 use skin_optics::{Preset, SkinParams, Wavelength};
-use validation::montecarlo::{DEFAULT_G, LayeredMedium, McOptions, McResult, RadialGrid, run};
-
-/// ∫ 2πr R(r) dr over [a, b] (mm) by the midpoint rule on 16 sub-intervals.
-fn annulus_energy(p: &Profile, a: f64, b: f64) -> f64 {
-    let h = (b - a) / 16.0;
-    (0..16)
-        .map(|k| {
-            let r = a + (k as f64 + 0.5) * h;
-            2.0 * std::f64::consts::PI * r * p.eval(r) * h
-        })
-        .sum()
-}
-
-fn energy_error(p: &Profile, mc: &McResult) -> (f64, f64) {
-    let g = mc.radial.grid;
-    let enter = 1.0 - mc.specular_reflectance;
-    let tot = mc.diffuse_reflectance.mean;
-    let (mut err, mut noise) = (0.0, 0.0);
-    for i in 0..g.bins() {
-        let area = g.annulus_area_mm2(i);
-        let model = enter * annulus_energy(p, g.inner_mm(i), g.outer_mm(i));
-        err += (model - mc.radial.reflectance_per_mm2[i] * area).abs();
-        noise += (2.0 / std::f64::consts::PI).sqrt() * mc.radial.stderr[i] * area;
-    }
-    (err / tot, noise / tot)
-}
+use validation::montecarlo::{DEFAULT_G, LayeredMedium, McOptions, RadialGrid, run};
+use validation::shape_error::energy_error;
 
 fn check(preset: Preset, nm: f64, photons: u64) {
     let skin = SkinParams::preset(preset);

@@ -25,6 +25,7 @@ mod transport;
 
 pub use crate::layered::{DEFAULT_G, Layer, LayeredMedium};
 pub use tally::{Estimate, McResult, RadialGrid, RadialProfile};
+pub(crate) use transport::white::{WhiteMedium, trace_white};
 pub use transport::{ROULETTE_SURVIVAL, ROULETTE_THRESHOLD};
 
 use crate::error::MultipoleError;
@@ -170,7 +171,6 @@ fn next_streams(base: &mut Xoshiro256StarStar, n: u32) -> Vec<Xoshiro256StarStar
 
 /// One generator per batch: xoshiro256** seeded from `seed`, each stream 2¹²⁸ draws after the
 /// previous (`jump`), so batches never overlap.
-#[cfg(test)]
-fn batch_streams(seed: u64, batches: u32) -> Vec<Xoshiro256StarStar> {
+pub(crate) fn batch_streams(seed: u64, batches: u32) -> Vec<Xoshiro256StarStar> {
     next_streams(&mut Xoshiro256StarStar::seed_from_u64(seed), batches)
 }

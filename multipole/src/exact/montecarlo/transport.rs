@@ -8,6 +8,7 @@
 mod sampling;
 #[cfg(test)]
 mod tests;
+pub(crate) mod white;
 
 use super::tally::{BatchTally, RadialGrid};
 use crate::layered::LayeredMedium;
