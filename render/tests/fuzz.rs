@@ -13,7 +13,7 @@ use proptest::prelude::*;
 use proptest::strategy::ValueTree;
 use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
 use render::mesh::{TriangleMesh, glb_container};
-use render::renderer::{RenderSettings, render};
+use render::renderer::{RenderOptions, render};
 use render::scene::{Scene, SceneOptions};
 use render::texture::Texture;
 use std::panic::{AssertUnwindSafe, catch_unwind};
@@ -322,14 +322,16 @@ fn load_scene(text: &str) -> Result<(), String> {
     render::scene_file::parse(text)?;
     let scene = Scene::from_toml(text, "fuzz.toml", None, &opts).map_err(|e| e.to_string())?;
     // Scenes that load are rendered (tiny), so geometry, lights and film see the values too.
-    let settings = RenderSettings {
+    let settings = RenderOptions {
         width: 4,
         height: 3,
         spp: 1,
         progress: false,
         threads: Some(1),
-        ..RenderSettings::default()
-    };
+        ..RenderOptions::default()
+    }
+    .validate()
+    .map_err(|e| e.to_string())?;
     let (film, _) = render(&scene, &settings).map_err(|e| e.to_string())?;
     for y in 0..3 {
         for x in 0..4 {
