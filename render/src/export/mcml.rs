@@ -104,7 +104,7 @@ pub fn write(
             spectral.rows.len(),
             opts.dermis_thickness_mm
         ),
-        "error: none by construction (our layers); MCML's Rd is per incident photon with the specular Rsp apart: compare with `skin spectrum`'s diffuse_reflectance column".to_string(),
+        "accuracy: nothing lost by construction (our layers); MCML's Rd is per incident photon with the specular Rsp apart: compare with `skin spectrum`'s diffuse_reflectance column".to_string(),
     ];
     Ok((x, notes))
 }

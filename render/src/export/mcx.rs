@@ -61,7 +61,7 @@ pub fn write(
             "conventions: Media[0] = air (n = {}), Media[1] = epidermis (z-layers 1-{EPIDERMIS_VOXELS}), Media[2] = dermis ({} mm, finite); pencil beam at the top centre, DoMismatch on",
             spectral.n_above, opts.dermis_thickness_mm
         ),
-        "error: none by construction (our layers); lateral and depth truncation of the volume are MCX's only departures from the model".to_string(),
+        "accuracy: nothing lost by construction (our layers); lateral and depth truncation of the volume are MCX's only departures from the model".to_string(),
     ];
     Ok((
         serde_json::to_string_pretty(&value).expect("a JSON value serialises"),

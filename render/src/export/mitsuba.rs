@@ -93,7 +93,7 @@ pub fn write(
             2.0 * HALF_WIDTH_MM
         ),
         "conventions: albedo = σs/σt (single scattering), sigma_t = σa + σs (not reduced), HG g; smooth dielectric face (the oily lobe is not written); add a sensor and emitter to render".to_string(),
-        "error: none by construction: the layers are ours, so volpath solves our transport exactly (only the finite dermis and block differ from the semi-infinite model)".to_string(),
+        "accuracy: nothing lost by construction: the layers are ours, so volpath solves our transport exactly (only the finite dermis and block differ from the semi-infinite model)".to_string(),
     ];
     Ok((x, notes))
 }

@@ -201,7 +201,8 @@ impl Surface {
         Self {
             eta: skin.eta(),
             oiliness: skin.oiliness(),
-            beckmann_m: f64::from(brdf::DEFAULT_ROUGHNESS),
+            // The f32 constant widened, rounded back to the decimal it was written as.
+            beckmann_m: (f64::from(brdf::DEFAULT_ROUGHNESS) * 1e6).round() / 1e6,
         }
     }
 

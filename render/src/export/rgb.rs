@@ -26,13 +26,23 @@ impl RgbProfile {
     /// RGB in `space`. Totals are the RGB of the spectrum of each row's own total.
     pub fn from_spectral(set: &SpectralProfiles, space: ColourSpace) -> Result<Self, ExportError> {
         let rows = set.profiles();
-        let radii = rows[0].radii_mm().to_vec();
-        if rows.iter().any(|p| p.radii_mm() != radii.as_slice()) {
+        // Exact rows share the Monte Carlo shape radii, each cut after its own 99.9% energy radius:
+        // every table is a prefix of the longest, and R = 0 beyond a table's end.
+        let longest = rows
+            .iter()
+            .max_by_key(|p| p.radii_mm().len())
+            .expect("a grid has wavelengths");
+        let radii = longest.radii_mm().to_vec();
+        if rows
+            .iter()
+            .any(|p| p.radii_mm() != &radii[..p.radii_mm().len()])
+        {
             return Err(ExportError::Fit(
                 "spectral profiles on different radii (use the exact method's Monte Carlo shapes)"
                     .into(),
             ));
         }
+        let value = |p: &Profile, i: usize| p.reflectance_per_mm2().get(i).copied().unwrap_or(0.0);
         let grid = *set.grid();
         let to_rgb = |values: Vec<f64>| -> Result<[f64; 3], ExportError> {
             let xyz = reflectance_to_xyz(&GridSpectrum::new(grid, values)?);
@@ -40,7 +50,7 @@ impl RgbProfile {
         };
         let mut values: [Vec<f64>; 3] = Default::default();
         for i in 0..radii.len() {
-            let rgb = to_rgb(rows.iter().map(|p| p.reflectance_per_mm2()[i]).collect())?;
+            let rgb = to_rgb(rows.iter().map(|p| value(p, i)).collect())?;
             for c in 0..3 {
                 // A saturated channel can dip below zero in a wide gamut; a profile cannot.
                 values[c].push(rgb[c].max(0.0));
