@@ -22,6 +22,53 @@ pub const BINS_R: usize = 500;
 /// Depth bins.
 pub const BINS_Z: usize = 100;
 
+/// `s` in ASCII, which is all MCML 1.2 reads (it stops at any other byte): Greek letters and unit
+/// superscripts spelled out, anything else left as `?`.
+#[must_use]
+pub fn ascii(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    for ch in s.chars() {
+        match ch {
+            c if c.is_ascii() => out.push(c),
+            'μ' => out.push_str("mu"),
+            'σ' => out.push_str("sigma"),
+            'β' => out.push_str("beta"),
+            'ρ' => out.push_str("rho"),
+            'η' => out.push_str("eta"),
+            '⁻' => out.push_str("^-"),
+            '¹' => out.push('1'),
+            '²' => out.push('2'),
+            '–' | '−' | '‒' => out.push('-'),
+            '×' => out.push('x'),
+            '≤' => out.push_str("<="),
+            '§' => out.push_str("section "),
+            _ => out.push('?'),
+        }
+    }
+    out
+}
+
+/// Width of a wrapped comment line, bytes (MCML's `fgets` reads 254 at a time).
+pub const COMMENT_WIDTH: usize = 100;
+
+/// `s` broken at spaces into lines of at most `width` bytes (a longer word keeps its own line).
+#[must_use]
+pub fn wrap(s: &str, width: usize) -> Vec<String> {
+    let mut lines = vec![String::new()];
+    for word in s.split(' ') {
+        let last = lines.last_mut().expect("one line at least");
+        if !last.is_empty() && last.len() + 1 + word.len() > width {
+            lines.push(word.to_string());
+        } else {
+            if !last.is_empty() {
+                last.push(' ');
+            }
+            last.push_str(word);
+        }
+    }
+    lines
+}
+
 /// One MCML run as written in the file.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MciRun {

@@ -347,9 +347,18 @@ fn materialise_notes(format: Format, notes: &[String], text: &str) -> String {
                 .collect();
             format!("{decl}\n{comments}{rest}")
         }
-        Format::Pbrt | Format::Mcml => {
+        Format::Pbrt => {
             let comments: String = notes.iter().map(|n| format!("# {n}\n")).collect();
             format!("{comments}{text}")
+        }
+        Format::Mcml => {
+            // MCML reads lines of at most 254 bytes: the notes are wrapped.
+            let comments: String = notes
+                .iter()
+                .flat_map(|n| mcml::wrap(&mcml::ascii(n), mcml::COMMENT_WIDTH))
+                .map(|l| format!("# {l}\n"))
+                .collect();
+            format!("{comments}{}", mcml::ascii(text))
         }
         Format::Unreal | Format::Hdrp | Format::Gaussians | Format::Burley | Format::Mcx => {
             let mut value: serde_json::Value =
