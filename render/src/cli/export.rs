@@ -23,19 +23,38 @@ pub struct ExportArgs {
     #[arg(long, value_name = "FILE")]
     pub out: Option<PathBuf>,
     /// First wavelength, nm, [250, 1000].
-    #[arg(long, value_name = "NM", default_value_t = 400.0, allow_negative_numbers = true)]
+    #[arg(
+        long,
+        value_name = "NM",
+        default_value_t = 400.0,
+        allow_negative_numbers = true
+    )]
     pub from: f64,
     /// Last wavelength, nm, [250, 1000], ≥ --from.
-    #[arg(long, value_name = "NM", default_value_t = 700.0, allow_negative_numbers = true)]
+    #[arg(
+        long,
+        value_name = "NM",
+        default_value_t = 700.0,
+        allow_negative_numbers = true
+    )]
     pub to: f64,
     /// Wavelength step, nm, [0.01, 750].
-    #[arg(long, value_name = "NM", default_value_t = 10.0, allow_negative_numbers = true)]
+    #[arg(
+        long,
+        value_name = "NM",
+        default_value_t = 10.0,
+        allow_negative_numbers = true
+    )]
     pub step: f64,
     /// Escaping photons of each exact profile's Monte Carlo shape, [100, 1e9] (reference accuracy).
     #[arg(long, value_name = "N", default_value_t = ExportOptions::default().escapes)]
     pub escapes: u64,
     /// Colour space of exported colours: lin_rec709 or acescg.
-    #[arg(long = "colour-space", value_name = "NAME", default_value = "lin_rec709")]
+    #[arg(
+        long = "colour-space",
+        value_name = "NAME",
+        default_value = "lin_rec709"
+    )]
     pub colour_space: String,
     /// Length of one scene unit in mm (OpenPBR, Standard Surface, pbrt, Mitsuba), [1e-6, 1e6].
     #[arg(long = "unit-mm", value_name = "MM", default_value_t = 1.0)]
@@ -66,7 +85,8 @@ impl ExportArgs {
             anyhow::bail!("--to {} nm is below --from {} nm", self.to, self.from);
         }
         let opts = ExportOptions {
-            grid: WavelengthGrid::new(self.from, self.to, self.step).context("--from/--to/--step")?,
+            grid: WavelengthGrid::new(self.from, self.to, self.step)
+                .context("--from/--to/--step")?,
             escapes: self.escapes,
             colour_space: self
                 .colour_space
@@ -97,7 +117,11 @@ pub fn run(args: &ExportArgs) -> anyhow::Result<()> {
             && dir.exists()
             && !dir.is_dir()
         {
-            anyhow::bail!("--out {}: {} is not a folder", path.display(), dir.display());
+            anyhow::bail!(
+                "--out {}: {} is not a folder",
+                path.display(),
+                dir.display()
+            );
         }
     }
     let exported = export(&skin, format, &opts)?;

@@ -4,7 +4,7 @@
 use std::fmt;
 use std::str::FromStr;
 
-/// Linear Rec.709 → ACEScg: the AP1 primaries of [ACES-S2014-004] with the Bradford adaptation from D65
+/// Linear Rec.709 → ACEScg: the AP1 primaries of [ACES] with the Bradford adaptation from D65
 /// to the ACES white, as published with the ACES reference implementation (each row sums to 1 to 1e-6,
 /// so white stays white).
 pub const REC709_TO_ACESCG: [[f64; 3]; 3] = [
@@ -76,8 +76,16 @@ mod tests {
         // AP1 is wider than Rec.709: a Rec.709 primary has every AP1 component positive.
         let red = ColourSpace::AcesCg.from_rec709([1.0, 0.0, 0.0]);
         assert!(red.iter().all(|&c| c > 0.0) && red[0] < 1.0);
-        assert_eq!(ColourSpace::LinRec709.from_rec709([0.2, 0.3, 0.4]), [0.2, 0.3, 0.4]);
+        assert_eq!(
+            ColourSpace::LinRec709.from_rec709([0.2, 0.3, 0.4]),
+            [0.2, 0.3, 0.4]
+        );
         assert_eq!("ACEScg".parse::<ColourSpace>(), Ok(ColourSpace::AcesCg));
-        assert!("xyz".parse::<ColourSpace>().unwrap_err().contains("lin_rec709"));
+        assert!(
+            "xyz"
+                .parse::<ColourSpace>()
+                .unwrap_err()
+                .contains("lin_rec709")
+        );
     }
 }

@@ -83,7 +83,7 @@ impl GaussianFit {
         let mut weights = vec![[0.0; 3]; terms];
         for c in 0..3 {
             let sum: f64 = raw.iter().map(|w| w[c]).sum();
-            if !(sum > 0.0) {
+            if sum.is_nan() || sum <= 0.0 {
                 return Err(ExportError::Fit(format!(
                     "Gaussian fit: no positive weight in channel {c}"
                 )));
@@ -130,7 +130,9 @@ impl Samples {
                 .collect();
             let h = (hi / lo).ln() / (n - 1) as f64;
             let e: f64 = p.iter().sum::<f64>() * h;
-            p.into_iter().map(|v| v / e.max(f64::MIN_POSITIVE)).collect()
+            p.into_iter()
+                .map(|v| v / e.max(f64::MIN_POSITIVE))
+                .collect()
         });
         Self { radii, targets }
     }
@@ -154,8 +156,7 @@ impl Samples {
             .collect();
         let mut weights = vec![[0.0; 3]; n];
         let mut residual = 0.0;
-        for c in 0..3 {
-            let t = &self.targets[c];
+        for (c, t) in self.targets.iter().enumerate() {
             let b: Vec<f64> = basis.iter().map(|row| dot(row, t)).collect();
             // Projected coordinate descent on ½aᵀQa − bᵀa, a ≥ 0 (converges for Q positive semidefinite).
             let mut a = vec![0.0; n];

@@ -118,7 +118,11 @@ pub fn write(
     let _ = writeln!(x, "{}\t# number of runs", spectral.rows.len());
     for row in &spectral.rows {
         let _ = writeln!(x, "\n#### run: {} nm", row.lambda_nm);
-        let _ = writeln!(x, "skin_{}nm.mco\tA\t# output file name, ASCII", row.lambda_nm);
+        let _ = writeln!(
+            x,
+            "skin_{}nm.mco\tA\t# output file name, ASCII",
+            row.lambda_nm
+        );
         let _ = writeln!(x, "{}\t# photons", opts.photons);
         let _ = writeln!(x, "{BIN_CM}\t{BIN_CM}\t# dz, dr (cm)");
         let _ = writeln!(x, "{BINS_Z}\t{BINS_R}\t1\t# number of dz, dr, da");
@@ -201,7 +205,11 @@ pub fn parse(text: &str) -> Result<Vec<MciRun>, ExportError> {
     for _ in 0..runs as usize {
         let (line, l) = next("the output file name")?;
         let output = l.split_whitespace().next().unwrap_or("").to_string();
-        if !l.split_whitespace().nth(1).is_some_and(|f| f == "A" || f == "a") {
+        if !l
+            .split_whitespace()
+            .nth(1)
+            .is_some_and(|f| f == "A" || f == "a")
+        {
             return Err(ExportError::Mci {
                 line,
                 message: format!("expected 'NAME A' (ASCII output), found '{l}'"),
@@ -262,6 +270,11 @@ mod tests {
         let bad = text.replace("1.37 2 10 0.0 0.2", "1.37 2 ten 0.0 0.2");
         let e = parse(&bad).unwrap_err().to_string();
         assert!(e.contains("line 11") && e.contains("n mua mus g d"), "{e}");
-        assert!(parse("1.0\n").unwrap_err().to_string().contains("number of runs"));
+        assert!(
+            parse("1.0\n")
+                .unwrap_err()
+                .to_string()
+                .contains("number of runs")
+        );
     }
 }

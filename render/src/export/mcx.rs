@@ -23,11 +23,12 @@ pub fn write(
     let nx = (WIDTH_MM / voxel_mm).round() as usize;
     let nz_dermis = (opts.dermis_thickness_mm / voxel_mm).round() as usize;
     let nz = EPIDERMIS_VOXELS + nz_dermis;
-    let media: Vec<_> = std::iter::once(json!({ "mua": 0.0, "mus": 0.0, "g": 1.0, "n": spectral.n_above }))
-        .chain(row.layers.iter().map(|l| {
-            json!({ "mua": l.sigma_a_per_mm, "mus": l.sigma_s_per_mm, "g": l.g, "n": l.n })
-        }))
-        .collect();
+    let media: Vec<_> =
+        std::iter::once(json!({ "mua": 0.0, "mus": 0.0, "g": 1.0, "n": spectral.n_above }))
+            .chain(row.layers.iter().map(
+                |l| json!({ "mua": l.sigma_a_per_mm, "mus": l.sigma_s_per_mm, "g": l.g, "n": l.n }),
+            ))
+            .collect();
     let value = json!({
         "Session": {
             "ID": format!("skin_{}nm", row.lambda_nm),

@@ -80,7 +80,13 @@ pub fn write(
     // faces coincide.
     let inset = 1e-3 * total;
     let dermis_half = (total - epi - inset) / 2.0;
-    block(&mut x, "skin_dermis", dermis_half, -epi - dermis_half, w - inset);
+    block(
+        &mut x,
+        "skin_dermis",
+        dermis_half,
+        -epi - dermis_half,
+        w - inset,
+    );
     let _ = writeln!(x, r#"        <bsdf type="null"/>"#);
     let _ = writeln!(x, r#"        <ref name="interior" id="dermis"/>"#);
     let _ = writeln!(x, r#"        <ref name="exterior" id="epidermis"/>"#);

@@ -166,10 +166,34 @@ impl ExportOptions {
     /// Check every knob against its range.
     pub fn validate(&self) -> Result<(), ExportError> {
         check("escapes", self.escapes as f64, 100.0, 1e9, "[100, 1e9]")?;
-        check("shape step (nm)", self.shape_step_nm, 0.01, 750.0, "[0.01, 750] nm")?;
-        check("scene unit (mm)", self.scene_unit_mm, 1e-6, 1e6, "[1e-6, 1e6] mm")?;
-        check("photons", self.photons as f64, 1.0, 2e9, "[1, 2e9] (MCML reads a C long)")?;
-        check("volume photons", self.volume_photons as f64, 100.0, 1e9, "[100, 1e9]")?;
+        check(
+            "shape step (nm)",
+            self.shape_step_nm,
+            0.01,
+            750.0,
+            "[0.01, 750] nm",
+        )?;
+        check(
+            "scene unit (mm)",
+            self.scene_unit_mm,
+            1e-6,
+            1e6,
+            "[1e-6, 1e6] mm",
+        )?;
+        check(
+            "photons",
+            self.photons as f64,
+            1.0,
+            2e9,
+            "[1, 2e9] (MCML reads a C long)",
+        )?;
+        check(
+            "volume photons",
+            self.volume_photons as f64,
+            100.0,
+            1e9,
+            "[100, 1e9]",
+        )?;
         check(
             "Gaussian terms",
             self.gaussian_terms as f64,
@@ -177,8 +201,20 @@ impl ExportOptions {
             gaussians::TERMS_RANGE.1 as f64,
             "[1, 8]",
         )?;
-        check("MCX wavelength (nm)", self.mcx_lambda_nm, 250.0, 1000.0, "[250, 1000] nm")?;
-        check("dermis thickness (mm)", self.dermis_thickness_mm, 1.0, 1000.0, "[1, 1000] mm")?;
+        check(
+            "MCX wavelength (nm)",
+            self.mcx_lambda_nm,
+            250.0,
+            1000.0,
+            "[250, 1000] nm",
+        )?;
+        check(
+            "dermis thickness (mm)",
+            self.dermis_thickness_mm,
+            1.0,
+            1000.0,
+            "[1, 1000] mm",
+        )?;
         Ok(())
     }
 }
@@ -244,7 +280,11 @@ pub fn rgb_profile(skin: &SkinParams, opts: &ExportOptions) -> Result<RgbProfile
 }
 
 /// Export `skin` in `format`.
-pub fn export(skin: &SkinParams, format: Format, opts: &ExportOptions) -> Result<Export, ExportError> {
+pub fn export(
+    skin: &SkinParams,
+    format: Format,
+    opts: &ExportOptions,
+) -> Result<Export, ExportError> {
     opts.validate()?;
     let surface = Surface::of(skin);
     let mut header = vec![format!(
@@ -266,9 +306,21 @@ pub fn export(skin: &SkinParams, format: Format, opts: &ExportOptions) -> Result
         export_rgb(format, &rgb, surface, opts)?
     } else if format == Format::Mcx {
         let grid = WavelengthGrid::new(opts.mcx_lambda_nm, opts.mcx_lambda_nm, 1.0)?;
-        export_spectral(format, &SpectralSkin::new(skin, &grid)?, skin, surface, opts)?
+        export_spectral(
+            format,
+            &SpectralSkin::new(skin, &grid)?,
+            skin,
+            surface,
+            opts,
+        )?
     } else {
-        export_spectral(format, &SpectralSkin::new(skin, &opts.grid)?, skin, surface, opts)?
+        export_spectral(
+            format,
+            &SpectralSkin::new(skin, &opts.grid)?,
+            skin,
+            surface,
+            opts,
+        )?
     };
     header.append(&mut out.notes);
     out.notes = header;

@@ -1,4 +1,4 @@
-//! A pbrt-v4 `subsurface` material ([PJH23]): spectral σa and σs inline as wavelength–value pairs, g,
+//! A pbrt-v4 `subsurface` material ([pbrt]): spectral σa and σs inline as wavelength–value pairs, g,
 //! eta and scale. pbrt's subsurface model is one homogeneous semi-infinite medium, so each wavelength
 //! gets [`single_layer_equivalent`]: the dermis' scattering with the absorption that returns our exact
 //! two-layer total; its shape error is measured at 450, 550 and 650 nm (docs/physics.md §14).
@@ -42,8 +42,16 @@ pub fn write(
     let mut x = String::new();
     let _ = writeln!(x, "MakeNamedMaterial \"skin\"");
     let _ = writeln!(x, "    \"string type\" \"subsurface\"");
-    let _ = writeln!(x, "    \"spectrum sigma_a\" [ {} ]", pairs(&|l| l.sigma_a_per_mm));
-    let _ = writeln!(x, "    \"spectrum sigma_s\" [ {} ]", pairs(&|l| l.sigma_s_per_mm));
+    let _ = writeln!(
+        x,
+        "    \"spectrum sigma_a\" [ {} ]",
+        pairs(&|l| l.sigma_a_per_mm)
+    );
+    let _ = writeln!(
+        x,
+        "    \"spectrum sigma_s\" [ {} ]",
+        pairs(&|l| l.sigma_s_per_mm)
+    );
     let _ = writeln!(x, "    \"float g\" {g}");
     let _ = writeln!(x, "    \"float eta\" {}", surface.eta);
     let _ = writeln!(x, "    \"float scale\" {}", opts.scene_unit_mm);

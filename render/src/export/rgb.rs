@@ -150,12 +150,20 @@ pub fn shape_error(reference: &Profile, model_per_mm2: impl Fn(f64) -> f64) -> f
     };
     let a = density(&|r| reference.eval(r));
     let b = density(&model_per_mm2);
-    let integral = |v: &[f64]| v.windows(2).map(|w| 0.5 * (w[0] + w[1]) * step).sum::<f64>();
+    let integral = |v: &[f64]| {
+        v.windows(2)
+            .map(|w| 0.5 * (w[0] + w[1]) * step)
+            .sum::<f64>()
+    };
     let (ea, eb) = (integral(&a), integral(&b));
     if !(ea > 0.0 && eb > 0.0) {
         return 2.0;
     }
-    let diff: Vec<f64> = a.iter().zip(&b).map(|(x, y)| (x / ea - y / eb).abs()).collect();
+    let diff: Vec<f64> = a
+        .iter()
+        .zip(&b)
+        .map(|(x, y)| (x / ea - y / eb).abs())
+        .collect();
     integral(&diff)
 }
 

@@ -117,7 +117,11 @@ impl SpectralSkin {
 
 /// The layers of `layers` as a Monte Carlo stack in air (the last layer semi-infinite if it has no
 /// thickness).
-pub fn to_stack(layers: &[LayerOptics], n_above: f64, n_below: f64) -> Result<LayerStack, ExportError> {
+pub fn to_stack(
+    layers: &[LayerOptics],
+    n_above: f64,
+    n_below: f64,
+) -> Result<LayerStack, ExportError> {
     let layers = layers
         .iter()
         .map(|l| match l.thickness_mm {
@@ -133,7 +137,8 @@ pub fn to_stack(layers: &[LayerOptics], n_above: f64, n_below: f64) -> Result<La
 /// model has one layer).
 pub fn single_layer_equivalent(row: &SpectralRow) -> Result<LayerOptics, ExportError> {
     let dermis = *row.layers.last().expect("a skin has layers");
-    let total = |sigma_a: f64| semi_infinite_total(sigma_a, dermis.sigma_s_per_mm, dermis.g, dermis.n);
+    let total =
+        |sigma_a: f64| semi_infinite_total(sigma_a, dermis.sigma_s_per_mm, dermis.g, dermis.n);
     let sigma_a = solve_decreasing(row.total, 1e-8, 1e4, total)?;
     Ok(LayerOptics {
         sigma_a_per_mm: sigma_a,

@@ -170,9 +170,8 @@ impl VolumeFit {
             fit.mean_free_path_mm[c] = mfp;
             fit.total_error[c] = total_error(target, total(u)?);
             fit.van_de_hulst_total_error[c] = total_error(target, total(1.0 - vdh)?);
-            fit.shape_error[c] = shape_error(&rgb.channel(c)?, |r| {
-                profile.eval(r / mfp) / (mfp * mfp)
-            });
+            fit.shape_error[c] =
+                shape_error(&rgb.channel(c)?, |r| profile.eval(r / mfp) / (mfp * mfp));
         }
         Ok(fit)
     }
@@ -189,7 +188,10 @@ mod tests {
             let s = ((1.0_f64 - alpha) / (1.0 - alpha * g)).sqrt();
             let c = (1.0 - s) * (1.0 - 0.139 * s) / (1.0 + 1.17 * s);
             // The published inversion is a fit to 3e-3 in α near these values.
-            assert!((van_de_hulst_albedo(c, g) - alpha).abs() < 3e-3, "{alpha} {g}");
+            assert!(
+                (van_de_hulst_albedo(c, g) - alpha).abs() < 3e-3,
+                "{alpha} {g}"
+            );
         }
     }
 
@@ -202,6 +204,14 @@ mod tests {
         .unwrap();
         let got = semi_infinite_total(u, 1.0 - u, 0.9, 1.4).unwrap();
         assert!((got - target).abs() < 1e-8, "{got}");
-        assert!(solve_decreasing(1.5, 1e-9, 0.5, |u| semi_infinite_total(u, 1.0 - u, 0.9, 1.4)).is_err());
+        assert!(
+            solve_decreasing(1.5, 1e-9, 0.5, |u| semi_infinite_total(
+                u,
+                1.0 - u,
+                0.9,
+                1.4
+            ))
+            .is_err()
+        );
     }
 }
