@@ -1,9 +1,9 @@
-//! Beckmann distribution of microfacet normals and its importance sampling ([TS67]; physics.md §7).
+//! Beckmann distribution of microfacet normals and its importance sampling ([TS67]; docs/physics.md §7).
 //!
 //! D(h) = exp(−tan²θh / m²) / (π m² cos⁴θh), with m the RMS slope of the surface. It is normalised
 //! over projected microfacet area: ∫ D(h) cosθh dω_h = 1 over the upper hemisphere (the substitution
 //! t = tan²θh turns the integral into ∫₀^∞ e^(−t/m²) dt / m² = 1). This is the normalisation of
-//! [TS67]/pbrt; GPU variants without the 1/π (Kelemen & Szirmay-Kalos) are not interchangeable.
+//! [TS67]/pbrt; GPU variants without the 1/π ([KSK01]) are not interchangeable.
 //!
 //! Sampling draws h with density D(h) cosθh per solid angle of h: φh = 2π u₁ and, inverting the
 //! radial CDF 1 − exp(−tan²θh/m²), tan²θh = −m² ln(1 − u₀).

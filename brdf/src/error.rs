@@ -1,4 +1,7 @@
 //! Typed errors for invalid BRDF parameters.
+//!
+//! `NonFinite` and `OutOfRange` have the same shape as `skin_optics::OpticsError`'s: both crates are
+//! leaves with no common dependency, and each library crate owns one error enum.
 
 use thiserror::Error;
 
@@ -30,33 +33,43 @@ pub enum BrdfError {
 
 /// Validate a Beckmann roughness (RMS slope) m: finite and in (0, 1].
 pub fn check_roughness(roughness_m: f32) -> Result<f32, BrdfError> {
-    check_range(
+    check_f32(
         "roughness m",
-        f64::from(roughness_m),
+        roughness_m,
         0.0,
         1.0,
         Bounds::OpenBelow,
         "(0, 1]",
     )
-    .map(|_| roughness_m)
 }
 
 /// Validate an oiliness ρ_s (linear scale of the lobe): finite and in [0, 1].
 pub fn check_oiliness(oiliness_rho_s: f32) -> Result<f32, BrdfError> {
-    check_range(
+    check_f32(
         "oiliness ρ_s",
-        f64::from(oiliness_rho_s),
+        oiliness_rho_s,
         0.0,
         1.0,
         Bounds::Closed,
         "[0, 1]",
     )
-    .map(|_| oiliness_rho_s)
 }
 
 /// Validate a relative refractive index η: finite and in [1, 3].
 pub fn check_eta(eta: f32) -> Result<f32, BrdfError> {
-    check_range("eta η", f64::from(eta), 1.0, 3.0, Bounds::Closed, "[1, 3]").map(|_| eta)
+    check_f32("eta η", eta, 1.0, 3.0, Bounds::Closed, "[1, 3]")
+}
+
+/// [`check_range`] for an f32 parameter, returning it unchanged.
+fn check_f32(
+    name: &'static str,
+    value: f32,
+    min: f64,
+    max: f64,
+    bounds: Bounds,
+    range: &'static str,
+) -> Result<f32, BrdfError> {
+    check_range(name, f64::from(value), min, max, bounds, range).map(|_| value)
 }
 
 /// Which end of an interval is open.

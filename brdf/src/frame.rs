@@ -1,6 +1,6 @@
-//! Orthonormal shading frame built from a normal (Duff et al. 2017, "Building an Orthonormal Basis,
-//! Revisited", JCGT 6(1)): branchless, continuous except across the z = 0 plane, and exact for
-//! normals pointing straight down, where Frisvad's 2012 version loses all precision.
+//! Orthonormal shading frame built from a normal ([Duff17], "Building an Orthonormal Basis,
+//! Revisited"): branchless, continuous except across the z = 0 plane, and exact for
+//! normals pointing straight down, where Frisvad's 2012 version ([Fri12]) loses all precision.
 
 use glam::Vec3;
 

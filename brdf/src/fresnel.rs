@@ -1,7 +1,8 @@
 //! Exact unpolarised Fresnel reflectance of a smooth dielectric interface, and its angular moments.
 //!
-//! The only home of dielectric Fresnel in the workspace ([TS67] uses it inside the microfacet lobe;
-//! `multipole` uses it for the observable reflectance and the BSSRDF's directional term).
+//! The only home of dielectric Fresnel in the workspace (docs/physics.md §7): the microfacet lobe
+//! uses it ([TS67]); `multipole` uses it for the observable reflectance, the faces of adding-doubling
+//! and the Monte Carlo's interfaces; `render` for the BSSRDF's directional term.
 //! Written once, generic over the float width: f64 for the physics crates, f32 for the per-ray lobe.
 
 use crate::real::Real;

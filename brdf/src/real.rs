@@ -29,38 +29,28 @@ pub(crate) trait Real:
     fn clamp(self, lo: Self, hi: Self) -> Self;
 }
 
-impl Real for f32 {
-    const ZERO: Self = 0.0;
-    const ONE: Self = 1.0;
-    const TWO: Self = 2.0;
-    fn ln_1p(self) -> Self {
-        f32::ln_1p(self)
-    }
-    fn min(self, other: Self) -> Self {
-        f32::min(self, other)
-    }
-    fn sqrt(self) -> Self {
-        f32::sqrt(self)
-    }
-    fn clamp(self, lo: Self, hi: Self) -> Self {
-        f32::clamp(self, lo, hi)
-    }
+/// The impl for one float type: every method forwards to the inherent one of the same name.
+macro_rules! impl_real {
+    ($t:ty) => {
+        impl Real for $t {
+            const ZERO: Self = 0.0;
+            const ONE: Self = 1.0;
+            const TWO: Self = 2.0;
+            fn ln_1p(self) -> Self {
+                <$t>::ln_1p(self)
+            }
+            fn min(self, other: Self) -> Self {
+                <$t>::min(self, other)
+            }
+            fn sqrt(self) -> Self {
+                <$t>::sqrt(self)
+            }
+            fn clamp(self, lo: Self, hi: Self) -> Self {
+                <$t>::clamp(self, lo, hi)
+            }
+        }
+    };
 }
 
-impl Real for f64 {
-    const ZERO: Self = 0.0;
-    const ONE: Self = 1.0;
-    const TWO: Self = 2.0;
-    fn ln_1p(self) -> Self {
-        f64::ln_1p(self)
-    }
-    fn min(self, other: Self) -> Self {
-        f64::min(self, other)
-    }
-    fn sqrt(self) -> Self {
-        f64::sqrt(self)
-    }
-    fn clamp(self, lo: Self, hi: Self) -> Self {
-        f64::clamp(self, lo, hi)
-    }
-}
+impl_real!(f32);
+impl_real!(f64);

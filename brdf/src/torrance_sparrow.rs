@@ -1,5 +1,5 @@
 //! The Torrance–Sparrow microfacet BRDF of the skin's oily surface layer ([TS67], [DJ06] §3;
-//! physics.md §7): evaluation, importance sampling and pdf in the local frame (+Z = normal).
+//! docs/physics.md §7): evaluation, importance sampling and pdf in the local frame (+Z = normal).
 //!
 //! f_s(ωi, ωo) = ρ_s D(h) G(ωi, ωo) F(ωo·h) / (4 |n·ωi| |n·ωo|), h = normalize(ωi + ωo),
 //! with the Beckmann D of [`crate::beckmann`], the V-cavity G of `v_cavity` and the exact unpolarised
@@ -17,7 +17,7 @@ use glam::Vec3;
 pub const DEFAULT_ROUGHNESS: f32 = 0.3;
 /// Oiliness ρ_s of the paper's Figure 1 renders, 0.25 ([DJ06] Fig. 1).
 pub const DEFAULT_OILINESS: f32 = 0.25;
-/// Relative refractive index of skin's surface, η = 1.4 ([DJ06]; physics.md §7).
+/// Relative refractive index of skin's surface, η = 1.4 ([DJ06]; docs/physics.md §7).
 pub const DEFAULT_ETA: f32 = 1.4;
 
 /// One importance sample of the lobe: the incident direction and the BRDF and pdf there.
@@ -173,8 +173,8 @@ impl TorranceSparrow {
     /// Fraction of the light arriving with incidence cosine `cos_theta` that the surface lobe does
     /// not reflect: 1 − [`Self::directional_albedo`]. This is the energy split the renderer uses:
     /// the subsurface (BSSRDF) term of light entering at cosθ is scaled by this factor, so surface
-    /// plus subsurface reflectance never exceeds 1 (physics.md §7; the alternative, the smooth-surface
-    /// Fresnel transmittance, ignores the lobe's roughness and ρ_s).
+    /// plus subsurface reflectance never exceeds 1 (docs/physics.md §7; the alternative, the
+    /// smooth-surface Fresnel transmittance, ignores the lobe's roughness and ρ_s).
     #[must_use]
     pub fn transmitted_fraction(&self, cos_theta: f32) -> f32 {
         1.0 - self.directional_albedo(cos_theta)

@@ -1,10 +1,10 @@
-//! Torrance–Sparrow V-cavity geometric attenuation ([TS67]; physics.md §7).
+//! Torrance–Sparrow V-cavity geometric attenuation ([TS67]; docs/physics.md §7).
 //!
 //! The surface is modelled as symmetric V-grooves, each made of a facet with normal h and its mirror
 //! image about the macro-normal. Light to or from direction v is blocked by the opposite facet; the
 //! unblocked fraction of the facet is G₁(v, h) = min(1, 2 (n·h)(n·v) / (v·h)), and the bidirectional
-//! term is G(ωo, ωi) = min(1, G₁(ωo, h), G₁(ωi, h)), the formula of physics.md §7 (with ωi·h = ωo·h
-//! for the half-vector h). G is symmetric in ωo and ωi, so the BRDF is reciprocal.
+//! term is G(ωo, ωi) = min(1, G₁(ωo, h), G₁(ωi, h)), the formula of docs/physics.md §7 (with
+//! ωi·h = ωo·h for the half-vector h). G is symmetric in ωo and ωi, so the BRDF is reciprocal.
 
 use crate::real::Real;
 

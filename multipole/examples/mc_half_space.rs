@@ -1,14 +1,14 @@
-//! Photon rate of the layered Monte Carlo on issue 4's half-space speed case: one semi-infinite layer
+//! Photon rate of the layered Monte Carlo on its half-space speed case: one semi-infinite layer
 //! with σa = 0.01, σs' = 1 mm⁻¹ (σs = 10 mm⁻¹), g = 0.9, n = 1.4 under air (about 1,600 scatterings
 //! per photon: long histories, the hardest case for the photon loop).
 //!
 //! `cargo run --release -p multipole --example mc_half_space [PHOTONS] [THREADS] [SIGMA_A]`
-//! (defaults 100000, 1, 0.01 mm⁻¹; σs' stays 1 mm⁻¹). Prints R_d (issue 4's exact-transport
-//! values: 0.6040 for σa 0.01, 0.0713 for σa 0.5), energy, scatterings per photon, and the
+//! (defaults 100000, 1, 0.01 mm⁻¹; σs' stays 1 mm⁻¹). Prints R_d (exact-transport reference
+//! values, BENCHMARKS.md `## Exact method`: 0.6040 for σa 0.01, 0.0713 for σa 0.5), energy, scatterings per photon, and the
 //! wall-clock rate; for the CPU-time rate run the built binary under `/usr/bin/time -f "%U user"`
 //! and divide the photons by the user seconds (the setup is microseconds).
 
-use multipole::montecarlo::{Layer, LayerStack, McOptions, run};
+use multipole::montecarlo::{Layer, LayeredMedium, McOptions, run};
 use std::time::Instant;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -17,7 +17,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let threads: usize = args.next().map_or(Ok(1), |s| s.parse())?;
     let sigma_a: f64 = args.next().map_or(Ok(0.01), |s| s.parse())?;
     let half = Layer::from_reduced(sigma_a, 1.0, 0.9, 1.4, None)?;
-    let stack = LayerStack::new(vec![half], 1.0, 1.0)?;
+    let stack = LayeredMedium::new(vec![half], 1.0, 1.0)?;
     let opts = McOptions::new(photons, 32, 1)?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)

@@ -1,6 +1,6 @@
 //! CPU time of one full spectral set (31 wavelengths, 400–700 nm, two layers, 256 radii to the
-//! 99.9% radius) on one thread, robust to a loaded machine: it reads this thread's on-CPU time from
-//! `/proc/thread-self/schedstat` (Linux) besides the wall clock.
+//! 99.9% radius) on one thread, robust to a loaded machine: it reads this thread's on-CPU time (`cpu-time`)
+//! besides the wall clock.
 //!
 //! `cargo run --release -p multipole --example spectral_timing [ITERATIONS]` (default 200).
 
@@ -9,14 +9,9 @@ use multipole::skin::{Method, SpectralProfiles};
 use skin_optics::{Preset, SkinParams, WavelengthGrid};
 use std::time::Instant;
 
-/// Nanoseconds this thread has spent on a CPU (None off Linux).
+/// Nanoseconds this thread has spent on a CPU.
 fn thread_cpu_ns() -> Option<u64> {
-    std::fs::read_to_string("/proc/thread-self/schedstat")
-        .ok()?
-        .split_whitespace()
-        .next()?
-        .parse()
-        .ok()
+    u64::try_from(cpu_time::ThreadTime::now().as_duration().as_nanos()).ok()
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {

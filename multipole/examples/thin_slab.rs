@@ -1,5 +1,5 @@
 //! Thin-slab behaviour: total R and T of a slab against its thickness in mean free paths, for the raw
-//! multipole of physics.md §4 (source at ℓ, 11 pairs, no treatment) and for this crate's documented
+//! multipole of docs/physics.md §4 (source at ℓ, 11 pairs, no treatment) and for this crate's documented
 //! treatment (`Slab`: diffused fraction w = min(1, σs'd), source at ℓw², delta pass-through).
 //!
 //! `cargo run --release -p multipole --example thin_slab [OUT.csv]` (default `out/multipole_thin_slab.csv`).

@@ -1,9 +1,9 @@
-//! Typed errors of the diffusion crate: every variant names the parameter, its value and its range.
+//! Typed errors of the layered-transport crate: every variant names the parameter, its value and its range.
 
 use skin_optics::OpticsError;
 use thiserror::Error;
 
-/// An input outside the domain of the diffusion model.
+/// An input outside the domain of a transport method.
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum MultipoleError {
     /// A physical parameter (coefficient, thickness, index, radius) is NaN, infinite or out of range.
@@ -29,15 +29,15 @@ pub enum MultipoleError {
     /// A layer stack that cannot be combined (empty, or a semi-infinite layer above another layer).
     #[error("invalid layer stack: {0}")]
     Stack(&'static str),
-    /// A Monte Carlo layer stack that cannot be traced (empty, or a semi-infinite layer not last).
-    #[error("invalid Monte Carlo layer stack: {0}")]
-    McStack(String),
+    /// A layered medium that cannot be built (empty, or a semi-infinite layer not last).
+    #[error("invalid layered medium: {0}")]
+    Layers(String),
     /// An unknown method name (valid: `exact`, `multipole`).
     #[error("unknown method '{0}' (valid: exact, multipole)")]
     UnknownMethod(String),
     /// Invalid input to the exact (adding-doubling) transport solver.
     #[error(transparent)]
-    Exact(#[from] crate::adding_doubling::AddingDoublingError),
+    Exact(#[from] crate::exact::adding_doubling::AddingDoublingError),
     /// A profile table that is not finite and non-negative, or whose radii do not increase.
     #[error("invalid profile table: {0}")]
     Profile(&'static str),

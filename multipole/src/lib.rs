@@ -1,24 +1,24 @@
 #![doc = include_str!("../README.md")]
 
-pub mod adding_doubling;
-pub mod boundary;
-pub mod dipole;
+pub mod diffusion;
 pub mod error;
+pub mod exact;
 pub mod fit;
-pub mod hankel;
-pub mod medium;
-pub mod montecarlo;
-pub mod profile;
+pub mod layered;
+pub mod sampling;
 pub mod skin;
-pub mod slab;
-pub mod spatial;
-pub mod stack;
 
-pub use dipole::Dipole;
+// The modules by their short names, so `multipole::slab::Slab`, `multipole::montecarlo::run`, ...
+// keep working next to the grouped paths.
+pub use diffusion::{boundary, dipole, hankel, medium, profile, slab, spatial, stack};
+pub use exact::{adding_doubling, montecarlo};
+
+pub use diffusion::dipole::Dipole;
+pub use diffusion::medium::Medium;
+pub use diffusion::profile::Profile;
+pub use diffusion::slab::{Poles, Slab};
+pub use diffusion::spatial::ProfileOptions;
+pub use diffusion::stack::{DiffusionLayer, Response, Stack};
 pub use error::MultipoleError;
-pub use medium::Medium;
-pub use profile::Profile;
+pub use layered::{DEFAULT_G, Layer, LayeredMedium};
 pub use skin::{Method, SpectralProfiles};
-pub use slab::{Poles, Slab};
-pub use spatial::ProfileOptions;
-pub use stack::{Layer, Response, Stack};

@@ -182,7 +182,7 @@ mod tests {
             .min_by(|a, b| a.0.total_cmp(&b.0))
     }
 
-    /// Closest hits agree with testing every triangle, on 10,000 random rays (issue 6).
+    /// Closest hits agree with testing every triangle, on 10,000 random rays.
     #[test]
     fn closest_hit_matches_brute_force() {
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(6);

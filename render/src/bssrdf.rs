@@ -1,5 +1,5 @@
 //! Subsurface scattering for skin: the separable BSSRDF built from the multipole profiles
-//! (physics.md §8, [JMLH01], [DJ05], [DJ06]) and exit-point sampling with probe rays ([KHPC13]).
+//! (docs/physics.md §8, [JMLH01], [DJ05], [DJ06]) and exit-point sampling with probe rays ([KHPC13]).
 //!
 //! - [`table`]: per material and wavelength, 2πr R(r) on a geometric grid with its CDF (f32).
 //! - [`sampling`]: axis choice, probe segments and the one-sample MIS density over the axes.

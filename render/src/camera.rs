@@ -98,7 +98,7 @@ impl Camera {
         }
         // Thin lens: all rays through the lens meet on the plane of focus.
         let focus_point = self.position_mm + dir * (self.focus_distance_mm / dir.dot(self.forward));
-        let d = concentric_disk(lens) * self.lens_radius_mm;
+        let d = crate::sampling::concentric_disk(lens) * self.lens_radius_mm;
         let origin = self.position_mm + self.right * d.x + self.up * d.y;
         (origin, (focus_point - origin).normalize())
     }
@@ -108,24 +108,6 @@ impl Camera {
     pub fn position_mm(&self) -> Vec3 {
         self.position_mm
     }
-}
-
-/// Map [0, 1)² to the unit disk, area preserving (Shirley–Chiu concentric map).
-#[must_use]
-pub fn concentric_disk(u: Vec2) -> Vec2 {
-    let o = 2.0 * u - Vec2::ONE;
-    if o == Vec2::ZERO {
-        return Vec2::ZERO;
-    }
-    let (r, theta) = if o.x.abs() > o.y.abs() {
-        (o.x, std::f32::consts::FRAC_PI_4 * (o.y / o.x))
-    } else {
-        (
-            o.y,
-            std::f32::consts::FRAC_PI_2 - std::f32::consts::FRAC_PI_4 * (o.x / o.y),
-        )
-    };
-    Vec2::new(theta.cos(), theta.sin()) * r
 }
 
 #[cfg(test)]

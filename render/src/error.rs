@@ -50,15 +50,29 @@ pub enum RenderError {
         /// What is wrong with it.
         message: String,
     },
-    /// A render setting outside its valid range.
+    /// A scene setting outside its valid range (the camera's).
     #[error("{name} = {value} outside {range}")]
     Setting {
-        /// The setting as the user knows it (e.g. `--spp`).
+        /// The scene key (e.g. `camera.fov_deg`).
         name: &'static str,
         /// The offending value.
         value: String,
         /// The valid range.
         range: &'static str,
+    },
+    /// An output could not be written whole (see [`crate::atomic`]).
+    #[error(transparent)]
+    Write(#[from] crate::atomic::AtomicWriteError),
+    /// A render option outside its range (see [`crate::renderer::RenderOptions::validate`]).
+    #[error(transparent)]
+    Settings(#[from] crate::renderer::SettingError),
+    /// The render's worker threads could not be started.
+    #[error("cannot start {threads:?} render threads: {message}")]
+    Threads {
+        /// The requested count (None = all cores).
+        threads: Option<usize>,
+        /// The thread pool's message.
+        message: String,
     },
     /// An I/O error without more context (wrapped with the path where it is known).
     #[error(transparent)]

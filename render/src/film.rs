@@ -1,5 +1,5 @@
 //! The film: per-pixel CIE XYZ sums, written as linear-sRGB OpenEXR (f32) and as a tone-mapped
-//! sRGB PNG, both through `render::atomic` (temporary name, then rename).
+//! sRGB PNG, both through `render::atomic` (unique temporary name, then rename).
 
 use crate::atomic;
 use crate::error::RenderError;
@@ -77,7 +77,7 @@ impl Film {
             .map_err(|e| out_err(e.to_string()))
         })
         .map_err(|e: RenderError| match e {
-            e @ RenderError::Output { .. } => e,
+            e @ (RenderError::Output { .. } | RenderError::Write(_)) => e,
             other => out_err(other.to_string()),
         })
     }
@@ -113,10 +113,7 @@ impl Film {
                 path: path.to_path_buf(),
                 message: e.to_string(),
             })?;
-        atomic::write_bytes(path, &bytes).map_err(|e| RenderError::Output {
-            path: path.to_path_buf(),
-            message: e.to_string(),
-        })
+        Ok(atomic::write_bytes(path, &bytes)?)
     }
 }
 
@@ -164,7 +161,8 @@ mod tests {
                 .iter()
                 .all(|&r| (r - 1.0).abs() < 2e-3)
         );
-        assert!(!atomic::temp_path(&dir.join("a.exr")).exists());
+        let left = atomic::leftovers(&dir, &["a.exr", "a.png"]);
+        assert!(left.is_empty(), "left behind: {left:?}");
         std::fs::remove_dir_all(&dir).unwrap();
     }
 

@@ -6,7 +6,7 @@
 //! rays that reach an area light or the environment add its emission with the MIS weight of the
 //! same strategy pair. Delta lights (point, spot, distant) are only reached by light sampling.
 //!
-//! Skin with a BSSRDF (issue 7, `crate::bssrdf`): at a skin hit the surface lobe is handled as any
+//! Skin with a BSSRDF (`crate::bssrdf`): at a skin hit the surface lobe is handled as any
 //! BSDF (NEE + sampling); with the probability `Bsdf::subsurface_probability` the path instead
 //! takes the subsurface branch: an exit point is sampled with probe rays, the throughput gets
 //! T(θ_o) · R(r) · N / pdf (spectral MIS) · √(m_o m_i) / q, light at the exit point is gathered by
@@ -15,8 +15,8 @@
 
 use crate::bssrdf::{ProbeFrame, texture_modulation};
 use crate::geometry::offset_origin;
-use crate::light::cosine_hemisphere;
 use crate::material::Material;
+use crate::sampling::cosine_hemisphere;
 use crate::scene::{Hit, Scene};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use brdf::Frame;

@@ -16,6 +16,7 @@ pub mod material;
 pub mod mesh;
 pub mod plot;
 pub mod renderer;
+pub mod sampling;
 pub mod scene;
 pub mod scene_file;
 pub mod spectrum;

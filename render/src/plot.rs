@@ -58,6 +58,9 @@ pub enum PlotError {
     /// Writing the file failed.
     #[error("writing the chart failed: {0}")]
     Io(#[from] std::io::Error),
+    /// The chart could not be written whole (see [`crate::atomic`]).
+    #[error(transparent)]
+    Write(#[from] crate::atomic::AtomicWriteError),
 }
 
 /// How a series is drawn.
@@ -330,7 +333,7 @@ pub fn render_rgb(panels: &[Panel], width: u32, height: u32) -> Result<Vec<u8>, 
 }
 
 /// Render the panels (stacked vertically) and save them as a PNG of `width × height` pixels,
-/// atomically (temporary file, then rename).
+/// atomically ([`crate::atomic`]: unique temporary file, then rename).
 pub fn save_png(path: &Path, panels: &[Panel], width: u32, height: u32) -> Result<(), PlotError> {
     let buf = render_rgb(panels, width, height)?;
     // The buffer was allocated as width × height × 3 bytes above, so `from_raw` cannot fail.
@@ -478,7 +481,8 @@ mod tests {
         let dir = temp_dir("png");
         let path = dir.join("chart.png");
         save_png(&path, &sample_panels(), 640, 900).unwrap();
-        assert!(!crate::atomic::temp_path(&path).exists());
+        let left = crate::atomic::leftovers(&dir, &["chart.png"]);
+        assert!(left.is_empty(), "left behind: {left:?}");
         let img = image::open(&path).unwrap().to_rgb8();
         assert_eq!(img.dimensions(), (640, 900));
         let non_white = img.pixels().filter(|p| p.0 != [255, 255, 255]).count();

@@ -17,33 +17,42 @@ use rand_xoshiro::Xoshiro256PlusPlus;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::{Duration, Instant};
+use thiserror::Error;
 
 /// Tile edge, pixels.
 pub const TILE: usize = 16;
 
-/// What to render and how long.
+/// Largest image side, pixels (a 16384² film of XYZ sums is 3 GiB).
+pub const MAX_SIDE: usize = 16384;
+/// Most worker threads accepted.
+pub const MAX_THREADS: usize = 1024;
+/// Longest path accepted, scattering events.
+pub const MAX_DEPTH: u32 = 1024;
+
+/// What to render and how long, as requested; [`RenderOptions::validate`] checks it once and
+/// gives the [`RenderSettings`] that [`render`] takes.
 #[derive(Debug, Clone, PartialEq)]
-pub struct RenderSettings {
-    /// Image width, pixels.
+pub struct RenderOptions {
+    /// Image width, pixels, in [1, [`MAX_SIDE`]].
     pub width: usize,
-    /// Image height, pixels.
+    /// Image height, pixels, in [1, [`MAX_SIDE`]].
     pub height: usize,
-    /// Samples (paths) per pixel.
+    /// Samples (paths) per pixel, ≥ 1.
     pub spp: u32,
     /// Wall-clock budget: no pass is started that would end past it (None = no limit; at least
     /// one pass is always rendered).
     pub time_limit: Option<Duration>,
     /// Seed of every random number.
     pub seed: u64,
-    /// Worker threads (None = rayon's default, all cores).
+    /// Worker threads in [1, [`MAX_THREADS`]] (None = rayon's default, all cores).
     pub threads: Option<usize>,
-    /// Path tracer knobs.
+    /// Path tracer knobs (`max_depth` in [1, [`MAX_DEPTH`]]).
     pub path: PathSettings,
     /// Show a progress bar on stderr.
     pub progress: bool,
 }
 
-impl Default for RenderSettings {
+impl Default for RenderOptions {
     fn default() -> Self {
         Self {
             width: 512,
@@ -55,6 +64,59 @@ impl Default for RenderSettings {
             path: PathSettings::default(),
             progress: false,
         }
+    }
+}
+
+/// A render option outside its valid range; `name` is the [`RenderOptions`] field.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[error("render setting {name} = {value} outside {range}")]
+pub struct SettingError {
+    /// The field of [`RenderOptions`] (e.g. `spp`, `path.max_depth`).
+    pub name: &'static str,
+    /// The offending value.
+    pub value: String,
+    /// The valid range.
+    pub range: &'static str,
+}
+
+impl RenderOptions {
+    /// Check every option against its range.
+    pub fn validate(self) -> Result<RenderSettings, SettingError> {
+        let bad = |name, value: String, range| SettingError { name, value, range };
+        if !(1..=MAX_SIDE).contains(&self.width) {
+            return Err(bad("width", self.width.to_string(), "[1, 16384] pixels"));
+        }
+        if !(1..=MAX_SIDE).contains(&self.height) {
+            return Err(bad("height", self.height.to_string(), "[1, 16384] pixels"));
+        }
+        if self.spp == 0 {
+            return Err(bad("spp", "0".into(), "[1, 2^32)"));
+        }
+        if let Some(t) = self.threads
+            && !(1..=MAX_THREADS).contains(&t)
+        {
+            return Err(bad("threads", t.to_string(), "[1, 1024]"));
+        }
+        if !(1..=MAX_DEPTH).contains(&self.path.max_depth) {
+            return Err(bad(
+                "path.max_depth",
+                self.path.max_depth.to_string(),
+                "[1, 1024]",
+            ));
+        }
+        Ok(RenderSettings(self))
+    }
+}
+
+/// Render options that passed [`RenderOptions::validate`]: only these reach [`render`] (the
+/// default options are valid).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct RenderSettings(RenderOptions);
+
+impl std::ops::Deref for RenderSettings {
+    type Target = RenderOptions;
+    fn deref(&self) -> &RenderOptions {
+        &self.0
     }
 }
 
@@ -94,35 +156,19 @@ fn sample_seed(seed: u64, pixel: u64, sample: u32) -> u64 {
     z ^ (z >> 31)
 }
 
-/// Render `scene` into a new film.
+/// Render `scene` into a new film with validated `settings`.
 pub fn render(
     scene: &Scene,
     settings: &RenderSettings,
 ) -> Result<(Film, RenderStats), RenderError> {
-    let setting = |name, value: String, range| RenderError::Setting { name, value, range };
-    if settings.width == 0 || settings.width > 16384 {
-        return Err(setting("--width", settings.width.to_string(), "[1, 16384]"));
-    }
-    if settings.height == 0 || settings.height > 16384 {
-        return Err(setting(
-            "--height",
-            settings.height.to_string(),
-            "[1, 16384]",
-        ));
-    }
-    if settings.spp == 0 {
-        return Err(setting("--spp", "0".into(), "[1, 2^32)"));
-    }
-    if settings.threads == Some(0) {
-        return Err(setting("--threads", "0".into(), "[1, 1024]"));
-    }
     let mut builder = rayon::ThreadPoolBuilder::new();
     if let Some(t) = settings.threads {
         builder = builder.num_threads(t);
     }
-    let pool = builder
-        .build()
-        .map_err(|e| setting("--threads", e.to_string(), "[1, 1024]"))?;
+    let pool = builder.build().map_err(|e| RenderError::Threads {
+        threads: settings.threads,
+        message: e.to_string(),
+    })?;
     pool.install(|| render_passes(scene, settings))
 }
 

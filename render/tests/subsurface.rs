@@ -1,4 +1,4 @@
-//! End-to-end checks of subsurface scattering in the tracer (issue 7): the flat slab renders to the
+//! End-to-end checks of subsurface scattering in the tracer: the flat slab renders to the
 //! model's total diffuse reflectance with the documented energy split plus the specular term, a
 //! closed sphere of skin in a white furnace never outshines the environment, and skin parameters
 //! at the edges of their ranges render finite, non-negative images.

@@ -1,11 +1,11 @@
-//! End-to-end checks of the path tracer against closed forms (issue 6): white furnace, Lambertian
+//! End-to-end checks of the path tracer against closed forms: white furnace, Lambertian
 //! plane under a distant light, D65 round trip to sRGB white, bad scenes, the default scene,
 //! and thread-count independence.
 
 mod common;
 
 use common::{assert_close, mean_xyz, run, scene, xyz_of};
-use render::renderer::{RenderSettings, render};
+use render::renderer::{RenderOptions, render};
 use render::scene::{Scene, SceneOptions};
 
 /// Seed of every render in this file.
@@ -139,16 +139,16 @@ fn image_does_not_depend_on_thread_count() {
         intensity = 20
         "#,
     );
-    let mut settings = RenderSettings {
+    let mut settings = RenderOptions {
         width: 24,
         height: 16,
         spp: 3,
         threads: Some(1),
         ..Default::default()
     };
-    let a = render(&s, &settings).unwrap().0;
+    let a = render(&s, &settings.clone().validate().unwrap()).unwrap().0;
     settings.threads = Some(2);
-    let b = render(&s, &settings).unwrap().0;
+    let b = render(&s, &settings.clone().validate().unwrap()).unwrap().0;
     assert_eq!(a, b);
 }
 

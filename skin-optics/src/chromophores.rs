@@ -235,7 +235,8 @@ mod tests {
 
     #[test]
     fn blood_check_value_oxy_414() {
-        // docs/physics.md: 280.80 mm⁻¹; ε(414) = 524 280 cm⁻¹/M gives 280.7946 with Prahl's 2.303.
+        // docs/physics.md §1 check value: ε(414) = 524 280 cm⁻¹/M gives 280.7946 mm⁻¹ with Prahl's
+        // 2.303 for ln 10, 280.80 to the table's 5 digits.
         let v = oxyhemoglobin_sigma_a(wl(414.0));
         assert!((v - 280.80).abs() < 0.01, "{v}");
         assert!(rel(v, 2.303 * 524_280.0 * 150.0 / 64_500.0 / 10.0) < 1e-14);

@@ -1,4 +1,7 @@
 //! Typed errors for invalid optical inputs.
+//!
+//! `NonFinite` and `OutOfRange` have the same shape as `brdf::BrdfError`'s: both crates are leaves
+//! with no common dependency, and each library crate owns one error enum.
 
 use thiserror::Error;
 
@@ -48,4 +51,18 @@ pub(crate) fn check_range(
         return Err(OpticsError::OutOfRange { name, value, range });
     }
     Ok(value)
+}
+
+/// [`check_range`] on the half-open interval (0, `max`]: zero is rejected as out of range.
+pub(crate) fn check_positive(
+    name: &'static str,
+    value: f64,
+    max: f64,
+    range: &'static str,
+) -> Result<f64, OpticsError> {
+    let v = check_range(name, value, 0.0, max, range)?;
+    if v <= 0.0 {
+        return Err(OpticsError::OutOfRange { name, value, range });
+    }
+    Ok(v)
 }

@@ -211,7 +211,7 @@ pub fn delta_e_2000(c1: Lab, c2: Lab) -> f64 {
 }
 
 /// Skin-colour category of the Individual Typology Angle ([CGD91]; the six classes of
-/// Del Bino et al. 2006). Each class includes its upper bound: light is 41° < ITA° ≤ 55°,
+/// [DB06]). Each class includes its upper bound: light is 41° < ITA° ≤ 55°,
 /// very light is ITA° > 55°, dark is ITA° ≤ −30°.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum ItaCategory {

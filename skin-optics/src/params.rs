@@ -1,6 +1,6 @@
 //! The four physical parameters of skin ([DJ06]) and the constants the seed fixes, validated.
 
-use crate::error::{OpticsError, check_range};
+use crate::error::{OpticsError, check_positive, check_range};
 use std::fmt;
 use std::str::FromStr;
 
@@ -125,15 +125,8 @@ impl SkinParams {
 
     /// Same skin with epidermis thickness in mm, in (0, 10] mm.
     pub fn with_epidermis_thickness_mm(mut self, d_mm: f64) -> Result<Self, OpticsError> {
-        let d = check_range("epidermis thickness (mm)", d_mm, 0.0, 10.0, "(0, 10] mm")?;
-        if d <= 0.0 {
-            return Err(OpticsError::OutOfRange {
-                name: "epidermis thickness (mm)",
-                value: d_mm,
-                range: "(0, 10] mm",
-            });
-        }
-        self.epidermis_thickness_mm = d;
+        self.epidermis_thickness_mm =
+            check_positive("epidermis thickness (mm)", d_mm, 10.0, "(0, 10] mm")?;
         Ok(self)
     }
 
@@ -145,15 +138,8 @@ impl SkinParams {
 
     /// Same skin with the dermis reduced scattering scaled by `scale` in (0, 4] (1 = the seed).
     pub fn with_dermis_scattering_scale(mut self, scale: f64) -> Result<Self, OpticsError> {
-        let s = check_range("dermis scattering scale", scale, 0.0, 4.0, "(0, 4]")?;
-        if s <= 0.0 {
-            return Err(OpticsError::OutOfRange {
-                name: "dermis scattering scale",
-                value: scale,
-                range: "(0, 4]",
-            });
-        }
-        self.dermis_scattering_scale = s;
+        self.dermis_scattering_scale =
+            check_positive("dermis scattering scale", scale, 4.0, "(0, 4]")?;
         Ok(self)
     }
 
@@ -342,7 +328,7 @@ mod tests {
     }
 
     #[test]
-    fn presets_match_physics_md() {
+    fn presets_match_documented_values() {
         let get = |p| {
             let s = SkinParams::preset(p);
             (

@@ -1,4 +1,5 @@
-//! Photon rate of the layered Monte Carlo on the cases issue 4 quotes for the classic MCML:
+//! Photon rate of the layered Monte Carlo on the three cases BENCHMARKS.md compares with the classic
+//! MCML program ([WJZ95]):
 //! light preset at 550 nm (g = 0.9), very dark skin (C_m 0.5, β_m 0.9, C_h 0.07) at 550 nm, and a
 //! half-space with σa = 0.01, σs' = 1 mm⁻¹, g = 0.9, n = 1.4; on 1 and 2 rayon threads.
 //! Throughput is in photons (criterion reports elements/s).
@@ -6,9 +7,9 @@
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use skin_optics::{Preset, SkinParams, Wavelength};
 use std::hint::black_box;
-use validation::montecarlo::{DEFAULT_SKIN_G, Layer, LayerStack, McOptions, run};
+use validation::montecarlo::{DEFAULT_G, Layer, LayeredMedium, McOptions, run};
 
-fn cases() -> Vec<(&'static str, LayerStack, u64)> {
+fn cases() -> Vec<(&'static str, LayeredMedium, u64)> {
     let l550 = Wavelength::new(550.0).expect("550 nm is in range");
     let light = SkinParams::preset(Preset::Light);
     let very_dark = SkinParams::new(0.5, 0.9, 0.07, 0.25).expect("valid fractions");
@@ -16,17 +17,17 @@ fn cases() -> Vec<(&'static str, LayerStack, u64)> {
     vec![
         (
             "light_550nm",
-            LayerStack::skin(&light, l550, DEFAULT_SKIN_G).expect("valid"),
+            LayeredMedium::skin(&light, l550, DEFAULT_G).expect("valid"),
             4_000,
         ),
         (
             "very_dark_550nm",
-            LayerStack::skin(&very_dark, l550, DEFAULT_SKIN_G).expect("valid"),
+            LayeredMedium::skin(&very_dark, l550, DEFAULT_G).expect("valid"),
             40_000,
         ),
         (
             "half_space_sa0.01",
-            LayerStack::new(vec![half], 1.0, 1.0).expect("valid"),
+            LayeredMedium::new(vec![half], 1.0, 1.0).expect("valid"),
             1_000,
         ),
     ]

@@ -1,4 +1,4 @@
-//! Radial profile error of `Method::Exact` against the layered Monte Carlo (issue [exact]: energy-weighted
+//! Radial profile error of `Method::Exact` against the layered Monte Carlo (target: energy-weighted
 //! error within 10%), for each `multipole::skin::ExactShape` and the plain multipole.
 //!
 //! Error = Σ_bins |E_model − E_mc| / R_mc, E = ∫ 2πr R dr over each MC annulus (per incident photon:
@@ -14,7 +14,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use multipole::skin::{ExactShape, Method, exact_profile, profile};
 use multipole::{Profile, ProfileOptions};
 use skin_optics::{Preset, SkinParams, Wavelength};
-use validation::montecarlo::{DEFAULT_SKIN_G, LayerStack, McOptions, McResult, run};
+use validation::montecarlo::{DEFAULT_G, LayeredMedium, McOptions, McResult, run};
 
 /// Knob values of the Monte Carlo shape (escaping photons per wavelength).
 const ESCAPES: [u64; 3] = [1_000, 4_000, 16_000];
@@ -82,7 +82,7 @@ fn main() -> anyhow::Result<()> {
     for (preset, nm) in cases {
         let skin = SkinParams::preset(preset);
         let lambda = Wavelength::new(nm)?;
-        let mc = run(&LayerStack::skin(&skin, lambda, DEFAULT_SKIN_G)?, &mc_opts);
+        let mc = run(&LayeredMedium::skin(&skin, lambda, DEFAULT_G)?, &mc_opts);
         bar.inc(1);
         let multi = profile(&skin, lambda, Method::Multipole, &opts)?;
         let resc = exact_profile(&skin, lambda, ExactShape::RescaledTotal, &opts)?;

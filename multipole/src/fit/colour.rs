@@ -288,7 +288,7 @@ mod tests {
         worst
     }
 
-    /// Issue 8: 200 random valid skins, colour → fit → colour within ΔE00 0.5 with the paper's
+    /// 200 random valid skins, colour → fit → colour within ΔE00 0.5 with the paper's
     /// diffusion model (measured worst 0.094).
     #[test]
     fn round_trip_of_200_random_skins_multipole() {
@@ -313,7 +313,9 @@ mod tests {
         let full = ColourModel::new(10.0, Method::Exact, base).unwrap();
         let fine48 = ColourModel::with_forward(
             10.0,
-            Forward::Exact(crate::adding_doubling::AddingDoublingOptions::new(48, 0.9).unwrap()),
+            Forward::Exact(
+                crate::exact::adding_doubling::AddingDoublingOptions::new(48, 0.9).unwrap(),
+            ),
             base,
         )
         .unwrap();
@@ -330,7 +332,7 @@ mod tests {
             let m = ColourModel::with_forward(
                 10.0,
                 Forward::Exact(
-                    crate::adding_doubling::AddingDoublingOptions::new(points, 0.9).unwrap(),
+                    crate::exact::adding_doubling::AddingDoublingOptions::new(points, 0.9).unwrap(),
                 ),
                 base,
             )
@@ -345,20 +347,9 @@ mod tests {
         }
     }
 
-    /// Process CPU seconds (all threads) from /proc (Linux; NaN elsewhere).
+    /// Process CPU seconds (all threads).
     fn cpu_s() -> f64 {
-        let Ok(stat) = std::fs::read_to_string("/proc/self/stat") else {
-            return f64::NAN;
-        };
-        // Fields after the parenthesised command: utime and stime are the 12th and 13th (ticks of 10 ms).
-        let rest = stat.rsplit(')').next().unwrap_or("");
-        let f: Vec<f64> = rest
-            .split_whitespace()
-            .skip(11)
-            .take(2)
-            .filter_map(|v| v.parse().ok())
-            .collect();
-        f.iter().sum::<f64>() / 100.0
+        cpu_time::ProcessTime::now().as_duration().as_secs_f64()
     }
 
     /// Times and accuracy of exact colour fits for BENCHMARKS.md: the two-stage default against a

@@ -19,8 +19,7 @@
 use super::FitError;
 use super::nelder_mead::{Budget, minimize};
 use crate::Method;
-use crate::adding_doubling::{AddingDoublingOptions, skin_totals};
-use crate::error::MultipoleError;
+use crate::exact::adding_doubling::{AddingDoublingOptions, skin_totals};
 use crate::skin::diffuse_reflectance;
 use rayon::prelude::*;
 use skin_optics::{SkinParams, Wavelength};
@@ -62,7 +61,7 @@ impl Forward {
             Forward::Method(m) => Ok(diffuse_reflectance(skin, lambda, *m)?),
             Forward::Exact(o) => skin_totals(skin, lambda, o)
                 .map(|t| t.diffuse_reflectance)
-                .map_err(|e| FitError::Model(MultipoleError::from(e))),
+                .map_err(FitError::Model),
         }
     }
 

@@ -1,4 +1,5 @@
-//! Fitting the skin parameters C_m, β_m, C_h to a target colour or a measured reflectance spectrum:
+//! Fitting the skin parameters C_m, β_m, C_h to a target colour or a measured reflectance spectrum
+//! (docs/physics.md §12):
 //! the inverse of the spectral skin model ([DJ06]), with [`crate::skin::diffuse_reflectance`] as the
 //! forward model (the observable: per unit incident flux, specular excluded).
 //!
@@ -31,7 +32,7 @@
 //!
 //! **Forward model.** [`FitOptions::method`], default [`Method::Exact`] (adding-doubling totals: right
 //! for every skin tone, where diffusion draws dark skin two to three times too bright and so returns
-//! the wrong melanin, issue [exact]). An exact fit runs in two stages (module `forward`): the search
+//! the wrong melanin; BENCHMARKS.md `## Exact method`). An exact fit runs in two stages (module `forward`): the search
 //! above with adding-doubling at [`FitOptions::search_quadrature_points`] (8) and
 //! [`FitOptions::search_step_nm`] (20 nm), then output space mapping onto the full model (24 points,
 //! [`FitOptions::step_nm`]) in two to four full evaluations, about 0.7 CPU-s per colour fit instead
@@ -72,7 +73,7 @@ pub struct FitOptions {
     /// Forward model passed through to [`crate::skin::diffuse_reflectance`]. Default [`Method::Exact`]
     /// (adding-doubling totals, right for every skin tone), searched with a cheaper quadrature and
     /// corrected to the full model (module `forward`); [`Method::Multipole`] is the paper's diffusion
-    /// (closed-form totals, one stage, reproduces [DJ06]; wrong for dark skin, issue [exact]).
+    /// (closed-form totals, one stage, reproduces [DJ06]; wrong for dark skin, docs/physics.md §9).
     pub method: Method,
     /// Quadrature points per hemisphere of the adding-doubling model in the search stage (grid,
     /// starts, β_m sweep) of an exact fit; even, in [4, 64]. Default 8 (about 12 times cheaper than the
@@ -171,7 +172,7 @@ impl FitOptions {
         check(
             "search_quadrature_points",
             self.search_quadrature_points as f64,
-            (4..=crate::adding_doubling::MAX_QUADRATURE_POINTS)
+            (4..=crate::exact::adding_doubling::MAX_QUADRATURE_POINTS)
                 .contains(&self.search_quadrature_points)
                 && self.search_quadrature_points.is_multiple_of(2),
             "even numbers in [4, 64]",

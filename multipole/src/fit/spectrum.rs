@@ -157,7 +157,7 @@ mod tests {
         }
     }
 
-    /// Issue 8: a spectrum from known parameters plus 1 % (relative, Gaussian) noise on 61
+    /// A spectrum from known parameters plus 1 % (relative, Gaussian) noise on 61
     /// wavelengths, weighted by the inverse noise variance, fits back to C_m within 10 % and β_m
     /// within 0.1 where melanin shapes the spectrum (C_m ≥ 0.02), and C_h within 15 % where the
     /// dermis shows through (C_m ≤ 0.1; at C_m = 0.3 the whole range of C_h changes this spectrum by

@@ -1,15 +1,15 @@
 //! Why a method is (or is not) trustworthy at one wavelength: the numbers behind the choice of
-//! treatment, printed by `skin spectrum --explain` and `skin profile --explain` (issue [exact]).
+//! treatment, printed by `skin spectrum --explain` and `skin profile --explain` (docs/physics.md §9).
 
 use super::{ExactShape, Method, layer_scales, shape_photons, total_reflectance};
+use crate::diffusion::medium::Medium;
+use crate::diffusion::slab::Poles;
 use crate::error::MultipoleError;
-use crate::medium::Medium;
-use crate::slab::Poles;
 use skin_optics::{SkinParams, Wavelength};
 use std::fmt;
 
-/// Relative difference |multipole / exact − 1| below which diffusion is called accurate (the issue's
-/// 2% target for total reflectance).
+/// Relative difference |multipole / exact − 1| below which diffusion is called accurate (a 2%
+/// target for total reflectance).
 pub const DIFFUSION_OK: f64 = 0.02;
 
 /// The per-wavelength diagnostic of [`explain`].

@@ -3,14 +3,15 @@
 //! (exact transport, cached per material by whoever tabulates it, e.g. the renderer's tables).
 
 use super::{Method, stack, total_reflectance};
-use crate::adding_doubling::{AddingDoublingOptions, LayerTotals, skin_layer_totals};
-use crate::boundary::observable_reflectance;
+use crate::diffusion::boundary::observable_reflectance;
+use crate::diffusion::profile::Profile;
+use crate::diffusion::slab::Poles;
+use crate::diffusion::spatial::{ProfileOptions, stack_profile};
+use crate::diffusion::stack::Response;
 use crate::error::MultipoleError;
-use crate::montecarlo::{self, DEFAULT_SKIN_G, LayerStack, McOptions, RadialGrid};
-use crate::profile::Profile;
-use crate::slab::Poles;
-use crate::spatial::{ProfileOptions, stack_profile};
-use crate::stack::Response;
+use crate::exact::adding_doubling::{AddingDoublingOptions, LayerTotals, skin_layer_totals};
+use crate::exact::montecarlo::{self, McOptions, RadialGrid};
+use crate::layered::{DEFAULT_G, LayeredMedium};
 use skin_optics::{SkinParams, Wavelength};
 
 /// Escaping photons per wavelength of the default Monte Carlo shape (the accuracy knob: the
@@ -41,7 +42,7 @@ pub const SHAPE_SEED: u64 = 0x5EED_5111;
 /// | 550 nm | 32.0% / 224% | 32.3% / 67.8% | 29.8% / 67.8% | 10.0 / 5.3 / 2.8% (14 / 52 / 204 ms) | 5.6 / 3.9 / 3.2% (55 / 220 / 884 ms) | 1.2% / 1.3% |
 /// | 650 nm | 25.9% / 185% | 25.8% / 61.1% | 24.8% / 57.9% | 8.5 / 4.0 / 3.6% (27 / 105 / 406 ms) | 3.9 / 2.9 / 2.8% (226 / 882 / 3496 ms) | 1.5% / 1.5% |
 ///
-/// Neither diffusion shape meets issue [exact]'s 10%: the error is the shape of diffusion *within* a
+/// Neither diffusion shape meets a 10% target: the error is the shape of diffusion *within* a
 /// layer, which no scalar per layer can change. For dark skin the epidermis (transmitting 3·10⁻⁵ to
 /// 4% of the light) makes almost all of the reflectance, and the Monte Carlo puts 81% of it within
 /// 0.03 mm at 450 nm where diffusion puts 68%; for light skin diffusion has too much at 0.03–0.3 mm
@@ -55,13 +56,13 @@ pub enum ExactShape {
     /// split between the epidermis' narrow peak and the dermis' wide tail, which is wrong for dark skin
     /// (the low-albedo epidermis reflects far less, relative to the dermis, than diffusion says).
     RescaledTotal,
-    /// Each layer rescaled before stacking (issue [exact]): every diffusion response R̂(q), T̂(q) of
+    /// Each layer rescaled before stacking: every diffusion response R̂(q), T̂(q) of
     /// the epidermis (both directions) and the dermis is multiplied by exact/diffusion at q = 0, the
     /// exact per-layer totals coming from adding-doubling (`adding_doubling::skin_layer_totals`), then
     /// the stack is folded as usual and the result scaled to the exact two-layer total (a correction
     /// of a few percent: the scalars ignore the angular distributions passed between layers).
     PerLayer,
-    /// The shape of the layered Monte Carlo ([WJZ95], `crate::montecarlo`; HG g = 0.9, the model's
+    /// The shape of the layered Monte Carlo ([WJZ95], `crate::exact::montecarlo`; HG g = 0.9, the model's
     /// two layers and Fresnel boundaries) on a geometric grid ([`SHAPE_R0_MM`] to
     /// [`SHAPE_R_MAX_MM`], [`SHAPE_BINS`] annuli, fixed seed [`SHAPE_SEED`]), scaled to the exact
     /// total: transport is exact, only noise remains. `escapes` is the knob: the photons traced are
@@ -174,7 +175,7 @@ pub fn monte_carlo_shape(
             range: "[100, 1e12]",
         });
     }
-    let stack = LayerStack::skin(skin, lambda, DEFAULT_SKIN_G)?;
+    let stack = LayeredMedium::skin(skin, lambda, DEFAULT_G)?;
     let grid = shape_grid()?;
     let photons = shape_photons(escapes, total, skin.eta());
     let opts = McOptions::new(photons, 8, SHAPE_SEED)?.with_grid(grid);

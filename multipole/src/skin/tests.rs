@@ -1,14 +1,15 @@
 //! Tests of the two-layer skin: methods, totals, profiles, knobs.
 
 use super::*;
-use crate::stack::Response;
+use crate::diffusion::stack::Response;
 use skin_optics::{Preset, WavelengthGrid};
 
 #[test]
 fn exact_method_gives_adding_doubling_totals_and_rescaled_profiles() {
     let light = SkinParams::preset(Preset::Light);
     let lambda = Wavelength::new(550.0).unwrap();
-    // Issue [validation] reference for this skin and wavelength (exact transport): 0.4370 ± 0.0008.
+    // Independent exact-transport reference for this skin and wavelength (BENCHMARKS.md
+    // `## Exact method`): 0.4370 ± 0.0008.
     let obs = diffuse_reflectance(&light, lambda, Method::Exact).unwrap();
     assert!((obs - 0.4370).abs() < 0.005 * 0.4370, "{obs}");
     let total = total_reflectance(&light, lambda, Method::Exact).unwrap();
@@ -195,7 +196,7 @@ mod exact_properties {
     proptest! {
         #![proptest_config(ProptestConfig { cases: 16, ..ProptestConfig::default() })]
 
-        /// Issue [exact]: where the melanin-laden epidermis absorbs (C_m ≥ 0.05), exact transport never
+        /// Where the melanin-laden epidermis absorbs (C_m ≥ 0.05), exact transport never
         /// reflects more than diffusion (measured: diffusion is 22% to 260% too bright there), and the
         /// exact profile carries exactly the exact total, 99.9% of it inside its table.
         #[test]
@@ -219,12 +220,12 @@ mod exact_properties {
 
 mod direction_tests {
     use super::*;
-    use crate::stack::Response;
+    use crate::diffusion::stack::Response;
     use skin_optics::Preset;
 
     #[test]
     fn directional_stacking_differs_from_the_symmetric_shortcut() {
-        // physics.md §6: using ↓ for both directions overestimates light skin's red reflectance by
+        // docs/physics.md §6: using ↓ for both directions overestimates light skin's red reflectance by
         // about 16% at 650 nm. Pin the size (10–25%) and the sign.
         let skin = SkinParams::preset(Preset::Light);
         let st = stack(&skin, Wavelength::new(650.0).unwrap()).unwrap();

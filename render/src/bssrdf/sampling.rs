@@ -1,4 +1,4 @@
-//! Exit-point sampling with probe rays ([KHPC13], pbrt-v3/v4; physics.md §8).
+//! Exit-point sampling with probe rays ([KHPC13], pbrt-v3/v4; docs/physics.md §8).
 //!
 //! Pick an axis of the shading frame at the entry point (normal ½, each tangent ¼), a radius r
 //! from the hero wavelength's 2πr R(r) / R_tot and φ uniform; the probe is the segment of

@@ -1,4 +1,4 @@
-//! The separable BSSRDF ([JMLH01], pbrt-v3; physics.md §8) and its energy split with the specular
+//! The separable BSSRDF ([JMLH01], pbrt-v3; docs/physics.md §8) and its energy split with the specular
 //! surface layer:
 //!
 //! S(p_o, ω_o; p_i, ω_i) = T(cos θ_o) · R(‖p_o − p_i‖) · S_ω(ω_i),   S_ω(ω) = T(cos θ) / (c π),
@@ -7,7 +7,7 @@
 //! ∫ S_ω cos θ dω = 1 (so a flat slab reflects exactly R_tot · T(θ_o) of what enters).
 //!
 //! # Energy split (the choice, and why)
-//! physics.md §8 writes T = 1 − F_r (smooth-surface Fresnel) and c = 1 − 2 F̄₁ (`brdf::fresnel`).
+//! docs/physics.md §8 writes T = 1 − F_r (smooth-surface Fresnel) and c = 1 − 2 F̄₁ (`brdf::fresnel`).
 //! The renderer's surface layer is a *rough* oily Torrance–Sparrow lobe ([TS67], [DJ06]) that
 //! reflects ρ_dr(θ) = `directional_albedo`, which is not F_r(θ): with the Fresnel split, surface +
 //! subsurface could exceed 1 or leave a gap. The default is therefore [`EnergySplit::SpecularLobe`],
@@ -26,7 +26,7 @@ pub enum EnergySplit {
     /// T(θ) = 1 − directional albedo of the specular lobe (default, energy conserving with it).
     #[default]
     SpecularLobe,
-    /// T(θ) = 1 − F_r(cos θ, η) (smooth dielectric, physics.md §8 as written).
+    /// T(θ) = 1 − F_r(cos θ, η) (smooth dielectric, docs/physics.md §8 as written).
     Fresnel,
 }
 
@@ -52,7 +52,7 @@ impl Directional {
             c: 1.0,
         };
         d.c = match split {
-            // physics.md §8: c = 1 − 2 F̄₁, F̄₁ from the brdf crate's Fresnel moments.
+            // docs/physics.md §8: c = 1 − 2 F̄₁, F̄₁ from the brdf crate's Fresnel moments.
             EnergySplit::Fresnel => {
                 (1.0 - 2.0 * fresnel_moment(1, f64::from(d.surface.eta()))) as f32
             }
@@ -148,7 +148,7 @@ mod tests {
         }
     }
 
-    /// c for the Fresnel split is physics.md's ≈ 0.923 at η = 1.4 (0.919 with the exact moment).
+    /// c for the Fresnel split is docs/physics.md §8's ≈ 0.923 at η = 1.4 (0.919 with the exact moment).
     #[test]
     fn fresnel_normalisation_matches_physics_md() {
         let c = Directional::new(lobe(), EnergySplit::Fresnel).normalisation();

@@ -1,5 +1,5 @@
 //! Per-material radial profile tables for rendering: 2πr R(r) on one geometric radius grid per
-//! material, one row per tabulation wavelength, each with its CDF, in f32 (physics.md §8).
+//! material, one row per tabulation wavelength, each with its CDF, in f32 (docs/physics.md §8).
 //!
 //! The profiles themselves come from the owner, `multipole::SpectralProfiles` (`Method::Exact`:
 //! adding-doubling totals with layered Monte Carlo shapes, [`RENDER_SHAPE_ESCAPES`] every
@@ -21,7 +21,7 @@
 //! tail is redistributed over the table instead of being lost.
 
 use multipole::skin::ExactShape;
-use multipole::{Method, MultipoleError, Profile, ProfileOptions, SpectralProfiles};
+use multipole::{Method, MultipoleError, Profile, ProfileOptions, SpectralProfiles, sampling};
 use skin_optics::{SkinParams, WavelengthGrid};
 use std::f32::consts::PI;
 
@@ -159,7 +159,7 @@ impl ProfileTable {
                         (2.0 * std::f64::consts::PI * f64::from(r) * pr.eval(f64::from(r))) as f32
                     })
                     .collect();
-                let cdf = cumulative(&radii_mm, &p);
+                let cdf = sampling::cumulative(&radii_mm, &p);
                 let integral = cdf[len - 1];
                 let total = pr.total() as f32;
                 if integral.is_nan() || integral <= 0.0 || !total.is_finite() {
@@ -169,7 +169,7 @@ impl ProfileTable {
                 }
                 let scale = total / integral;
                 p.iter_mut().for_each(|v| *v *= scale);
-                let cdf = cumulative(&radii_mm, &p);
+                let cdf = sampling::cumulative(&radii_mm, &p);
                 Ok(Row { p, cdf, len, total })
             })
             .collect::<Result<Vec<_>, _>>()?;
@@ -231,16 +231,7 @@ impl ProfileTable {
 
     /// Density p(r) = 2πr R(r) of one row at `r_mm`, mm⁻¹ (0 beyond the row).
     fn row_p(&self, row: &Row, r_mm: f32) -> f32 {
-        let rs = &self.radii_mm[..row.len];
-        if r_mm.is_nan() || r_mm < 0.0 || r_mm > rs[row.len - 1] {
-            return 0.0;
-        }
-        let i = rs.partition_point(|&r| r < r_mm);
-        if i == 0 {
-            return row.p[0] * r_mm / rs[0];
-        }
-        let t = (r_mm - rs[i - 1]) / (rs[i] - rs[i - 1]);
-        row.p[i - 1] + t * (row.p[i] - row.p[i - 1])
+        sampling::density(&self.radii_mm[..row.len], &row.p[..row.len], r_mm)
     }
 
     /// R(r) at `nm` and distance `r_mm`, mm⁻² (integrates to [`ProfileTable::total`] over the plane).
@@ -285,38 +276,8 @@ impl ProfileTable {
     /// The radius of `row` where its cumulative energy reaches `target`.
     fn invert(&self, row: &Row, target: f32) -> f32 {
         let n = row.len;
-        if target >= row.cdf[n - 1] {
-            return self.radii_mm[n - 1];
-        }
-        let i = row.cdf[..n].partition_point(|&c| c < target);
-        let (r0, c0, p0) = if i == 0 {
-            (0.0, 0.0, 0.0)
-        } else {
-            (self.radii_mm[i - 1], row.cdf[i - 1], row.p[i - 1])
-        };
-        let (r1, p1) = (self.radii_mm[i], row.p[i]);
-        let h = r1 - r0;
-        // p linear on the segment: solve p0 s + (p1 − p0) s² / (2h) = target − c0 for s ∈ [0, h]
-        // with the cancellation-free root.
-        let need = (target - c0).max(0.0);
-        let a = 0.5 * (p1 - p0) / h;
-        let disc = (p0 * p0 + 4.0 * a * need).max(0.0);
-        let denom = p0 + disc.sqrt();
-        let s = if denom > 0.0 { 2.0 * need / denom } else { 0.0 };
-        r0 + s.clamp(0.0, h)
+        sampling::invert(&self.radii_mm[..n], &row.p[..n], &row.cdf[..n], target)
     }
-}
-
-/// Cumulative trapezoid of a density linear between `radii` (and from 0 at r = 0).
-fn cumulative(radii: &[f32], p: &[f32]) -> Vec<f32> {
-    let mut acc = 0.5 * radii[0] * p[0];
-    let mut out = Vec::with_capacity(p.len());
-    out.push(acc);
-    for i in 1..p.len() {
-        acc += 0.5 * (radii[i] - radii[i - 1]) * (p[i] + p[i - 1]);
-        out.push(acc);
-    }
-    out
 }
 
 #[cfg(test)]

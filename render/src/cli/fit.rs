@@ -125,6 +125,73 @@ fn params_json(skin: &SkinParams) -> serde_json::Value {
     })
 }
 
+/// What both kinds of fit report alike: the skin found, its colour, the β_m range and the effort.
+struct Found<'a> {
+    method: Method,
+    skin: &'a SkinParams,
+    fitted_hex: &'a str,
+    lab: Lab,
+    beta_range: Option<BetaRange>,
+    beta_prior: f64,
+    evaluations: usize,
+    full_evaluations: usize,
+}
+
+/// The [`Found`] of a colour or a spectrum fit (the two result types share these fields).
+macro_rules! found {
+    ($fit:expr, $hex:expr, $opts:expr) => {
+        Found {
+            method: $opts.method,
+            skin: &$fit.skin,
+            fitted_hex: $hex,
+            lab: $fit.lab,
+            beta_range: $fit.beta_range,
+            beta_prior: $opts.beta_prior,
+            evaluations: $fit.evaluations,
+            full_evaluations: $fit.full_evaluations,
+        }
+    };
+}
+
+impl Found<'_> {
+    /// One JSON object: the shared keys merged with the kind's `own` keys (objects under the same
+    /// key, such as `fitted`, are merged too).
+    fn json(&self, own: serde_json::Value) -> serde_json::Value {
+        let mut out = serde_json::json!({
+            "method": self.method.to_string(),
+            "parameters": params_json(self.skin),
+            "fitted": { "srgb": self.fitted_hex, "lab": lab_json(self.lab) },
+            "beta_range": beta_json(self.beta_range),
+            "beta_prior": self.beta_prior,
+            "evaluations": self.evaluations,
+            "full_evaluations": self.full_evaluations,
+        });
+        if let (Some(o), serde_json::Value::Object(own)) = (out.as_object_mut(), own) {
+            for (k, v) in own {
+                match (o.get_mut(&k), v) {
+                    (Some(serde_json::Value::Object(a)), serde_json::Value::Object(b)) => {
+                        a.extend(b);
+                    }
+                    (_, v) => {
+                        o.insert(k, v);
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    /// The text lines after the target's: skin, fitted colour, `residual`, β_m range in `unit`.
+    fn print(&self, residual: &str, unit: &str) {
+        println!("{}", skin_line(self.skin, self.method));
+        println!("{}", colour_line("fitted", self.fitted_hex, self.lab));
+        println!("{:<9}{residual}", "residual");
+        if let Some(l) = beta_line(self.beta_range, unit, self.beta_prior) {
+            println!("{l}");
+        }
+    }
+}
+
 /// Run `skin fit`.
 pub fn run(args: &FitArgs) -> anyhow::Result<()> {
     let opts = FitOptions {
@@ -136,29 +203,18 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
         let target = Lab::from_srgb(hex.srgb);
         let fit = fit_colour(target, &opts)?;
         let fitted_hex = hex_of(fit.xyz);
+        let found = found!(fit, &fitted_hex, opts);
         if args.json {
-            let out = serde_json::json!({
+            let out = found.json(serde_json::json!({
                 "target": { "srgb": hex.text, "lab": lab_json(target) },
-                "method": args.method.to_string(),
-                "parameters": params_json(&fit.skin),
-                "fitted": { "srgb": fitted_hex, "lab": lab_json(fit.lab) },
                 "residual": { "delta_e_2000": fit.delta_e },
                 "in_gamut": fit.in_gamut,
                 "gamut_threshold_delta_e_2000": opts.gamut_threshold_de,
-                "beta_range": beta_json(fit.beta_range),
-                "beta_prior": opts.beta_prior,
-                "evaluations": fit.evaluations,
-                "full_evaluations": fit.full_evaluations,
-            });
+            }));
             println!("{out}");
         } else {
             println!("{}", colour_line("target", &hex.text, target));
-            println!("{}", skin_line(&fit.skin, args.method));
-            println!("{}", colour_line("fitted", &fitted_hex, fit.lab));
-            println!("{:<9}ΔE2000 = {:.3}", "residual", fit.delta_e);
-            if let Some(l) = beta_line(fit.beta_range, "ΔE2000", opts.beta_prior) {
-                println!("{l}");
-            }
+            found.print(&format!("ΔE2000 = {:.3}", fit.delta_e), "ΔE2000");
         }
         if !fit.in_gamut {
             anyhow::bail!(
@@ -180,25 +236,15 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
         MeasuredSpectrum::parse_csv(&text).with_context(|| path.display().to_string())?;
     let fit = fit_spectrum(&measured, &opts)?;
     let fitted_hex = fit.lab.to_srgb().to_hex();
+    let found = found!(fit, &fitted_hex, opts);
     if args.json {
-        let out = serde_json::json!({
+        let out = found.json(serde_json::json!({
             "target": { "spectrum": path.display().to_string(), "points": measured.len() },
-            "method": args.method.to_string(),
-            "parameters": params_json(&fit.skin),
-            "fitted": {
-                "srgb": fitted_hex,
-                "lab": lab_json(fit.lab),
-                "lambda_nm": measured.lambda_nm(),
-                "reflectance": fit.model,
-            },
+            "fitted": { "lambda_nm": measured.lambda_nm(), "reflectance": fit.model },
             "residual": { "rms_reflectance": fit.rms },
             "within_tolerance": fit.within_tolerance,
             "max_rms_reflectance": opts.max_rms,
-            "beta_range": beta_json(fit.beta_range),
-            "beta_prior": opts.beta_prior,
-            "evaluations": fit.evaluations,
-            "full_evaluations": fit.full_evaluations,
-        });
+        }));
         println!("{out}");
     } else {
         println!(
@@ -209,12 +255,7 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
             measured.lambda_nm()[0],
             measured.lambda_nm()[measured.len() - 1]
         );
-        println!("{}", skin_line(&fit.skin, args.method));
-        println!("{}", colour_line("fitted", &fitted_hex, fit.lab));
-        println!("{:<9}RMS reflectance = {:.5}", "residual", fit.rms);
-        if let Some(l) = beta_line(fit.beta_range, "RMS", opts.beta_prior) {
-            println!("{l}");
-        }
+        found.print(&format!("RMS reflectance = {:.5}", fit.rms), "RMS");
     }
     if !fit.within_tolerance {
         anyhow::bail!(

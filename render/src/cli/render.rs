@@ -1,7 +1,7 @@
 //! `skin render`: load a scene (the built-in three-head scene by default), path trace it, and write
 //! OUT/render.exr (linear sRGB, f32) and OUT/render.png (sRGB, exposure + filmic tone curve).
 
-use crate::renderer::{RenderSettings, render};
+use crate::renderer::{RenderOptions, SettingError, render};
 use crate::scene::{Scene, SceneOptions};
 use clap::Args;
 use std::path::PathBuf;
@@ -55,8 +55,9 @@ pub struct RenderArgs {
         allow_hyphen_values = true
     )]
     pub exposure: f32,
-    /// Maximum scattering events per path.
-    #[arg(long, value_name = "N", default_value_t = 16)]
+    /// Maximum scattering events per path, in [1, 1024].
+    #[arg(long, value_name = "N", default_value_t = 16,
+          value_parser = clap::value_parser!(u32).range(1..=1024))]
     pub max_depth: u32,
     /// No progress bar.
     #[arg(long)]
@@ -74,6 +75,22 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
             args.exposure
         );
     }
+    // Validated before the scene loads, so a bad flag fails fast.
+    let settings = RenderOptions {
+        width: args.width as usize,
+        height: args.height as usize,
+        spp: args.spp,
+        time_limit: (args.time_limit > 0.0).then(|| Duration::from_secs_f64(args.time_limit)),
+        seed: args.seed,
+        threads: args.threads.map(|t| t as usize),
+        path: crate::integrator::PathSettings {
+            max_depth: args.max_depth,
+            ..Default::default()
+        },
+        progress: !args.quiet,
+    }
+    .validate()
+    .map_err(flag_error)?;
     let t0 = Instant::now();
     let scene = Scene::load(
         &args.scene,
@@ -92,19 +109,6 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         scene.materials.len(),
         load.as_secs_f64()
     );
-    let settings = RenderSettings {
-        width: args.width as usize,
-        height: args.height as usize,
-        spp: args.spp,
-        time_limit: (args.time_limit > 0.0).then(|| Duration::from_secs_f64(args.time_limit)),
-        seed: args.seed,
-        threads: args.threads.map(|t| t as usize),
-        path: crate::integrator::PathSettings {
-            max_depth: args.max_depth.max(1),
-            ..Default::default()
-        },
-        progress: !args.quiet,
-    };
     let (film, stats) = render(&scene, &settings)?;
     let exr = args.out.join("render.exr");
     let png = args.out.join("render.png");
@@ -127,6 +131,19 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         png.display()
     );
     Ok(())
+}
+
+/// A settings error in the words of the command line: the flag that sets the option.
+fn flag_error(e: SettingError) -> anyhow::Error {
+    let flag = match e.name {
+        "width" => "--width",
+        "height" => "--height",
+        "spp" => "--spp",
+        "threads" => "--threads",
+        "path.max_depth" => "--max-depth",
+        other => other,
+    };
+    anyhow::anyhow!("{flag} = {} outside {}", e.value, e.range)
 }
 
 fn rayon_threads(requested: Option<usize>) -> usize {

@@ -10,7 +10,7 @@
 use crate::export::ExportOptions;
 use crate::export::error::ExportError;
 use crate::export::spectral::{LayerOptics, SpectralSkin, to_stack};
-use multipole::montecarlo::LayerStack;
+use multipole::LayeredMedium;
 use std::fmt::Write;
 
 /// Millimetres per centimetre.
@@ -91,8 +91,8 @@ pub struct MciRun {
 }
 
 impl MciRun {
-    /// The run's layers as our Monte Carlo stack (mm, mm⁻¹).
-    pub fn to_stack(&self) -> Result<LayerStack, ExportError> {
+    /// The run's layers as our layered medium (mm, mm⁻¹).
+    pub fn to_stack(&self) -> Result<LayeredMedium, ExportError> {
         let layers: Vec<LayerOptics> = self
             .layers
             .iter()

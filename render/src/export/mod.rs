@@ -339,7 +339,7 @@ pub fn export_rgb(
         Format::OpenPbr | Format::StandardSurface => {
             let fit = volume::VolumeFit::fit(
                 rgb,
-                multipole::montecarlo::DEFAULT_SKIN_G,
+                multipole::DEFAULT_G,
                 surface.eta,
                 opts.volume_photons,
             )?;

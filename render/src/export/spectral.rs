@@ -5,7 +5,7 @@
 use crate::export::error::ExportError;
 use crate::export::volume::{semi_infinite_total, solve_decreasing};
 use multipole::Method;
-use multipole::montecarlo::{DEFAULT_SKIN_G, Layer, LayerStack};
+use multipole::{DEFAULT_G, Layer, LayeredMedium};
 use skin_optics::{SkinParams, WavelengthGrid};
 
 /// One homogeneous layer: σa, σs (mm⁻¹), HG g, index n, thickness (mm; `None` = semi-infinite).
@@ -86,7 +86,7 @@ impl SpectralSkin {
         let rows = grid
             .iter()
             .map(|lambda| {
-                let stack = LayerStack::skin(skin, lambda, DEFAULT_SKIN_G)?;
+                let stack = LayeredMedium::skin(skin, lambda, DEFAULT_G)?;
                 Ok(SpectralRow {
                     lambda_nm: lambda.nm(),
                     layers: stack.layers().iter().map(LayerOptics::from_layer).collect(),
@@ -115,13 +115,13 @@ impl SpectralSkin {
     }
 }
 
-/// The layers of `layers` as a Monte Carlo stack in air (the last layer semi-infinite if it has no
+/// The layers of `layers` as `multipole`'s layered medium (the last layer semi-infinite if it has no
 /// thickness).
 pub fn to_stack(
     layers: &[LayerOptics],
     n_above: f64,
     n_below: f64,
-) -> Result<LayerStack, ExportError> {
+) -> Result<LayeredMedium, ExportError> {
     let layers = layers
         .iter()
         .map(|l| match l.thickness_mm {
@@ -129,7 +129,7 @@ pub fn to_stack(
             None => Layer::semi_infinite(l.sigma_a_per_mm, l.sigma_s_per_mm, l.g, l.n),
         })
         .collect::<Result<Vec<_>, _>>()?;
-    Ok(LayerStack::new(layers, n_above, n_below)?)
+    Ok(LayeredMedium::new(layers, n_above, n_below)?)
 }
 
 /// The single semi-infinite layer that returns the row's exact total: the dermis' scattering, g and

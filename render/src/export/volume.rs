@@ -12,9 +12,9 @@
 
 use crate::export::error::{ExportError, check};
 use crate::export::rgb::{RgbProfile, shape_error, total_error};
-use multipole::adding_doubling::{AddingDoublingOptions, LayeredSlab, SlabLayer};
-use multipole::montecarlo::{Layer, LayerStack, McOptions, RadialGrid, run};
-use multipole::{MultipoleError, Profile};
+use multipole::adding_doubling::{AddingDoublingOptions, solve};
+use multipole::montecarlo::{McOptions, RadialGrid, run};
+use multipole::{Layer, LayeredMedium, MultipoleError, Profile};
 
 /// Generator seed of the medium's Monte Carlo profiles (fixed: an export is a pure function).
 pub const VOLUME_SEED: u64 = 0x0BE1_7A11;
@@ -29,12 +29,17 @@ pub fn semi_infinite_total(
     g: f64,
     eta: f64,
 ) -> Result<f64, ExportError> {
-    let layer = SlabLayer::semi_infinite(sigma_a_per_mm, sigma_s_per_mm, g)
-        .map_err(MultipoleError::from)?;
-    let slab = LayeredSlab::new(vec![layer], eta, 1.0, 1.0).map_err(MultipoleError::from)?;
-    let t = slab
-        .solve(&AddingDoublingOptions::default())
-        .map_err(MultipoleError::from)?;
+    let medium = LayeredMedium::new(
+        vec![Layer::semi_infinite(
+            sigma_a_per_mm,
+            sigma_s_per_mm,
+            g,
+            eta,
+        )?],
+        1.0,
+        1.0,
+    )?;
+    let t = solve(&medium, &AddingDoublingOptions::default()).map_err(MultipoleError::from)?;
     Ok(t.diffuse_reflectance / (1.0 - t.specular_reflectance))
 }
 
@@ -80,7 +85,7 @@ pub fn semi_infinite_profile(
         (500.0 * transport_mfp).min(1000.0),
         96,
     )?;
-    let stack = LayerStack::new(
+    let stack = LayeredMedium::new(
         vec![Layer::semi_infinite(
             sigma_a_per_mm,
             sigma_s_per_mm,

@@ -1,9 +1,8 @@
 //! Drawing of [`HeatMap`] panels: coloured cells (viridis), overlay series and a colour bar.
 
-use super::line::build_chart;
+use super::line::{Axis, build_chart, draw_axes};
 use super::{HeatMap, PlotError, SeriesStyle, draw_err, rgb, sanitize_range, tick_label, usable};
 use plotters::coord::Shift;
-use plotters::coord::ranged1d::{AsRangedCoord, Ranged, ValueFormatter};
 use plotters::prelude::*;
 
 pub(super) fn draw_heat_panel<DB: DrawingBackend>(
@@ -54,20 +53,13 @@ fn cell_edge(r: (f64, f64), n: usize, k: usize, log: bool) -> f64 {
     }
 }
 
-fn draw_cells_in<DB, X, Y>(
+fn draw_cells_in<DB: DrawingBackend, X: Axis, Y: Axis>(
     area: &DrawingArea<DB, Shift>,
     h: &HeatMap,
     x: X,
     y: Y,
     (vmin, vmax): (f64, f64),
-) -> Result<(), PlotError>
-where
-    DB: DrawingBackend,
-    X: AsRangedCoord<Value = f64>,
-    Y: AsRangedCoord<Value = f64>,
-    X::CoordDescType: Ranged<ValueType = f64> + ValueFormatter<f64>,
-    Y::CoordDescType: Ranged<ValueType = f64> + ValueFormatter<f64>,
-{
+) -> Result<(), PlotError> {
     let xr = sanitize_range(h.x_range, h.log_x);
     let yr = sanitize_range(h.y_range, h.log_y);
     let mut chart = build_chart(area, &h.title, x, y)?;
@@ -91,18 +83,7 @@ where
             Rectangle::new([p0, p1], color.filled())
         }))
         .map_err(draw_err)?;
-    let fmt = |v: &f64| tick_label(*v);
-    chart
-        .configure_mesh()
-        .disable_mesh()
-        .x_desc(h.x_label.as_str())
-        .y_desc(h.y_label.as_str())
-        .x_label_formatter(&fmt)
-        .y_label_formatter(&fmt)
-        .label_style(("sans-serif", 13))
-        .axis_desc_style(("sans-serif", 15))
-        .draw()
-        .map_err(draw_err)?;
+    draw_axes(&mut chart, &h.x_label, &h.y_label, false)?;
     for s in &h.overlay {
         let color = rgb(s.color.unwrap_or([255, 255, 255]));
         let pts: Vec<(f64, f64)> = s

@@ -15,6 +15,17 @@ pub(super) type Chart<'b, DB, X, Y> = ChartContext<
     Cartesian2d<<X as AsRangedCoord>::CoordDescType, <Y as AsRangedCoord>::CoordDescType>,
 >;
 
+/// An axis spec whose coordinates are f64 with tick labels: what every panel draws on.
+pub(super) trait Axis:
+    AsRangedCoord<Value = f64, CoordDescType: Ranged<ValueType = f64> + ValueFormatter<f64>>
+{
+}
+
+impl<T> Axis for T where
+    T: AsRangedCoord<Value = f64, CoordDescType: Ranged<ValueType = f64> + ValueFormatter<f64>>
+{
+}
+
 pub(super) fn draw_line_panel<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     c: &LineChart,
@@ -65,31 +76,41 @@ where
         .map_err(draw_err)
 }
 
-fn draw_lines_in<DB, X, Y>(
-    area: &DrawingArea<DB, Shift>,
-    c: &LineChart,
-    x: X,
-    y: Y,
+/// Axes with tick labels and their descriptions, and the grid when `grid` (every panel's style).
+pub(super) fn draw_axes<DB, XC, YC>(
+    chart: &mut ChartContext<'_, DB, Cartesian2d<XC, YC>>,
+    x_label: &str,
+    y_label: &str,
+    grid: bool,
 ) -> Result<(), PlotError>
 where
     DB: DrawingBackend,
-    X: AsRangedCoord<Value = f64>,
-    Y: AsRangedCoord<Value = f64>,
-    X::CoordDescType: Ranged<ValueType = f64> + ValueFormatter<f64>,
-    Y::CoordDescType: Ranged<ValueType = f64> + ValueFormatter<f64>,
+    XC: Ranged<ValueType = f64> + ValueFormatter<f64>,
+    YC: Ranged<ValueType = f64> + ValueFormatter<f64>,
 {
-    let mut chart = build_chart(area, &c.title, x, y)?;
     let fmt = |v: &f64| tick_label(*v);
-    chart
-        .configure_mesh()
-        .x_desc(c.x_label.as_str())
-        .y_desc(c.y_label.as_str())
+    let mut mesh = chart.configure_mesh();
+    if !grid {
+        mesh.disable_mesh();
+    }
+    mesh.x_desc(x_label)
+        .y_desc(y_label)
         .x_label_formatter(&fmt)
         .y_label_formatter(&fmt)
         .label_style(("sans-serif", 13))
         .axis_desc_style(("sans-serif", 15))
         .draw()
-        .map_err(draw_err)?;
+        .map_err(draw_err)
+}
+
+fn draw_lines_in<DB: DrawingBackend, X: Axis, Y: Axis>(
+    area: &DrawingArea<DB, Shift>,
+    c: &LineChart,
+    x: X,
+    y: Y,
+) -> Result<(), PlotError> {
+    let mut chart = build_chart(area, &c.title, x, y)?;
+    draw_axes(&mut chart, &c.x_label, &c.y_label, true)?;
 
     let mut any_legend = false;
     for (i, s) in c.series.iter().enumerate() {

@@ -4,7 +4,7 @@
 #![allow(dead_code)]
 
 use render::film::Film;
-use render::renderer::{RenderSettings, render};
+use render::renderer::{RenderOptions, render};
 use render::scene::{Scene, SceneOptions};
 use skin_optics::color::{cie_xyz_bar, cie_y_integral};
 
@@ -15,14 +15,14 @@ pub fn scene(text: &str) -> Scene {
 
 /// Render `scene` at `w`×`h` with `spp` samples per pixel and a fixed `seed`.
 pub fn run(scene: &Scene, w: usize, h: usize, spp: u32, seed: u64) -> Film {
-    let settings = RenderSettings {
+    let settings = RenderOptions {
         width: w,
         height: h,
         spp,
         seed,
         ..Default::default()
     };
-    render(scene, &settings).unwrap().0
+    render(scene, &settings.validate().unwrap()).unwrap().0
 }
 
 /// Mean XYZ over the whole film.

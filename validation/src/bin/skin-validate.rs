@@ -7,7 +7,7 @@ use render::cli::args::SkinArgs;
 use skin_optics::Wavelength;
 use std::path::PathBuf;
 use std::time::Instant;
-use validation::montecarlo::{self, LayerStack, McOptions, McResult};
+use validation::montecarlo::{self, LayeredMedium, McOptions, McResult};
 
 /// Monte Carlo ground truth for layered skin, and charts of where diffusion fails.
 ///
@@ -135,7 +135,7 @@ fn photon_bar(total: u64) -> ProgressBar {
 fn run_mc(args: &McArgs) -> anyhow::Result<()> {
     let skin = args.skin.to_params()?;
     let lambda = Wavelength::new(args.lambda)?;
-    let stack = LayerStack::skin(&skin, lambda, args.g)?;
+    let stack = LayeredMedium::skin(&skin, lambda, args.g)?;
     let opts = McOptions::new(args.photons, args.batches, args.seed)?;
     let bar = photon_bar(opts.total_photons());
     let start = Instant::now();

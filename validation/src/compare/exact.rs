@@ -1,13 +1,13 @@
 //! Study 5: `Method::Exact` (adding-doubling totals) beside `Method::Multipole`, both against the
 //! Monte Carlo: total diffuse reflectance over 400–700 nm for C_m ∈ {0, 0.01, 0.05, 0.1, 0.25, 0.5}
 //! (β_m 0.7, C_h 0.02), and the energy-weighted radial profile error of the light and dark presets
-//! at 450/550/650 nm (issue [exact], "Evidence").
+//! at 450/550/650 nm (docs/physics.md §9).
 
 use super::profiles::{PROFILE_WAVELENGTHS_NM, annulus_mean};
-use super::{Settings, Summary, progress, write_csv};
-use crate::montecarlo::{self, DEFAULT_SKIN_G, LayerStack, McOptions, RadialGrid};
+use super::{Settings, Summary, progress, write_csv, write_study};
+use crate::montecarlo::{self, DEFAULT_G, LayeredMedium, McOptions, RadialGrid};
 use multipole::{Method, ProfileOptions};
-use render::plot::{LineChart, Panel, Series, SeriesStyle, save_png};
+use render::plot::{LineChart, Panel, Series, SeriesStyle};
 use skin_optics::{Preset, SkinParams, Wavelength, WavelengthGrid};
 use std::path::Path;
 
@@ -50,7 +50,7 @@ fn spectra(settings: &Settings, out: &Path, summary: &mut Summary) -> anyhow::Re
         // Largest |error| beyond two standard errors of the MC: what noise cannot explain.
         let mut excess = [0.0f64; 2];
         for lambda in grid.iter() {
-            let stack = LayerStack::skin(&skin, lambda, DEFAULT_SKIN_G)?;
+            let stack = LayeredMedium::skin(&skin, lambda, DEFAULT_G)?;
             let expected = multipole::skin::diffuse_reflectance(&skin, lambda, Method::Exact)?;
             let photons = ((settings.exact_escapes as f64 / expected.max(1e-6)) as u64)
                 .clamp(settings.exact_photons, 100 * settings.exact_photons);
@@ -102,19 +102,17 @@ fn spectra(settings: &Settings, out: &Path, summary: &mut Summary) -> anyhow::Re
         }
     }
     bar.finish_and_clear();
-    write_csv(
-        &out.join("exact_vs_multipole.csv"),
-        "melanin,eumelanin_blend,hemoglobin,lambda_nm,exact,multipole,monte_carlo,monte_carlo_stderr,exact_relative_error,multipole_relative_error,photons",
-        &rows,
-    )?;
     let [a, b] = charts;
-    save_png(
-        &out.join("exact_vs_multipole.png"),
+    write_study(
+        out,
+        "exact_vs_multipole",
+        (
+            "melanin,eumelanin_blend,hemoglobin,lambda_nm,exact,multipole,monte_carlo,monte_carlo_stderr,exact_relative_error,multipole_relative_error,photons",
+            &rows,
+        ),
         &[Panel::Line(a), Panel::Line(b)],
-        1000,
-        1100,
-    )?;
-    Ok(())
+        (1000, 1100),
+    )
 }
 
 /// Energy-weighted profile error Σ 2πr Δr |R − R_mc| / R_mc,tot of both methods, light and dark presets.
@@ -139,7 +137,7 @@ fn profiles(settings: &Settings, out: &Path, summary: &mut Summary) -> anyhow::R
         let skin = SkinParams::preset(preset);
         for (k, &nm) in PROFILE_WAVELENGTHS_NM.iter().enumerate() {
             let lambda = Wavelength::new(nm)?;
-            let stack = LayerStack::skin(&skin, lambda, DEFAULT_SKIN_G)?;
+            let stack = LayeredMedium::skin(&skin, lambda, DEFAULT_G)?;
             let opts = McOptions::new(settings.profile_photons, 16, settings.seed)?.with_grid(grid);
             let mc = montecarlo::run(&stack, &opts);
             let color = [[40, 80, 220], [40, 160, 60], [210, 40, 40]][k];
@@ -200,21 +198,19 @@ fn profiles(settings: &Settings, out: &Path, summary: &mut Summary) -> anyhow::R
     }
     bar.finish_and_clear();
     write_csv(
-        &out.join("exact_profiles.csv"),
-        "preset,lambda_nm,exact_energy_error,multipole_energy_error,photons,monte_carlo_total",
-        &rows,
-    )?;
-    write_csv(
         &out.join("exact_profiles_radial.csv"),
         "preset,lambda_nm,r_mm,exact_per_mm2,multipole_per_mm2,monte_carlo_per_mm2,monte_carlo_stderr",
         &detail,
     )?;
     let [a, b] = charts;
-    save_png(
-        &out.join("exact_profiles.png"),
+    write_study(
+        out,
+        "exact_profiles",
+        (
+            "preset,lambda_nm,exact_energy_error,multipole_energy_error,photons,monte_carlo_total",
+            &rows,
+        ),
         &[Panel::Line(a), Panel::Line(b)],
-        1000,
-        1300,
-    )?;
-    Ok(())
+        (1000, 1300),
+    )
 }

@@ -13,11 +13,11 @@
 const SHAPE_ESCAPES: [u64; 5] = [250, 1_000, 4_000, 16_000, 64_000];
 
 use super::profiles::annulus_mean;
-use super::{Settings, Summary, progress, timed_mc, write_csv};
-use crate::montecarlo::{self, DEFAULT_SKIN_G, LayerStack, McOptions, RadialGrid};
+use super::{Settings, Summary, progress, timed_mc, write_study};
+use crate::montecarlo::{self, DEFAULT_G, LayeredMedium, McOptions, RadialGrid};
 use multipole::skin::ExactShape;
 use multipole::{Method, Poles, ProfileOptions};
-use render::plot::{LineChart, Panel, Series, SeriesStyle, save_png};
+use render::plot::{LineChart, Panel, Series, SeriesStyle};
 use skin_optics::{Preset, SkinParams, Wavelength};
 use std::path::Path;
 use std::time::Instant;
@@ -95,7 +95,7 @@ pub fn run(settings: &Settings, out: &Path, summary: &mut Summary) -> anyhow::Re
         bar.inc(1);
     }
     let exact = multipole::skin::diffuse_reflectance(&skin, lambda, Method::Exact)?;
-    let stack = LayerStack::skin(&skin, lambda, DEFAULT_SKIN_G)?;
+    let stack = LayeredMedium::skin(&skin, lambda, DEFAULT_G)?;
     let (mut mc_pts, mut se_pts) = (Vec::new(), Vec::new());
     for &n in &photon_counts {
         let (r, s) = timed_mc(&stack, &McOptions::new(n, 16, settings.seed)?);
@@ -182,13 +182,13 @@ pub fn run(settings: &Settings, out: &Path, summary: &mut Summary) -> anyhow::Re
             )
             .with_style(SeriesStyle::LinePoints),
         );
-    write_csv(
-        &out.join("knobs.csv"),
-        "knob,setting,seconds,relative_error",
-        &rows,
-    )?;
-    save_png(&out.join("knobs.png"), &[Panel::Line(chart)], 1000, 700)?;
-    Ok(())
+    write_study(
+        out,
+        "knobs",
+        ("knob,setting,seconds,relative_error", &rows),
+        &[Panel::Line(chart)],
+        (1000, 700),
+    )
 }
 
 /// Time and energy-weighted error of the exact profile's Monte Carlo shape per escapes setting.
@@ -200,7 +200,7 @@ fn shape_knob(
     bar: &indicatif::ProgressBar,
 ) -> anyhow::Result<Vec<(f64, f64)>> {
     let grid = RadialGrid::new(0.02, 300)?;
-    let stack = LayerStack::skin(skin, lambda, DEFAULT_SKIN_G)?;
+    let stack = LayeredMedium::skin(skin, lambda, DEFAULT_G)?;
     // A seed of its own: the reference must be independent of the shape's fixed seed.
     let opts = McOptions::new(settings.profile_photons, 16, settings.seed + 7)?.with_grid(grid);
     let mc = montecarlo::run(&stack, &opts);

@@ -18,7 +18,7 @@ pub mod profiles;
 pub mod spectra;
 pub mod stability;
 
-use crate::montecarlo::{self, LayerStack, McOptions, McResult};
+use crate::montecarlo::{self, LayeredMedium, McOptions, McResult};
 use anyhow::Context;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::fmt::Write as _;
@@ -126,7 +126,7 @@ pub(crate) fn progress(total: u64, what: &str) -> ProgressBar {
 }
 
 /// One MC run, timed (seconds).
-pub(crate) fn timed_mc(stack: &LayerStack, opts: &McOptions) -> (McResult, f64) {
+pub(crate) fn timed_mc(stack: &LayeredMedium, opts: &McOptions) -> (McResult, f64) {
     let t = Instant::now();
     let r = montecarlo::run(stack, opts);
     (r, t.elapsed().as_secs_f64())
@@ -143,6 +143,20 @@ pub(crate) fn write_csv(path: &Path, header: &str, rows: &[String]) -> anyhow::R
     }
     render::atomic::write_bytes(path, s.as_bytes())
         .with_context(|| format!("writing {}", path.display()))
+}
+
+/// A study's two outputs: `out/{name}.csv` (`header`, then `rows`) and the chart `out/{name}.png`
+/// of `panels`, `size` = (width, height) pixels.
+pub(crate) fn write_study(
+    out: &Path,
+    name: &str,
+    (header, rows): (&str, &[String]),
+    panels: &[render::plot::Panel],
+    (width, height): (u32, u32),
+) -> anyhow::Result<()> {
+    write_csv(&out.join(format!("{name}.csv")), header, rows)?;
+    render::plot::save_png(&out.join(format!("{name}.png")), panels, width, height)
+        .with_context(|| format!("writing {name}.png"))
 }
 
 /// One study: writes its charts and CSV into the folder and its worst errors into the summary.

@@ -1,10 +1,10 @@
 //! Study 2: radial profiles R(r) of the light preset at 450, 550, 650 nm, multipole against MC.
 
-use super::{Settings, Summary, progress, write_csv};
-use crate::montecarlo::{self, DEFAULT_SKIN_G, LayerStack, McOptions, RadialGrid};
+use super::{Settings, Summary, progress, write_study};
+use crate::montecarlo::{self, DEFAULT_G, LayeredMedium, McOptions, RadialGrid};
 use multipole::boundary::observable_reflectance;
 use multipole::{Method, ProfileOptions};
-use render::plot::{LineChart, Panel, Series, save_png};
+use render::plot::{LineChart, Panel, Series};
 use skin_optics::{Preset, SkinParams, Wavelength};
 use std::path::Path;
 
@@ -40,7 +40,7 @@ pub fn run(settings: &Settings, out: &Path, summary: &mut Summary) -> anyhow::Re
         let lambda = Wavelength::new(nm)?;
         let mp =
             multipole::skin::profile(&skin, lambda, Method::Multipole, &ProfileOptions::default())?;
-        let stack = LayerStack::skin(&skin, lambda, DEFAULT_SKIN_G)?;
+        let stack = LayeredMedium::skin(&skin, lambda, DEFAULT_G)?;
         let opts = McOptions::new(settings.profile_photons, 16, settings.seed)?.with_grid(grid);
         let mc = montecarlo::run(&stack, &opts);
         let (mut line, mut pts) = (Vec::new(), Vec::new());
@@ -76,11 +76,14 @@ pub fn run(settings: &Settings, out: &Path, summary: &mut Summary) -> anyhow::Re
         bar.inc(1);
     }
     bar.finish_and_clear();
-    write_csv(
-        &out.join("profiles.csv"),
-        "lambda_nm,r_mm,multipole_per_mm2,monte_carlo_per_mm2,monte_carlo_stderr",
-        &rows,
-    )?;
-    save_png(&out.join("profiles.png"), &[Panel::Line(chart)], 1000, 700)?;
-    Ok(())
+    write_study(
+        out,
+        "profiles",
+        (
+            "lambda_nm,r_mm,multipole_per_mm2,monte_carlo_per_mm2,monte_carlo_stderr",
+            &rows,
+        ),
+        &[Panel::Line(chart)],
+        (1000, 700),
+    )
 }

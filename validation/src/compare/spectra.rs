@@ -1,9 +1,9 @@
 //! Study 1: observable diffuse reflectance over 400–700 nm for each preset, multipole against MC.
 
-use super::{Settings, Summary, progress, timed_mc, write_csv};
-use crate::montecarlo::{DEFAULT_SKIN_G, LayerStack, McOptions};
+use super::{Settings, Summary, progress, timed_mc, write_study};
+use crate::montecarlo::{DEFAULT_G, LayeredMedium, McOptions};
 use multipole::Method;
-use render::plot::{LineChart, Panel, Series, save_png};
+use render::plot::{LineChart, Panel, Series};
 use skin_optics::{Preset, SkinParams, Wavelength, WavelengthGrid};
 use std::path::Path;
 
@@ -66,18 +66,16 @@ pub fn run(settings: &Settings, out: &Path, summary: &mut Summary) -> anyhow::Re
         );
     }
     bar.finish_and_clear();
-    write_csv(
-        &out.join("spectra.csv"),
-        "preset,lambda_nm,multipole,monte_carlo,monte_carlo_stderr,relative_error,photons,mc_seconds",
-        &rows,
-    )?;
-    save_png(
-        &out.join("spectra.png"),
+    write_study(
+        out,
+        "spectra",
+        (
+            "preset,lambda_nm,multipole,monte_carlo,monte_carlo_stderr,relative_error,photons,mc_seconds",
+            &rows,
+        ),
         &[Panel::Line(refl), Panel::Line(err)],
-        1000,
-        1100,
-    )?;
-    Ok(())
+        (1000, 1100),
+    )
 }
 
 /// Multipole observable and MC (mean, stderr, seconds) for one skin and wavelength.
@@ -87,7 +85,7 @@ fn compare_one(
     settings: &Settings,
 ) -> anyhow::Result<(f64, (f64, f64), f64)> {
     let m = multipole::skin::diffuse_reflectance(skin, lambda, Method::Multipole)?;
-    let stack = LayerStack::skin(skin, lambda, DEFAULT_SKIN_G)?;
+    let stack = LayeredMedium::skin(skin, lambda, DEFAULT_G)?;
     let opts = McOptions::new(settings.spectrum_photons, 16, settings.seed)?;
     let (r, s) = timed_mc(&stack, &opts);
     Ok((

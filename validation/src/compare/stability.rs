@@ -7,7 +7,7 @@
 //! σs = σs'/(1 − g). The albedo axis is uniform in −log(1 − α').
 
 use super::{Settings, Summary, progress, write_csv};
-use crate::montecarlo::{self, Layer, LayerStack, McOptions};
+use crate::montecarlo::{self, Layer, LayeredMedium, McOptions};
 use multipole::boundary::observable_reflectance;
 use multipole::{Medium, Poles, Slab};
 use render::plot::{HeatMap, Panel, Series, save_png};
@@ -39,7 +39,7 @@ pub fn run(settings: &Settings, out: &Path, summary: &mut Summary) -> anyhow::Re
             let slab = Slab::new(Medium::new(sigma_a, sigma_s_prime)?, d, ETA, 1.0)?;
             let diffusion = observable_reflectance(slab.total_reflectance(Poles::Exact), ETA);
             let layer = Layer::from_reduced(sigma_a, sigma_s_prime, G, ETA, Some(d))?;
-            let stack = LayerStack::new(vec![layer], 1.0, ETA)?;
+            let stack = LayeredMedium::new(vec![layer], 1.0, ETA)?;
             let opts = McOptions::new(settings.stability_photons, 8, settings.seed)?;
             let mc = montecarlo::run(&stack, &opts);
             let rd = mc.diffuse_reflectance;

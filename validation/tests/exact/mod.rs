@@ -1,20 +1,20 @@
 //! Adding-doubling (`Method::Exact`, via `multipole::skin::diffuse_reflectance`) against the layered
-//! Monte Carlo for the light, medium and dark presets at 550 nm (issue [exact], "Tests").
+//! Monte Carlo for the light, medium and dark presets at 550 nm (docs/physics.md §9–§11).
 //!
 //! Tolerance: 4 standard errors of the Monte Carlo plus 0.5% of its mean, the residual both exact
-//! methods are allowed (the independent runs of issue [exact] agree within 0.6%); diffusion misses
+//! methods are allowed (the independent exact-transport runs of [XT] agree within 0.6%); diffusion misses
 //! the dark preset by about +100%, so a method that fell back to it fails.
 
 use crate::montecarlo::photons;
 use multipole::Method;
 use skin_optics::{Preset, SkinParams, Wavelength};
-use validation::montecarlo::{DEFAULT_SKIN_G, LayerStack, McOptions, run};
+use validation::montecarlo::{DEFAULT_G, LayeredMedium, McOptions, run};
 
 fn check(preset: Preset, seed: u64) {
     let skin = SkinParams::preset(preset);
     let lambda = Wavelength::new(550.0).unwrap();
     let exact = multipole::skin::diffuse_reflectance(&skin, lambda, Method::Exact).unwrap();
-    let stack = LayerStack::skin(&skin, lambda, DEFAULT_SKIN_G).unwrap();
+    let stack = LayeredMedium::skin(&skin, lambda, DEFAULT_G).unwrap();
     let mc = run(&stack, &McOptions::new(photons(60_000), 20, seed).unwrap()).diffuse_reflectance;
     let tol = 4.0 * mc.stderr + 0.005 * mc.mean;
     assert!(

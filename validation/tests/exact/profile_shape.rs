@@ -1,5 +1,5 @@
-//! Issue [exact]'s profile target: the default `Method::Exact` profile (Monte Carlo shape, exact
-//! total) against an independent Monte Carlo run, energy-weighted error within 10%.
+//! The profile target of `Method::Exact` (docs/physics.md §9): the default profile (Monte Carlo
+//! shape, exact total) against an independent Monte Carlo run, energy-weighted error within 10%.
 //!
 //! Error = Σ_annuli |E_model − E_mc| / R_mc on the reference's uniform 0.02 mm annuli to 6 mm,
 //! E = ∫ 2πr R dr per annulus (model per incident photon: its per-entering profile × (1 − F_r(0))).
@@ -9,7 +9,7 @@
 use multipole::skin::{Method, profile};
 use multipole::{Profile, ProfileOptions};
 use skin_optics::{Preset, SkinParams, Wavelength};
-use validation::montecarlo::{DEFAULT_SKIN_G, LayerStack, McOptions, McResult, RadialGrid, run};
+use validation::montecarlo::{DEFAULT_G, LayeredMedium, McOptions, McResult, RadialGrid, run};
 
 /// ∫ 2πr R(r) dr over [a, b] (mm) by the midpoint rule on 16 sub-intervals.
 fn annulus_energy(p: &Profile, a: f64, b: f64) -> f64 {
@@ -40,7 +40,7 @@ fn check(preset: Preset, nm: f64, photons: u64) {
     let skin = SkinParams::preset(preset);
     let lambda = Wavelength::new(nm).unwrap();
     let model = profile(&skin, lambda, Method::Exact, &ProfileOptions::default()).unwrap();
-    let stack = LayerStack::skin(&skin, lambda, DEFAULT_SKIN_G).unwrap();
+    let stack = LayeredMedium::skin(&skin, lambda, DEFAULT_G).unwrap();
     let grid = RadialGrid::new(0.02, 300).unwrap();
     let mc = run(
         &stack,

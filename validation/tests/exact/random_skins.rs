@@ -1,4 +1,4 @@
-//! Issue [exact]'s totals target over the whole parameter box: for random skins (C_m ∈ [0, 0.5],
+//! The totals target of `Method::Exact` over the whole parameter box: for random skins (C_m ∈ [0, 0.5],
 //! β_m ∈ [0, 1], C_h ∈ [0.001, 0.1]) and wavelengths in 400–700 nm, adding-doubling's observable
 //! diffuse reflectance is within 2% of the layered Monte Carlo, plus 3 of its standard errors.
 //!
@@ -9,7 +9,7 @@
 use multipole::Method;
 use proptest::prelude::*;
 use skin_optics::{SkinParams, Wavelength};
-use validation::montecarlo::{DEFAULT_SKIN_G, LayerStack, McOptions, run};
+use validation::montecarlo::{DEFAULT_G, LayeredMedium, McOptions, run};
 
 proptest! {
     #![proptest_config(ProptestConfig { cases: 6, ..ProptestConfig::default() })]
@@ -24,7 +24,7 @@ proptest! {
         let lambda = Wavelength::new(nm).expect("visible");
         let exact = multipole::skin::diffuse_reflectance(&skin, lambda, Method::Exact).expect("solves");
         let photons = ((20_000.0 / exact) as u64).clamp(50_000, 4_000_000);
-        let stack = LayerStack::skin(&skin, lambda, DEFAULT_SKIN_G).expect("stack");
+        let stack = LayeredMedium::skin(&skin, lambda, DEFAULT_G).expect("stack");
         let mc = run(&stack, &McOptions::new(photons, 16, seed).expect("options")).diffuse_reflectance;
         let tol = 0.02 * mc.mean + 3.0 * mc.stderr;
         prop_assert!(

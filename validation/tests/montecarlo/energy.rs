@@ -1,7 +1,7 @@
 //! Exact energy accounting for random valid stacks (proptest).
 
 use proptest::prelude::*;
-use validation::montecarlo::{Layer, LayerStack, McOptions, run};
+use validation::montecarlo::{Layer, LayeredMedium, McOptions, run};
 
 /// One physically valid layer: σa in [0, 50], σs in [0, 200] mm⁻¹, g in [−0.5, 0.95], n in
 /// [1, 1.6], thickness in [0.01, 2] mm (semi-infinite layers get σa ≥ 0.05 to keep histories short).
@@ -24,7 +24,7 @@ fn layer(last: bool) -> impl Strategy<Value = Layer> {
 }
 
 /// A stack of one to three layers with ambient indices in [1, 1.6].
-fn stack() -> impl Strategy<Value = LayerStack> {
+fn stack() -> impl Strategy<Value = LayeredMedium> {
     (1usize..=3)
         .prop_flat_map(|k| {
             (
@@ -36,7 +36,7 @@ fn stack() -> impl Strategy<Value = LayerStack> {
         })
         .prop_map(|(mut layers, last, up, down)| {
             layers.push(last);
-            LayerStack::new(layers, up, down).expect("only the last layer may be semi-infinite")
+            LayeredMedium::new(layers, up, down).expect("only the last layer may be semi-infinite")
         })
 }
 

@@ -1,12 +1,12 @@
-//! Agreement with independent exact-transport totals (issue 4's table: other Monte Carlo and
-//! adding-doubling runs of the same model; index 1.4, g = 0.9, σs = σs'/(1 − g)).
+//! Agreement with independent exact-transport totals ([XT]: other Monte Carlo and adding-doubling
+//! runs of the same model; index 1.4, g = 0.9, σs = σs'/(1 − g)).
 //!
 //! Tolerance: 4 standard errors of this run plus the reference's stated ±0.0008 (the skin rows) or
 //! its last printed digit (the half-space rows), so a 1% bias at these photon counts fails.
 
 use super::photons;
 use skin_optics::{Preset, SkinParams, Wavelength};
-use validation::montecarlo::{Layer, LayerStack, McOptions, McResult, run};
+use validation::montecarlo::{Layer, LayeredMedium, McOptions, McResult, run};
 
 fn check(r: &McResult, reference: f64, reference_uncertainty: f64, what: &str) {
     let rd = r.diffuse_reflectance;
@@ -21,7 +21,7 @@ fn check(r: &McResult, reference: f64, reference_uncertainty: f64, what: &str) {
 }
 
 fn light_skin(nm: f64, n: u64, seed: u64) -> McResult {
-    let stack = LayerStack::skin(
+    let stack = LayeredMedium::skin(
         &SkinParams::preset(Preset::Light),
         Wavelength::new(nm).unwrap(),
         0.9,
@@ -62,7 +62,7 @@ fn light_skin_650_nm() {
 
 fn half_space(sigma_a: f64, n: u64) -> McResult {
     let layer = Layer::from_reduced(sigma_a, 1.0, 0.9, 1.4, None).unwrap();
-    let stack = LayerStack::new(vec![layer], 1.0, 1.0).unwrap();
+    let stack = LayeredMedium::new(vec![layer], 1.0, 1.0).unwrap();
     run(&stack, &McOptions::new(photons(n), 20, 17).unwrap())
 }
 

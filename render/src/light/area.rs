@@ -1,0 +1,196 @@
+//! Area lights, which rays can hit and BSDF sampling can find (MIS with light sampling): the
+//! sphere and the one-sided parallelogram (quad).
+
+use super::{LightSample, facing};
+use crate::sampling::{uniform_cone, uniform_cone_pdf};
+use crate::spectrum::{SampledWavelengths, SpectrumTable};
+use glam::{Vec2, Vec3};
+use std::f32::consts::PI;
+
+/// Smallest 1 − cos θ_max sampled as a cone (a smaller visible cap is too far to matter).
+const CONE_EPS: f32 = 1e-4;
+
+/// Spherical area light, emitting uniformly outwards.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SphereLight {
+    /// Centre, mm.
+    pub center_mm: Vec3,
+    /// Radius, mm.
+    pub radius_mm: f32,
+    /// Emitted radiance spectrum.
+    pub radiance: SpectrumTable,
+}
+
+impl SphereLight {
+    /// cos θ_max of the visible cap seen from `p`, or None inside the light or when the cap is
+    /// below [`CONE_EPS`].
+    fn cone(&self, p: Vec3) -> Option<f32> {
+        let d2 = (self.center_mm - p).length_squared();
+        let sin2_max = self.radius_mm * self.radius_mm / d2;
+        let cos_max = (1.0 - sin2_max).max(0.0).sqrt();
+        (sin2_max < 1.0 && 1.0 - cos_max >= CONE_EPS).then_some(cos_max)
+    }
+
+    /// A direction uniform in the cone of the visible cap ([pbrt] sphere sampling).
+    #[must_use]
+    pub fn sample(&self, p: Vec3, u: Vec2, wl: &SampledWavelengths) -> Option<LightSample> {
+        let to_c = self.center_mm - p;
+        let d2 = to_c.length_squared();
+        let cos_max = self.cone(p)?;
+        let frame = brdf::Frame::from_normal(to_c / d2.sqrt());
+        let wi = frame.to_world(uniform_cone(u, cos_max));
+        let t = self.intersect(p, wi).unwrap_or(d2.sqrt());
+        Some(LightSample {
+            wi,
+            distance_mm: t,
+            li: self.radiance.eval(wl),
+            pdf: uniform_cone_pdf(cos_max),
+            is_delta: false,
+        })
+    }
+
+    /// Selection proxy at `p` with normal `n`: L · solid angle, times the widened cosine.
+    #[must_use]
+    pub fn selection_weight(&self, p: Vec3, n: Vec3) -> f32 {
+        let to = self.center_mm - p;
+        let r2 = self.radius_mm * self.radius_mm;
+        let d2 = to.length_squared().max(r2);
+        let d = d2.sqrt();
+        self.radiance.mean() * PI * r2 / d2 * facing(n, to, d, self.radius_mm / d)
+    }
+
+    /// Nearest positive hit of the ray (`o`, unit `d`) with the sphere.
+    #[must_use]
+    pub fn intersect(&self, o: Vec3, d: Vec3) -> Option<f32> {
+        let oc = o - self.center_mm;
+        let b = oc.dot(d);
+        let disc = b * b - (oc.length_squared() - self.radius_mm * self.radius_mm);
+        if disc < 0.0 {
+            return None;
+        }
+        let s = disc.sqrt();
+        let t0 = -b - s;
+        let t1 = -b + s;
+        if t0 > 0.0 {
+            Some(t0)
+        } else if t1 > 0.0 {
+            Some(t1)
+        } else {
+            None
+        }
+    }
+
+    /// Solid-angle density of [`SphereLight::sample`] from `p`, sr⁻¹.
+    #[must_use]
+    pub fn pdf(&self, p: Vec3) -> f32 {
+        self.cone(p).map_or(0.0, uniform_cone_pdf)
+    }
+}
+
+/// Parallelogram area light `corner + s·edge_u + t·edge_v`, emitting on the side of
+/// `edge_u × edge_v`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct QuadLight {
+    /// One corner, mm.
+    pub corner_mm: Vec3,
+    /// First edge, mm.
+    pub edge_u_mm: Vec3,
+    /// Second edge, mm.
+    pub edge_v_mm: Vec3,
+    /// Emitted radiance spectrum.
+    pub radiance: SpectrumTable,
+}
+
+impl QuadLight {
+    /// A point uniform in area, converted to solid angle (None from behind).
+    #[must_use]
+    pub fn sample(&self, p: Vec3, u: Vec2, wl: &SampledWavelengths) -> Option<LightSample> {
+        let q = self.corner_mm + self.edge_u_mm * u.x + self.edge_v_mm * u.y;
+        let n = self.edge_u_mm.cross(self.edge_v_mm);
+        let area = n.length();
+        let d = q - p;
+        let r2 = d.length_squared();
+        let wi = d / r2.sqrt();
+        let cos_l = -wi.dot(n / area);
+        (cos_l > 0.0).then(|| LightSample {
+            wi,
+            distance_mm: r2.sqrt(),
+            li: self.radiance.eval(wl),
+            pdf: r2 / (cos_l * area),
+            is_delta: false,
+        })
+    }
+
+    /// Selection proxy at `p` with normal `n`: L · (projected) solid angle of the quad, times the
+    /// widened cosine; 0 behind the emitting side.
+    #[must_use]
+    pub fn selection_weight(&self, p: Vec3, n: Vec3) -> f32 {
+        let (eu, ev) = (self.edge_u_mm, self.edge_v_mm);
+        let nl = eu.cross(ev);
+        let area = nl.length();
+        let nl = nl / area;
+        if (p - self.corner_mm).dot(nl) <= 0.0 {
+            return 0.0;
+        }
+        let c = self.corner_mm + (eu + ev) * 0.5;
+        let to = c - p;
+        let d2 = to.length_squared().max(area);
+        let d = d2.sqrt();
+        let cos_l = (-to.dot(nl) / d).max(0.05);
+        let half_diagonal = 0.5 * (eu + ev).length();
+        self.radiance.mean() * area * cos_l / d2 * facing(n, to, d, half_diagonal / d)
+    }
+
+    /// Distance at which the ray (`o`, unit `d`) hits the emitting side, if it does.
+    #[must_use]
+    pub fn intersect(&self, o: Vec3, d: Vec3) -> Option<f32> {
+        let (eu, ev) = (self.edge_u_mm, self.edge_v_mm);
+        let n = eu.cross(ev);
+        let denom = d.dot(n);
+        if denom >= 0.0 {
+            return None; // back side does not emit, and is not drawn
+        }
+        let t = (self.corner_mm - o).dot(n) / denom;
+        if t <= 0.0 {
+            return None;
+        }
+        let rel = o + d * t - self.corner_mm;
+        let (uu, vv) = (eu.length_squared(), ev.length_squared());
+        let s = rel.dot(eu) / uu;
+        let w = rel.dot(ev) / vv;
+        ((0.0..=1.0).contains(&s) && (0.0..=1.0).contains(&w)).then_some(t)
+    }
+
+    /// Solid-angle density of [`QuadLight::sample`] for direction `wi` hitting at distance `t`, sr⁻¹.
+    #[must_use]
+    pub fn pdf(&self, wi: Vec3, t: f32) -> f32 {
+        let n = self.edge_u_mm.cross(self.edge_v_mm);
+        let area = n.length();
+        let cos_l = -wi.dot(n / area);
+        if cos_l <= 0.0 {
+            0.0
+        } else {
+            t * t / (cos_l * area)
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quad_sample_pdf_matches_pdf_function() {
+        let wl = SampledWavelengths::sample_visible(0.3);
+        let q = QuadLight {
+            corner_mm: Vec3::new(-1.0, -1.0, 5.0),
+            edge_u_mm: Vec3::new(0.0, 2.0, 0.0),
+            edge_v_mm: Vec3::new(2.0, 0.0, 0.0),
+            radiance: SpectrumTable::constant(1.0),
+        };
+        let s = q.sample(Vec3::ZERO, Vec2::new(0.3, 0.8), &wl).unwrap();
+        let t = q.intersect(Vec3::ZERO, s.wi).unwrap();
+        assert!((t - s.distance_mm).abs() < 1e-4);
+        assert!((q.pdf(s.wi, t) - s.pdf).abs() < 1e-4 * s.pdf);
+    }
+}

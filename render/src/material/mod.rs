@@ -1,0 +1,314 @@
+//! Materials and their BSDFs at a shading point: `Skin` (oily Torrance–Sparrow surface over a
+//! diffusing body) and `Diffuse` (Lambert) for backdrops.
+//!
+//! # Skin with subsurface scattering (the default)
+//!
+//! When the material carries a [`Subsurface`] model, its BSDF is the surface lobe alone
+//! (`Lobes::SkinSurface`) and the body is rendered by the separable BSSRDF in the integrator
+//! (`crate::bssrdf`): at each skin hit the path follows the surface lobe with probability p
+//! (∝ ρ_dr(θ_o) against T(θ_o) R̄_tot) or the subsurface branch with 1 − p. The energy split is
+//! the same as below, so on a flat slab both forms render the same radiance.
+//!
+//! # Skin without subsurface scattering (`SkinKnobs::no_subsurface`)
+//!
+//! Skin shades as its surface lobe ([TS67], `brdf::TorranceSparrow`, m = 0.3, ρ_s from the
+//! `SkinParams`, η = 1.4) plus a Lambertian body term built from the skin model's total
+//! diffuse reflectance R_d(λ) (`multipole::skin::total_reflectance` with the scene's method, per
+//! unit flux entering), tabulated per material at scene load by [`SkinMaterial::build`]. The energy split is the lobe's own: the light the lobe does
+//! not reflect, T(θ) = 1 − ρ_dr(θ) (`ts.transmitted_fraction`), enters; R_d of it comes back out,
+//! leaving with the same split. Reciprocal and energy conserving:
+//!
+//! f_body(ωi, ωo; λ) = R_d(λ) · m(uv) · T(θi) · T(θo) / (π T̄),  T̄ = ∫ T(θ) 2 cosθ d cosθ,
+//!
+//! so the body reflects R_d · T(θi) of the incident flux and surface + body ≤ ρ_dr + (1 − ρ_dr) R_d ≤ 1.
+//! (The observable `multipole::skin::diffuse_reflectance` is the same R_d with the smooth-surface
+//! split (1 − F(0)) instead of T(0°); the two differ by under 2% for ρ_s ≤ 0.25.)
+//! `m(uv)` is the optional albedo texture's luminance relative to its mean, so the texture adds
+//! spatial detail (brows, lips, pores) without replacing the model's spectral colour; the product
+//! is clamped at 1.
+
+use crate::spectrum::{SampledSpectrum, SampledWavelengths, SpectrumTable, linear_srgb_at_nm};
+use crate::texture::Texture;
+use brdf::{Frame, TorranceSparrow};
+use glam::{Vec2, Vec3};
+use std::f32::consts::FRAC_1_PI;
+
+mod skin;
+
+pub use skin::{SKIN_TABLE_STEP_NM, SkinBuildError, SkinKnobs, SkinMaterial};
+
+/// An albedo texture used by a material.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TextureRef {
+    /// Index into the scene's textures.
+    pub index: usize,
+    /// Mean luminance of the texture (for relative modulation).
+    pub mean_luminance: f32,
+}
+
+/// Lambertian material with a spectral albedo, optionally times an sRGB texture.
+#[derive(Debug, Clone)]
+pub struct DiffuseMaterial {
+    /// Albedo ρ(λ) in [0, 1].
+    pub albedo: SpectrumTable,
+    /// Optional albedo texture (its linear sRGB multiplies ρ, via the box-basis spectrum).
+    pub albedo_texture: Option<TextureRef>,
+}
+
+/// A surface material.
+#[derive(Debug, Clone)]
+pub enum Material {
+    /// Human skin ([DJ06]).
+    Skin(SkinMaterial),
+    /// Lambertian.
+    Diffuse(DiffuseMaterial),
+}
+
+/// The BSDF at one shading point, for the path's wavelengths, in the shading frame.
+#[derive(Debug, Clone)]
+pub struct Bsdf<'a> {
+    /// Shading frame (+Z = shading normal, facing the outgoing direction).
+    pub frame: Frame,
+    lobes: Lobes<'a>,
+}
+
+#[derive(Debug, Clone)]
+enum Lobes<'a> {
+    Skin {
+        surface: &'a TorranceSparrow,
+        /// R_d(λ) m(uv) / (π T̄).
+        body: SampledSpectrum,
+    },
+    Lambert {
+        /// ρ(λ) / π.
+        body: SampledSpectrum,
+    },
+    /// Skin whose body is rendered by the BSSRDF: only the surface lobe is a BSDF here; the
+    /// integrator takes the subsurface branch with probability 1 − p (`subsurface_probability`).
+    SkinSurface {
+        surface: &'a TorranceSparrow,
+        /// Mean over the path's wavelengths of R_tot(λ) m(uv), for choosing the branch.
+        subsurface_albedo: f32,
+    },
+}
+
+/// A sampled incident direction with the BSDF value and density there.
+#[derive(Debug, Clone, Copy)]
+pub struct BsdfSample {
+    /// Incident direction, world space.
+    pub wi: Vec3,
+    /// f(ωo, ωi) per wavelength, sr⁻¹.
+    pub f: SampledSpectrum,
+    /// Density of ωi, sr⁻¹.
+    pub pdf: f32,
+}
+
+impl Material {
+    /// The BSDF at a point with shading normal `n` (facing the viewer) and texture coordinate `uv`.
+    #[must_use]
+    pub fn bsdf<'a>(
+        &'a self,
+        n: Vec3,
+        uv: Vec2,
+        wl: &SampledWavelengths,
+        textures: &[Texture],
+    ) -> Bsdf<'a> {
+        let frame = Frame::from_normal(n);
+        let lobes = match self {
+            Material::Skin(s) if s.subsurface.is_some() => {
+                let m = s.texture_factor(uv, textures);
+                Lobes::SkinSurface {
+                    surface: &s.surface,
+                    subsurface_albedo: (s.total_reflectance.eval(wl).average() * m).min(1.0),
+                }
+            }
+            Material::Skin(s) => {
+                let m = s.texture_factor(uv, textures);
+                let rd = s.total_reflectance.eval(wl).map(|r| (r * m).min(1.0));
+                Lobes::Skin {
+                    surface: &s.surface,
+                    body: rd * (FRAC_1_PI / s.mean_transmitted),
+                }
+            }
+            Material::Diffuse(d) => {
+                let mut rho = d.albedo.eval(wl);
+                if let Some(t) = d.albedo_texture {
+                    let rgb = textures[t.index].lookup(uv);
+                    rho = SampledSpectrum(std::array::from_fn(|i| {
+                        rho.0[i] * linear_srgb_at_nm(rgb, wl.nm(i))
+                    }));
+                }
+                Lobes::Lambert {
+                    body: rho.map(|r| r.clamp(0.0, 1.0) * FRAC_1_PI),
+                }
+            }
+        };
+        Bsdf { frame, lobes }
+    }
+}
+
+impl Bsdf<'_> {
+    /// f(ωo, ωi), sr⁻¹, for world directions (reflection only: zero unless both are above the
+    /// shading surface).
+    #[must_use]
+    pub fn eval(&self, wo: Vec3, wi: Vec3) -> SampledSpectrum {
+        let (o, i) = (self.frame.to_local(wo), self.frame.to_local(wi));
+        if o.z <= 0.0 || i.z <= 0.0 {
+            return SampledSpectrum::zero();
+        }
+        match &self.lobes {
+            Lobes::Skin { surface, body } => {
+                let split = surface.transmitted_fraction(i.z) * surface.transmitted_fraction(o.z);
+                *body * split + SampledSpectrum::splat(surface.eval(o, i))
+            }
+            Lobes::Lambert { body } => *body,
+            Lobes::SkinSurface { surface, .. } => SampledSpectrum::splat(surface.eval(o, i)),
+        }
+    }
+
+    /// Probability that the integrator follows the subsurface branch at this point for `wo`
+    /// (0 unless the skin's body is rendered by the BSSRDF).
+    #[must_use]
+    pub fn subsurface_probability(&self, wo: Vec3) -> f32 {
+        let o = self.frame.to_local(wo);
+        match &self.lobes {
+            Lobes::SkinSurface { .. } if o.z > 0.0 => 1.0 - self.specular_probability(o.z),
+            _ => 0.0,
+        }
+    }
+
+    /// Probability of choosing the surface lobe when sampling from `o` (local): proportional to
+    /// the lobe's albedo against the body's mean albedo.
+    fn specular_probability(&self, o_z: f32) -> f32 {
+        match &self.lobes {
+            Lobes::Skin { surface, body } => {
+                let s = surface.directional_albedo(o_z);
+                let d = body.average() * std::f32::consts::PI * surface.transmitted_fraction(o_z);
+                if s <= 0.0 {
+                    0.0
+                } else if d <= 0.0 {
+                    1.0
+                } else {
+                    (s / (s + d)).clamp(0.05, 0.95)
+                }
+            }
+            Lobes::SkinSurface {
+                surface,
+                subsurface_albedo,
+            } => {
+                let s = surface.directional_albedo(o_z);
+                let d = subsurface_albedo * surface.transmitted_fraction(o_z);
+                if s <= 0.0 {
+                    0.05
+                } else if d <= 0.0 {
+                    1.0
+                } else {
+                    (s / (s + d)).clamp(0.05, 0.95)
+                }
+            }
+            Lobes::Lambert { .. } => 0.0,
+        }
+    }
+
+    /// Density with which [`Bsdf::sample`] picks `wi` for `wo`, sr⁻¹.
+    #[must_use]
+    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        let (o, i) = (self.frame.to_local(wo), self.frame.to_local(wi));
+        if o.z <= 0.0 || i.z <= 0.0 {
+            return 0.0;
+        }
+        let p = self.specular_probability(o.z);
+        let diffuse = i.z * FRAC_1_PI;
+        match &self.lobes {
+            Lobes::Skin { surface, .. } => p * surface.pdf(o, i) + (1.0 - p) * diffuse,
+            // The other branch (1 − p) leaves through the BSSRDF, not through a direction here.
+            Lobes::SkinSurface { surface, .. } => p * surface.pdf(o, i),
+            Lobes::Lambert { .. } => diffuse,
+        }
+    }
+
+    /// Sample ωi for `wo`: `u_lobe` picks the lobe, `u` the direction.
+    #[must_use]
+    pub fn sample(&self, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
+        let o = self.frame.to_local(wo);
+        if o.z <= 0.0 {
+            return None;
+        }
+        let p = self.specular_probability(o.z);
+        let i = match &self.lobes {
+            Lobes::Skin { surface, .. } if u_lobe < p => surface.sample(o, [u.x, u.y])?.wi,
+            // The integrator already chose the surface branch (with probability p).
+            Lobes::SkinSurface { surface, .. } => surface.sample(o, [u.x, u.y])?.wi,
+            _ => crate::sampling::cosine_hemisphere(u),
+        };
+        if i.z <= 0.0 {
+            return None;
+        }
+        let wi = self.frame.to_world(i);
+        let pdf = self.pdf(wo, wi);
+        (pdf > 0.0).then(|| BsdfSample {
+            wi,
+            f: self.eval(wo, wi),
+            pdf,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{Rng, SeedableRng};
+    use rand_xoshiro::Xoshiro256PlusPlus;
+
+    fn skin(rd: f32) -> Material {
+        Material::Skin(SkinMaterial::new(
+            skin_optics::SkinParams::preset(skin_optics::Preset::Light),
+            TorranceSparrow::new(0.3, 0.25, 1.4).unwrap(),
+            SpectrumTable::constant(rd),
+            None,
+        ))
+    }
+
+    /// Directional albedo by importance sampling: ∫ f cos dω = E[f cos / pdf].
+    fn albedo(m: &Material, cos_o: f32) -> f32 {
+        let wl = SampledWavelengths::sample_visible(0.1);
+        let b = m.bsdf(Vec3::Z, Vec2::ZERO, &wl, &[]);
+        let wo = Vec3::new((1.0 - cos_o * cos_o).sqrt(), 0.0, cos_o);
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(3);
+        let n = 200_000;
+        let mut sum = 0.0f64;
+        for _ in 0..n {
+            if let Some(s) = b.sample(wo, rng.random(), Vec2::new(rng.random(), rng.random())) {
+                sum += f64::from(s.f.0[0] * s.wi.z / s.pdf);
+            }
+        }
+        (sum / f64::from(n)) as f32
+    }
+
+    /// Body + surface reflect ρ_dr(θ) + R_d T(θ): the documented energy split, to 1% (MC).
+    #[test]
+    fn skin_albedo_is_surface_plus_split_body() {
+        let ts = TorranceSparrow::new(0.3, 0.25, 1.4).unwrap();
+        for cos_o in [1.0, 0.5, 0.2] {
+            let expect = ts.directional_albedo(cos_o) + 0.6 * ts.transmitted_fraction(cos_o);
+            let got = albedo(&skin(0.6), cos_o);
+            assert!(
+                (got - expect).abs() < 0.01 * expect,
+                "cos {cos_o}: {got} vs {expect}"
+            );
+        }
+        // Even a white body never reflects more than it receives.
+        assert!(albedo(&skin(1.0), 0.3) <= 1.0 + 0.01);
+    }
+
+    #[test]
+    fn skin_bsdf_is_reciprocal() {
+        let wl = SampledWavelengths::sample_visible(0.1);
+        let m = skin(0.5);
+        let b = m.bsdf(Vec3::Z, Vec2::ZERO, &wl, &[]);
+        let a = Vec3::new(0.3, 0.1, 0.9).normalize();
+        let c = Vec3::new(-0.5, 0.2, 0.4).normalize();
+        let (x, y) = (b.eval(a, c).0[0], b.eval(c, a).0[0]);
+        assert!((x - y).abs() < 1e-5 * x.max(1e-3), "{x} vs {y}");
+    }
+}

@@ -1,0 +1,240 @@
+//! The skin material and its one constructor, [`SkinMaterial::build`]: from validated parameters
+//! and the scene's knobs to the surface lobe, the total diffuse reflectance R_tot(λ) and (unless
+//! subsurface scattering is off) the BSSRDF.
+//!
+//! R_tot(λ) is computed once per material and every consumer reads that one set of numbers: with a
+//! BSSRDF they are the profile table's totals (`ProfileTable::total`, which the integrator's energy
+//! cap and the branch choice between surface and body both read); without one (`no_subsurface`)
+//! the Lambertian stand-in tabulates the same model's totals (`multipole::skin::total_reflectance`)
+//! on the same 10-nm grid.
+
+use crate::bssrdf::{Directional, EnergySplit, ProfileTable, Subsurface, TableOptions};
+use crate::material::TextureRef;
+use crate::spectrum::SpectrumTable;
+use crate::texture::{Texture, luminance};
+use brdf::TorranceSparrow;
+use glam::Vec2;
+use rayon::prelude::*;
+use skin_optics::{SkinParams, Wavelength};
+use std::sync::Arc;
+use thiserror::Error;
+
+/// Wavelength step of the skin reflectance tables computed at load, nm (interpolated to 5 nm).
+pub const SKIN_TABLE_STEP_NM: f64 = 10.0;
+
+/// Knobs of every skin material of a scene, chosen once when it is loaded.
+#[derive(Debug, Clone, Copy)]
+pub struct SkinKnobs {
+    /// How skin reflectance is computed (default exact: adding-doubling totals, Monte Carlo shapes).
+    pub method: multipole::Method,
+    /// Shade skin's body with the Lambertian stand-in instead of the BSSRDF (for comparisons;
+    /// default false: subsurface scattering on).
+    pub no_subsurface: bool,
+    /// Escaping photons per Monte Carlo profile shape (`Method::Exact`; default
+    /// [`crate::bssrdf::RENDER_SHAPE_ESCAPES`]).
+    pub shape_escapes: u64,
+}
+
+impl Default for SkinKnobs {
+    fn default() -> Self {
+        Self {
+            method: multipole::Method::default(),
+            no_subsurface: false,
+            shape_escapes: crate::bssrdf::RENDER_SHAPE_ESCAPES,
+        }
+    }
+}
+
+/// Why a skin material could not be built.
+#[derive(Debug, Error)]
+pub enum SkinBuildError {
+    /// The surface lobe's roughness (or the skin's oiliness or η) is outside its range.
+    #[error("{0}")]
+    Surface(#[from] brdf::BrdfError),
+    /// The radial profiles of the BSSRDF could not be computed.
+    #[error("skin profiles: {0}")]
+    Profiles(multipole::MultipoleError),
+    /// The total reflectance could not be computed at a wavelength.
+    #[error("skin reflectance at {nm} nm: {source}")]
+    Reflectance {
+        /// The wavelength, nm.
+        nm: f64,
+        /// What the model reported.
+        source: multipole::MultipoleError,
+    },
+    /// A wavelength of the table is outside the model's range.
+    #[error("{0}")]
+    Wavelength(String),
+    /// A total came out outside [0, 1] (a model failure, never silently clamped).
+    #[error("skin reflectance {0} outside [0, 1]")]
+    OutOfRange(f64),
+}
+
+/// Skin: validated parameters, the surface lobe and the body reflectance table.
+#[derive(Debug, Clone)]
+pub struct SkinMaterial {
+    /// The skin's parameters.
+    pub params: SkinParams,
+    /// The oily surface layer.
+    pub surface: TorranceSparrow,
+    /// Total diffuse reflectance R_d(λ) per unit flux entering: with a BSSRDF, its profile table's
+    /// totals; without, the same model's totals at [`SKIN_TABLE_STEP_NM`] steps.
+    pub total_reflectance: SpectrumTable,
+    /// Optional albedo texture (relative luminance modulation).
+    pub albedo_texture: Option<TextureRef>,
+    /// T̄ = ∫ T(θ) 2 cosθ dcosθ, the cosine-weighted mean of the transmitted fraction.
+    pub mean_transmitted: f32,
+    /// The BSSRDF; when present it replaces the Lambertian body term.
+    pub subsurface: Option<Subsurface>,
+}
+
+impl SkinMaterial {
+    /// The skin of `params` with surface roughness `roughness_m` (Beckmann RMS slope, (0, 1]) and
+    /// an optional albedo texture: its surface lobe, its totals and, unless `knobs.no_subsurface`,
+    /// its BSSRDF, all built here once.
+    pub fn build(
+        params: SkinParams,
+        roughness_m: f32,
+        albedo_texture: Option<TextureRef>,
+        knobs: &SkinKnobs,
+    ) -> Result<Self, SkinBuildError> {
+        let surface =
+            TorranceSparrow::new(roughness_m, params.oiliness() as f32, params.eta() as f32)?;
+        if knobs.no_subsurface {
+            let totals = total_table(&params, knobs.method)?;
+            return Ok(Self::new(params, surface, totals, albedo_texture));
+        }
+        let mut opts = TableOptions::default();
+        opts.profile.exact_shape = multipole::skin::ExactShape::MonteCarlo {
+            escapes: knobs.shape_escapes,
+        };
+        let table =
+            ProfileTable::build(&params, knobs.method, &opts).map_err(SkinBuildError::Profiles)?;
+        if let Some(bad) = (0..table.wavelengths())
+            .map(|j| f64::from(table.total(opts.from_nm as f32 + j as f32 * opts.step_nm as f32)))
+            .find(|r| !(r.is_finite() && (0.0..=1.0).contains(r)))
+        {
+            return Err(SkinBuildError::OutOfRange(bad));
+        }
+        let totals = SpectrumTable::from_fn(|nm| f64::from(table.total(nm as f32)));
+        let directional = Directional::new(surface.clone(), EnergySplit::default());
+        let subsurface = Subsurface::new(Arc::new(table), directional);
+        Ok(Self::new(params, surface, totals, albedo_texture).with_subsurface(subsurface))
+    }
+
+    /// Skin from its parameters, surface lobe and R_d(λ) table (no BSSRDF).
+    #[must_use]
+    pub fn new(
+        params: SkinParams,
+        surface: TorranceSparrow,
+        total_reflectance: SpectrumTable,
+        albedo_texture: Option<TextureRef>,
+    ) -> Self {
+        // Midpoint rule in μ = cosθ; T is smooth, 256 nodes are far below f32 noise.
+        let n = 256;
+        let mean_transmitted = (0..n)
+            .map(|i| {
+                let mu = (i as f32 + 0.5) / n as f32;
+                surface.transmitted_fraction(mu) * 2.0 * mu / n as f32
+            })
+            .sum();
+        Self {
+            params,
+            surface,
+            total_reflectance,
+            albedo_texture,
+            mean_transmitted,
+            subsurface: None,
+        }
+    }
+
+    /// The same skin shading its body with the BSSRDF `subsurface` instead of the Lambertian term.
+    #[must_use]
+    pub fn with_subsurface(mut self, subsurface: Subsurface) -> Self {
+        self.subsurface = Some(subsurface);
+        self
+    }
+
+    /// The albedo texture's relative luminance m(uv) (texture luminance / its mean; 1 without one).
+    #[must_use]
+    pub fn texture_factor(&self, uv: Vec2, textures: &[Texture]) -> f32 {
+        self.albedo_texture.map_or(1.0, |t| {
+            luminance(textures[t.index].lookup(uv)) / t.mean_luminance
+        })
+    }
+}
+
+/// R_tot(λ) of `params` with `method` at [`SKIN_TABLE_STEP_NM`] steps over 380–780 nm, computed in
+/// parallel and interpolated linearly.
+fn total_table(
+    params: &SkinParams,
+    method: multipole::Method,
+) -> Result<SpectrumTable, SkinBuildError> {
+    let n = ((780.0 - 380.0) / SKIN_TABLE_STEP_NM) as usize + 1;
+    let rd = (0..n)
+        .into_par_iter()
+        .map(|i| {
+            let nm = 380.0 + SKIN_TABLE_STEP_NM * i as f64;
+            let lambda =
+                Wavelength::new(nm).map_err(|e| SkinBuildError::Wavelength(e.to_string()))?;
+            multipole::skin::total_reflectance(params, lambda, method)
+                .map_err(|source| SkinBuildError::Reflectance { nm, source })
+        })
+        .collect::<Result<Vec<f64>, _>>()?;
+    if let Some(&bad) = rd
+        .iter()
+        .find(|r| !(r.is_finite() && (0.0..=1.0).contains(*r)))
+    {
+        return Err(SkinBuildError::OutOfRange(bad));
+    }
+    Ok(SpectrumTable::from_fn(|nm| {
+        let x = ((nm - 380.0) / SKIN_TABLE_STEP_NM).clamp(0.0, (n - 1) as f64);
+        let i = (x as usize).min(n - 2);
+        rd[i] + (x - i as f64) * (rd[i + 1] - rd[i])
+    }))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use skin_optics::Preset;
+
+    /// One set of totals per skin. With a BSSRDF the totals the BSDF reads are the profile table's
+    /// (both interpolate linearly between the same 10-nm rows, so they agree at every 5-nm step to
+    /// f32 rounding, 1e-6); without one they are the model's at the same 10-nm steps, and the two
+    /// agree there to the 1e-5 to which the table's rows hold the model's totals.
+    #[test]
+    fn the_bsdf_and_the_bssrdf_read_the_same_totals() {
+        let params = SkinParams::preset(Preset::Light);
+        let with = SkinMaterial::build(params, 0.3, None, &SkinKnobs::default()).unwrap();
+        let table = &with
+            .subsurface
+            .as_ref()
+            .expect("BSSRDF on by default")
+            .table;
+        let knobs = SkinKnobs {
+            no_subsurface: true,
+            ..SkinKnobs::default()
+        };
+        let without = SkinMaterial::build(params, 0.3, None, &knobs).unwrap();
+        assert!(without.subsurface.is_none());
+        for k in 0..=80 {
+            let nm = 380.0 + 5.0 * k as f32;
+            let a = with.total_reflectance.at_nm(nm);
+            let t = table.total(nm);
+            assert!((a - t).abs() <= 1e-6 * t, "{nm} nm: BSDF {a} vs table {t}");
+            if k % 2 == 0 {
+                let b = without.total_reflectance.at_nm(nm);
+                assert!((a - b).abs() <= 1e-5 * b, "{nm} nm: {a} vs model {b}");
+            }
+        }
+    }
+
+    /// A bad roughness is the surface's typed error, before any profile is computed.
+    #[test]
+    fn bad_roughness_is_a_surface_error() {
+        let params = SkinParams::preset(Preset::Dark);
+        let e = SkinMaterial::build(params, 0.0, None, &SkinKnobs::default()).unwrap_err();
+        assert!(matches!(e, SkinBuildError::Surface(_)), "{e}");
+    }
+}

@@ -1,0 +1,364 @@
+//! Loading a scene file: the camera, meshes and their placement, lights and the environment, with
+//! every value checked and every error naming the file and key.
+
+use super::Scene;
+use crate::builtin;
+use crate::camera::Camera;
+use crate::error::RenderError;
+use crate::geometry::Geometry;
+use crate::light::{
+    DistantLight, EmissionShape, Environment, Light, PointLight, QuadLight, SphereLight, SpotLight,
+};
+use crate::material::{DiffuseMaterial, Material, SkinKnobs, SkinMaterial};
+use crate::mesh::{Placement, TriangleMesh};
+use crate::scene_file::{EnvironmentDesc, LightDesc, MeshDesc, SceneDesc, ShapeKind, SpectrumKind};
+use crate::spectrum::SpectrumTable;
+use crate::texture::Texture;
+use glam::Vec3;
+use std::borrow::Cow;
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+/// One scene file being loaded: where it is, and the choices made for its materials.
+pub(super) struct Loader<'a> {
+    pub(super) file: &'a str,
+    pub(super) base_dir: Option<&'a Path>,
+    pub(super) opts: &'a SkinKnobs,
+}
+
+impl Loader<'_> {
+    pub(super) fn err(&self, key: impl Into<String>, message: impl Into<String>) -> RenderError {
+        RenderError::value(self.file, key, message)
+    }
+
+    fn vec3(&self, key: &str, v: [f32; 3]) -> Result<Vec3, RenderError> {
+        if v.iter().all(|x| x.is_finite()) {
+            Ok(Vec3::from(v))
+        } else {
+            Err(self.err(key, format!("expected three finite numbers, got {v:?}")))
+        }
+    }
+
+    fn positive(&self, key: &str, v: f32) -> Result<f32, RenderError> {
+        if v.is_finite() && v > 0.0 {
+            Ok(v)
+        } else {
+            Err(self.err(key, format!("expected a finite number > 0, got {v}")))
+        }
+    }
+
+    fn non_negative(&self, key: &str, v: f32) -> Result<f32, RenderError> {
+        if v.is_finite() && v >= 0.0 {
+            Ok(v)
+        } else {
+            Err(self.err(key, format!("expected a finite number ≥ 0, got {v}")))
+        }
+    }
+
+    /// Bytes of a referenced file (or built-in asset) and its resolved path.
+    pub(super) fn read(
+        &self,
+        what: &'static str,
+        spec: &str,
+    ) -> Result<(Cow<'static, [u8]>, PathBuf), RenderError> {
+        if let Some(name) = spec.strip_prefix(builtin::PREFIX) {
+            return builtin::asset(name)
+                .map(|b| (Cow::Borrowed(b), PathBuf::from(spec)))
+                .ok_or_else(|| RenderError::MissingFile {
+                    what,
+                    path: PathBuf::from(spec),
+                    source: std::io::Error::new(
+                        std::io::ErrorKind::NotFound,
+                        "no such built-in asset",
+                    ),
+                });
+        }
+        let path = match self.base_dir {
+            Some(dir) => dir.join(spec),
+            None => PathBuf::from(spec),
+        };
+        std::fs::read(&path)
+            .map(|b| (Cow::Owned(b), path.clone()))
+            .map_err(|source| RenderError::MissingFile { what, path, source })
+    }
+
+    fn emission(
+        &self,
+        key: &str,
+        kind: Option<SpectrumKind>,
+        temperature_k: Option<f64>,
+        intensity: f32,
+    ) -> Result<SpectrumTable, RenderError> {
+        let intensity = self.non_negative(&format!("{key}.intensity"), intensity)?;
+        let shape = match kind.unwrap_or(SpectrumKind::D65) {
+            SpectrumKind::D65 => EmissionShape::D65,
+            SpectrumKind::Constant => EmissionShape::Constant,
+            SpectrumKind::Blackbody => match temperature_k {
+                Some(t) if t.is_finite() && (500.0..=100_000.0).contains(&t) => {
+                    EmissionShape::Blackbody { kelvin: t }
+                }
+                Some(t) => {
+                    return Err(self.err(
+                        format!("{key}.temperature_k"),
+                        format!("{t} outside [500, 100000] K"),
+                    ));
+                }
+                None => {
+                    return Err(self.err(
+                        format!("{key}.temperature_k"),
+                        "required with spectrum = \"blackbody\"",
+                    ));
+                }
+            },
+        };
+        Ok(shape.table(intensity))
+    }
+
+    pub(super) fn load(&self, desc: SceneDesc) -> Result<Scene, RenderError> {
+        let c = &desc.camera;
+        let camera = Camera::new(
+            self.vec3("camera.position_mm", c.position_mm)?,
+            self.vec3("camera.look_at_mm", c.look_at_mm)?,
+            self.vec3("camera.up", c.up)?,
+            c.fov_deg,
+            c.aperture_mm,
+            c.focus_distance_mm,
+        )
+        .map_err(|e| match e {
+            RenderError::Setting { name, value, range } => {
+                self.err(name, format!("expected {range}, got {value}"))
+            }
+            other => other,
+        })?;
+        if !desc.film.exposure_stops.is_finite() {
+            return Err(self.err("film.exposure_stops", "expected a finite number"));
+        }
+
+        let (materials, material_names, textures) = self.materials(&desc.materials)?;
+
+        let mut meshes = Vec::new();
+        let mut cache: HashMap<String, TriangleMesh> = HashMap::new();
+        for (i, m) in desc.meshes.iter().enumerate() {
+            let key = format!("meshes[{i}]");
+            let material = material_names
+                .iter()
+                .position(|n| *n == m.material)
+                .ok_or_else(|| {
+                    self.err(
+                        format!("{key}.material"),
+                        format!(
+                            "no material named '{}' (defined: {})",
+                            m.material,
+                            material_names.join(", ")
+                        ),
+                    )
+                })?;
+            let mut mesh = self.mesh(&key, m, &mut cache)?;
+            if let Material::Skin(SkinMaterial {
+                albedo_texture: Some(_),
+                ..
+            })
+            | Material::Diffuse(DiffuseMaterial {
+                albedo_texture: Some(_),
+                ..
+            }) = &materials[material]
+                && mesh.uvs.is_none()
+            {
+                return Err(self.err(
+                    &key,
+                    "the material has a texture but the mesh has no texture coordinates",
+                ));
+            }
+            let placement = Placement {
+                units_mm: self.positive(&format!("{key}.units_mm"), m.units_mm)?,
+                scale: self.positive(&format!("{key}.scale"), m.scale)?,
+                rotate_deg: self.vec3(&format!("{key}.rotate_deg"), m.rotate_deg)?,
+                translate_mm: self.vec3(&format!("{key}.translate_mm"), m.translate_mm)?,
+            };
+            mesh.transform(&placement.to_affine());
+            if m.flip_v
+                && let Some(uvs) = &mut mesh.uvs
+            {
+                uvs.iter_mut().for_each(|uv| uv.y = 1.0 - uv.y);
+            }
+            meshes.push((mesh, material as u32));
+        }
+
+        let lights = desc
+            .lights
+            .iter()
+            .enumerate()
+            .map(|(i, l)| self.light(&format!("lights[{i}]"), l))
+            .collect::<Result<Vec<_>, _>>()?;
+        let environment = desc
+            .environment
+            .as_ref()
+            .map(|e| self.environment(e))
+            .transpose()?;
+
+        Ok(Scene {
+            name: self.file.to_string(),
+            camera,
+            lights,
+            environment,
+            materials,
+            material_names,
+            textures,
+            geometry: Geometry::new(meshes),
+            exposure_stops: desc.film.exposure_stops,
+        })
+    }
+
+    fn mesh(
+        &self,
+        key: &str,
+        m: &MeshDesc,
+        cache: &mut HashMap<String, TriangleMesh>,
+    ) -> Result<TriangleMesh, RenderError> {
+        match (&m.file, m.shape) {
+            (Some(_), Some(_)) | (None, None) => {
+                Err(self.err(key, "expected exactly one of `file` and `shape`"))
+            }
+            (None, Some(ShapeKind::Sphere)) => Ok(TriangleMesh::sphere(4)),
+            (None, Some(ShapeKind::Quad)) => Ok(TriangleMesh::quad()),
+            (Some(file), None) => {
+                if let Some(mesh) = cache.get(file) {
+                    return Ok(mesh.clone());
+                }
+                let (bytes, path) = self.read("mesh", file)?;
+                let lower = file.to_ascii_lowercase();
+                let mesh = if lower.ends_with(".glb") {
+                    TriangleMesh::from_glb(&bytes, &path)?
+                } else if lower.ends_with(".obj") {
+                    TriangleMesh::from_obj(&bytes, &path)?
+                } else {
+                    return Err(self.err(
+                        format!("{key}.file"),
+                        format!("expected a .glb or .obj file, got {file}"),
+                    ));
+                };
+                cache.insert(file.clone(), mesh.clone());
+                Ok(mesh)
+            }
+        }
+    }
+
+    fn light(&self, key: &str, l: &LightDesc) -> Result<Light, RenderError> {
+        Ok(match l {
+            LightDesc::Point {
+                position_mm,
+                spectrum,
+                temperature_k,
+                intensity,
+            } => Light::Point(PointLight {
+                position_mm: self.vec3(&format!("{key}.position_mm"), *position_mm)?,
+                intensity: self.emission(key, *spectrum, *temperature_k, *intensity)?,
+            }),
+            LightDesc::Spot {
+                position_mm,
+                look_at_mm,
+                inner_deg,
+                outer_deg,
+                spectrum,
+                temperature_k,
+                intensity,
+            } => {
+                let p = self.vec3(&format!("{key}.position_mm"), *position_mm)?;
+                let dir = self.vec3(&format!("{key}.look_at_mm"), *look_at_mm)? - p;
+                if dir.length() <= 0.0 {
+                    return Err(
+                        self.err(format!("{key}.look_at_mm"), "must differ from position_mm")
+                    );
+                }
+                if !(*inner_deg >= 0.0 && inner_deg <= outer_deg && *outer_deg < 180.0) {
+                    return Err(self.err(
+                        format!("{key}.outer_deg"),
+                        format!(
+                            "expected 0 ≤ inner_deg ≤ outer_deg < 180, got {inner_deg}, {outer_deg}"
+                        ),
+                    ));
+                }
+                Light::Spot(SpotLight {
+                    position_mm: p,
+                    direction: dir.normalize(),
+                    cos_inner: inner_deg.to_radians().cos(),
+                    cos_outer: outer_deg.to_radians().cos(),
+                    intensity: self.emission(key, *spectrum, *temperature_k, *intensity)?,
+                })
+            }
+            LightDesc::Distant {
+                direction,
+                spectrum,
+                temperature_k,
+                intensity,
+            } => {
+                let d = self.vec3(&format!("{key}.direction"), *direction)?;
+                if d.length() <= 0.0 {
+                    return Err(self.err(format!("{key}.direction"), "expected a non-zero vector"));
+                }
+                Light::Distant(DistantLight {
+                    to_light: d.normalize(),
+                    irradiance: self.emission(key, *spectrum, *temperature_k, *intensity)?,
+                })
+            }
+            LightDesc::Sphere {
+                center_mm,
+                radius_mm,
+                spectrum,
+                temperature_k,
+                intensity,
+            } => Light::Sphere(SphereLight {
+                center_mm: self.vec3(&format!("{key}.center_mm"), *center_mm)?,
+                radius_mm: self.positive(&format!("{key}.radius_mm"), *radius_mm)?,
+                radiance: self.emission(key, *spectrum, *temperature_k, *intensity)?,
+            }),
+            LightDesc::Quad {
+                center_mm,
+                look_at_mm,
+                size_mm,
+                spectrum,
+                temperature_k,
+                intensity,
+            } => {
+                let c = self.vec3(&format!("{key}.center_mm"), *center_mm)?;
+                let n = self.vec3(&format!("{key}.look_at_mm"), *look_at_mm)? - c;
+                if n.length() <= 0.0 {
+                    return Err(self.err(format!("{key}.look_at_mm"), "must differ from center_mm"));
+                }
+                let n = n.normalize();
+                let w = self.positive(&format!("{key}.size_mm"), size_mm[0])?;
+                let h = self.positive(&format!("{key}.size_mm"), size_mm[1])?;
+                let hint = if n.y.abs() > 0.99 { Vec3::X } else { Vec3::Y };
+                let right = hint.cross(n).normalize();
+                let up = n.cross(right);
+                // edge_u × edge_v = w h (right × up) = w h n: the emitting side faces look_at.
+                let (eu, ev) = (right * w, up * h);
+                Light::Quad(QuadLight {
+                    corner_mm: c - eu * 0.5 - ev * 0.5,
+                    edge_u_mm: eu,
+                    edge_v_mm: ev,
+                    radiance: self.emission(key, *spectrum, *temperature_k, *intensity)?,
+                })
+            }
+        })
+    }
+
+    fn environment(&self, e: &EnvironmentDesc) -> Result<Environment, RenderError> {
+        match &e.exr {
+            Some(file) => {
+                let scale = self.non_negative("environment.intensity", e.intensity)?;
+                let (bytes, path) = self.read("environment map", file)?;
+                Ok(Environment::LatLong {
+                    map: Texture::from_exr_bytes(&bytes, &path)?,
+                    scale,
+                })
+            }
+            None => Ok(Environment::Constant(self.emission(
+                "environment",
+                e.spectrum,
+                e.temperature_k,
+                e.intensity,
+            )?)),
+        }
+    }
+}

@@ -1,0 +1,188 @@
+//! The materials of a scene file: skin (preset and overrides, surface lobe, texture) and diffuse
+//! backdrops (constant, sRGB, sampled or textured albedo). Each key is checked here; the skin's
+//! physics is built by [`SkinMaterial::build`].
+
+use super::load::Loader;
+use crate::error::RenderError;
+use crate::material::{DiffuseMaterial, Material, SkinBuildError, SkinMaterial, TextureRef};
+use crate::scene_file::MaterialDesc;
+use crate::spectrum::{SpectrumTable, linear_srgb_to_spectrum};
+use crate::texture::{Texture, luminance};
+use skin_optics::{Preset, SkinParams};
+use std::collections::{BTreeMap, HashMap};
+
+/// Materials in name order (as the file's table is read), their names (same order) and the textures
+/// they use.
+type Materials = (Vec<Material>, Vec<String>, Vec<Texture>);
+
+impl Loader<'_> {
+    /// Every material of the file, each texture read once.
+    pub(super) fn materials(
+        &self,
+        descs: &BTreeMap<String, MaterialDesc>,
+    ) -> Result<Materials, RenderError> {
+        let mut textures = Vec::new();
+        let mut texture_ids: HashMap<String, usize> = HashMap::new();
+        let mut material_names = Vec::new();
+        let mut materials = Vec::new();
+        for (name, m) in descs {
+            let key = format!("materials.{name}");
+            let mut texture = |spec: &Option<String>| -> Result<Option<TextureRef>, RenderError> {
+                let Some(spec) = spec else { return Ok(None) };
+                let index = match texture_ids.get(spec) {
+                    Some(&i) => i,
+                    None => {
+                        let (bytes, path) = self.read("texture", spec)?;
+                        textures.push(Texture::from_srgb_bytes(&bytes, &path)?);
+                        texture_ids.insert(spec.clone(), textures.len() - 1);
+                        textures.len() - 1
+                    }
+                };
+                let mean_luminance = luminance(textures[index].mean()).max(1e-6);
+                Ok(Some(TextureRef {
+                    index,
+                    mean_luminance,
+                }))
+            };
+            let material = match m {
+                MaterialDesc::Skin {
+                    preset,
+                    melanin,
+                    eumelanin,
+                    hemoglobin,
+                    oil,
+                    roughness,
+                    albedo_texture,
+                } => {
+                    let params =
+                        self.skin_params(&key, preset, [*melanin, *eumelanin, *hemoglobin, *oil])?;
+                    let m_rough = roughness.unwrap_or(brdf::DEFAULT_ROUGHNESS);
+                    let rough_err =
+                        |e: brdf::BrdfError| self.err(format!("{key}.roughness"), e.to_string());
+                    brdf::check_roughness(m_rough).map_err(rough_err)?;
+                    let tex = texture(albedo_texture)?;
+                    let skin = SkinMaterial::build(params, m_rough, tex, self.opts).map_err(
+                        |e| match e {
+                            SkinBuildError::Surface(e) => rough_err(e),
+                            other => self.err(&key, other.to_string()),
+                        },
+                    )?;
+                    Material::Skin(skin)
+                }
+                MaterialDesc::Diffuse {
+                    albedo,
+                    albedo_srgb,
+                    albedo_spectrum,
+                    albedo_texture,
+                } => {
+                    let set = [
+                        albedo.is_some(),
+                        albedo_srgb.is_some(),
+                        albedo_spectrum.is_some(),
+                    ];
+                    let table = match (albedo, albedo_srgb, albedo_spectrum) {
+                        _ if set.iter().filter(|&&s| s).count() > 1 => {
+                            return Err(self.err(
+                                &key,
+                                "give only one of albedo, albedo_srgb, albedo_spectrum",
+                            ));
+                        }
+                        (Some(a), _, _) => {
+                            SpectrumTable::constant(self.unit(&format!("{key}.albedo"), *a)?)
+                        }
+                        (_, Some(rgb), _) => {
+                            let mut lin = [0.0; 3];
+                            for (i, &c) in rgb.iter().enumerate() {
+                                let c = self.unit(&format!("{key}.albedo_srgb"), c)?;
+                                lin[i] = skin_optics::color::srgb_decode(f64::from(c)) as f32;
+                            }
+                            linear_srgb_to_spectrum(lin)
+                        }
+                        (_, _, Some(samples)) => {
+                            self.sampled_albedo(&format!("{key}.albedo_spectrum"), samples)?
+                        }
+                        _ if albedo_texture.is_some() => SpectrumTable::constant(1.0),
+                        _ => {
+                            return Err(self.err(
+                                &key,
+                                "expected one of albedo, albedo_srgb, albedo_spectrum",
+                            ));
+                        }
+                    };
+                    Material::Diffuse(DiffuseMaterial {
+                        albedo: table,
+                        albedo_texture: texture(albedo_texture)?,
+                    })
+                }
+            };
+            material_names.push(name.clone());
+            materials.push(material);
+        }
+        Ok((materials, material_names, textures))
+    }
+
+    fn unit(&self, key: &str, v: f32) -> Result<f32, RenderError> {
+        if v.is_finite() && (0.0..=1.0).contains(&v) {
+            Ok(v)
+        } else {
+            Err(self.err(key, format!("expected a value in [0, 1], got {v}")))
+        }
+    }
+
+    fn sampled_albedo(&self, key: &str, s: &[[f64; 2]]) -> Result<SpectrumTable, RenderError> {
+        if s.is_empty() || s.windows(2).any(|w| w[1][0] <= w[0][0]) {
+            return Err(self.err(key, "expected [nm, value] pairs with increasing nm"));
+        }
+        for p in s {
+            self.unit(key, p[1] as f32)?;
+        }
+        Ok(SpectrumTable::from_fn(|nm| {
+            let i = s.partition_point(|p| p[0] <= nm);
+            if i == 0 {
+                s[0][1]
+            } else if i == s.len() {
+                s[s.len() - 1][1]
+            } else {
+                let (a, b) = (s[i - 1], s[i]);
+                a[1] + (nm - a[0]) / (b[0] - a[0]) * (b[1] - a[1])
+            }
+        }))
+    }
+
+    /// The preset with explicit fractions replacing its values; an invalid one is reported by its key.
+    fn skin_params(
+        &self,
+        key: &str,
+        preset: &Option<String>,
+        overrides: [Option<f64>; 4],
+    ) -> Result<SkinParams, RenderError> {
+        let base = match preset {
+            Some(p) => SkinParams::preset(
+                p.parse::<Preset>()
+                    .map_err(|e| self.err(format!("{key}.preset"), e.to_string()))?,
+            ),
+            None => SkinParams::preset(Preset::Light),
+        };
+        let names = ["melanin", "eumelanin", "hemoglobin", "oil"];
+        let values = |o: [Option<f64>; 4]| {
+            [
+                o[0].unwrap_or(base.melanin()),
+                o[1].unwrap_or(base.eumelanin_blend()),
+                o[2].unwrap_or(base.hemoglobin()),
+                o[3].unwrap_or(base.oiliness()),
+            ]
+        };
+        // Check each override alone first, so the error names the offending key.
+        for (i, name) in names.iter().enumerate() {
+            if overrides[i].is_some() {
+                let mut one = [None; 4];
+                one[i] = overrides[i];
+                let v = values(one);
+                SkinParams::new(v[0], v[1], v[2], v[3])
+                    .map_err(|e| self.err(format!("{key}.{name}"), e.to_string()))?;
+            }
+        }
+        let v = values(overrides);
+        SkinParams::new(v[0], v[1], v[2], v[3]).map_err(|e| self.err(key, e.to_string()))
+    }
+}
