@@ -7,6 +7,7 @@ pub mod builtin;
 pub mod camera;
 pub mod cli;
 pub mod error;
+pub mod export;
 pub mod film;
 pub mod geometry;
 pub mod input;

@@ -24,6 +24,8 @@ enum Command {
     Render(cli::render::RenderArgs),
     /// Fit skin parameters to an sRGB colour or a measured reflectance spectrum.
     Fit(cli::fit::FitArgs),
+    /// Write the skin for another renderer or simulator (OpenPBR, Unreal, HDRP, pbrt, Mitsuba, MCML, ...).
+    Export(cli::export::ExportArgs),
 }
 
 fn main() -> ExitCode {
@@ -34,6 +36,7 @@ fn main() -> ExitCode {
         Command::Brdf(a) => cli::brdf::run(a),
         Command::Render(a) => cli::render::run(a),
         Command::Fit(a) => cli::fit::run(a),
+        Command::Export(a) => cli::export::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

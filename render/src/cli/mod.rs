@@ -4,6 +4,7 @@
 
 pub mod args;
 pub mod brdf;
+pub mod export;
 pub mod fit;
 pub mod profile;
 pub mod render;
