@@ -13,6 +13,7 @@ pub mod integrator;
 pub mod light;
 pub mod material;
 pub mod mesh;
+pub mod noise;
 pub mod plot;
 pub mod renderer;
 pub mod sampling;
