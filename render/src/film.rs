@@ -27,6 +27,20 @@ impl Film {
         }
     }
 
+    /// A film from each pixel's mean XYZ (row-major), for renders whose pixels took different
+    /// sample counts; `spp` is the largest count, as reported by [`Film::spp`].
+    #[must_use]
+    pub fn from_mean_xyz(width: usize, height: usize, mean_xyz: Vec<[f64; 3]>, spp: u32) -> Self {
+        debug_assert_eq!(mean_xyz.len(), width * height);
+        let n = f64::from(spp.max(1));
+        Self {
+            width,
+            height,
+            sum_xyz: mean_xyz.into_iter().map(|m| m.map(|v| v * n)).collect(),
+            spp,
+        }
+    }
+
     /// Width and height, pixels.
     #[must_use]
     pub fn size(&self) -> (usize, usize) {

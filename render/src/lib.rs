@@ -1,6 +1,7 @@
 #![doc = include_str!("../README.md")]
 
 pub mod accel;
+pub mod adaptive;
 pub mod atomic;
 pub mod bssrdf;
 pub mod builtin;
