@@ -155,7 +155,13 @@ impl Accumulator {
             .zip(&self.count)
             .map(|(s, &n)| s.map(|v| v / f64::from(n.max(1))))
             .collect();
-        Film::from_mean_xyz(self.width, self.height, mean, self.count.iter().copied().max().unwrap_or(0))
+        let var = self
+            .variance_of_mean()
+            .into_iter()
+            .map(|v| if v.is_finite() { v } else { 0.0 })
+            .collect();
+        let spp = self.count.iter().copied().max().unwrap_or(0);
+        Film::from_means(self.width, self.height, mean, var, spp)
     }
 }
 

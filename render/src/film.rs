@@ -13,6 +13,8 @@ pub struct Film {
     height: usize,
     sum_xyz: Vec<[f64; 3]>,
     spp: u32,
+    /// Estimated variance of each pixel's mean luminance Y (zero when not estimated).
+    variance_y: Vec<f64>,
 }
 
 impl Film {
@@ -24,21 +26,36 @@ impl Film {
             height,
             sum_xyz: vec![[0.0; 3]; width * height],
             spp: 0,
+            variance_y: vec![0.0; width * height],
         }
     }
 
-    /// A film from each pixel's mean XYZ (row-major), for renders whose pixels took different
-    /// sample counts; `spp` is the largest count, as reported by [`Film::spp`].
+    /// A film from each pixel's mean XYZ and the variance of its mean luminance (row-major), for
+    /// renders whose pixels took different sample counts; `spp` is the largest count.
     #[must_use]
-    pub fn from_mean_xyz(width: usize, height: usize, mean_xyz: Vec<[f64; 3]>, spp: u32) -> Self {
+    pub fn from_means(
+        width: usize,
+        height: usize,
+        mean_xyz: Vec<[f64; 3]>,
+        variance_y: Vec<f64>,
+        spp: u32,
+    ) -> Self {
         debug_assert_eq!(mean_xyz.len(), width * height);
+        debug_assert_eq!(variance_y.len(), width * height);
         let n = f64::from(spp.max(1));
         Self {
             width,
             height,
             sum_xyz: mean_xyz.into_iter().map(|m| m.map(|v| v * n)).collect(),
             spp,
+            variance_y,
         }
+    }
+
+    /// Estimated variance of pixel (x, y)'s mean luminance Y (the `variance` pass).
+    #[must_use]
+    pub fn variance(&self, x: usize, y: usize) -> f64 {
+        self.variance_y[y * self.width + x]
     }
 
     /// Width and height, pixels.

@@ -15,6 +15,7 @@ pub mod light;
 pub mod material;
 pub mod mesh;
 pub mod noise;
+pub mod passes;
 pub mod plot;
 pub mod renderer;
 pub mod sampling;

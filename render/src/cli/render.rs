@@ -1,5 +1,5 @@
 //! `skin render`: load a scene (the built-in three-head scene by default), path trace it, and write
-//! OUT/render.exr (linear sRGB, f32) and OUT/render.png (sRGB, exposure + filmic tone curve).
+//! OUT/render.exr (linear sRGB, f32, with the passes of `render::passes`) and OUT/render.png (sRGB, exposure + filmic tone curve).
 
 use crate::renderer::{RenderOptions, SettingError, render};
 use crate::scene::{Scene, SceneOptions};
@@ -122,7 +122,8 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     let (film, stats) = render(&scene, &settings)?;
     let exr = args.out.join("render.exr");
     let png = args.out.join("render.png");
-    film.write_exr(&exr)?;
+    crate::passes::Passes::first_hit(&scene, settings.width, settings.height)
+        .write_exr(&film, &exr)?;
     film.write_png(&png, scene.exposure_stops + args.exposure)?;
     println!(
         "rendered {}×{} at {:.1} spp (mean; at most {}) in {:.1} s ({} threads): {:.2} M rays/s, {:.3} s per sample per pixel",
