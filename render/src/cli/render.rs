@@ -25,10 +25,10 @@ pub struct RenderArgs {
     #[arg(long, value_name = "REL", default_value_t = 0.02)]
     pub noise: f64,
     /// Image width, pixels.
-    #[arg(long, value_name = "W", default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    #[arg(long, value_name = "W", default_value_t = 768, value_parser = clap::value_parser!(u32).range(1..=16384))]
     pub width: u32,
     /// Image height, pixels.
-    #[arg(long, value_name = "H", default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    #[arg(long, value_name = "H", default_value_t = 384, value_parser = clap::value_parser!(u32).range(1..=16384))]
     pub height: u32,
     /// Wall-clock budget in seconds: no pass starts that would end past it (0 = no limit).
     #[arg(long, value_name = "SECONDS", default_value_t = 60.0)]
@@ -122,8 +122,8 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     let (film, stats) = render(&scene, &settings)?;
     let exr = args.out.join("render.exr");
     let png = args.out.join("render.png");
-    crate::passes::Passes::first_hit(&scene, settings.width, settings.height)
-        .write_exr(&film, &exr)?;
+    let passes = crate::passes::Passes::first_hit(&scene, settings.width, settings.height);
+    passes.write_exr(&film, &exr)?;
     film.write_png(&png, scene.exposure_stops + args.exposure)?;
     println!(
         "rendered {}×{} at {:.1} spp (mean; at most {}) in {:.1} s ({} threads): {:.2} M rays/s, {:.3} s per sample per pixel",
@@ -137,10 +137,11 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         stats.seconds_per_spp()
     );
     println!(
-        "estimated noise {:.2}% over the lit pixels; {} of {} pixels reached the target",
+        "estimated noise {:.2}% over the lit pixels; {} of {} pixels reached the target; skin covers {:.1}% of the frame",
         100.0 * stats.noise,
         stats.converged,
-        settings.width * settings.height
+        settings.width * settings.height,
+        100.0 * passes.skin.iter().sum::<f32>() / passes.skin.len().max(1) as f32
     );
     println!(
         "total {:.1} s; wrote {} and {}",
