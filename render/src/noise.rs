@@ -55,7 +55,10 @@ pub fn lit_threshold(mean: &[f64]) -> f64 {
     if mean.is_empty() {
         return 0.0;
     }
-    let mut sorted: Vec<f64> = mean.iter().map(|v| if v.is_finite() { *v } else { 0.0 }).collect();
+    let mut sorted: Vec<f64> = mean
+        .iter()
+        .map(|v| if v.is_finite() { *v } else { 0.0 })
+        .collect();
     sorted.sort_by(f64::total_cmp);
     let idx = ((sorted.len() - 1) as f64 * 0.95).round() as usize;
     LIT_FRACTION * sorted[idx]
@@ -92,7 +95,9 @@ pub fn relative_noise(a: &[f64], b: &[f64]) -> Result<NoiseReport, NoiseError> {
 /// Luminance (CIE Y) of linear sRGB.
 #[must_use]
 pub fn luminance(rgb: [f32; 3]) -> f64 {
-    skin_optics::color::LinearSrgb(rgb.map(f64::from)).to_xyz().0[1]
+    skin_optics::color::LinearSrgb(rgb.map(f64::from))
+        .to_xyz()
+        .0[1]
 }
 
 /// The luminance of every pixel of an RGB OpenEXR (its first RGB layer), and its size.
@@ -156,6 +161,9 @@ mod tests {
         let r = relative_noise(&a, &b).unwrap();
         assert_eq!(r.relative_noise, 0.0);
         assert_eq!(r.lit_pixels, 99);
-        assert!(matches!(relative_noise(&[0.0; 4], &[0.0; 4]), Err(NoiseError::Black)));
+        assert!(matches!(
+            relative_noise(&[0.0; 4], &[0.0; 4]),
+            Err(NoiseError::Black)
+        ));
     }
 }

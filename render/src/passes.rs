@@ -81,7 +81,9 @@ impl Passes {
                                 (reflectance_rgb(|nm| (t.at_nm(nm) * f).min(1.0)), 1.0)
                             }
                             Material::Diffuse(m) => {
-                                let tex = m.albedo_texture.map(|t| scene.textures[t.index].lookup(s.uv));
+                                let tex = m
+                                    .albedo_texture
+                                    .map(|t| scene.textures[t.index].lookup(s.uv));
                                 let rho = |nm| {
                                     let base = m.albedo.at_nm(nm);
                                     let t = tex.map_or(1.0, |rgb| linear_srgb_at_nm(rgb, nm));
@@ -137,7 +139,10 @@ impl Passes {
         );
         let image = Image::from_layer(layer);
         atomic::write_via_temp(path, |tmp| {
-            image.write().to_file(tmp).map_err(|e| out_err(e.to_string()))
+            image
+                .write()
+                .to_file(tmp)
+                .map_err(|e| out_err(e.to_string()))
         })
         .map_err(|e: RenderError| match e {
             e @ (RenderError::Output { .. } | RenderError::Write(_)) => e,

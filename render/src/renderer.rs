@@ -232,8 +232,9 @@ fn render_passes(scene: &Scene, s: &RenderSettings) -> Result<(Film, RenderStats
                         if !active[i] {
                             continue;
                         }
-                        let mut rng =
-                            Xoshiro256PlusPlus::seed_from_u64(sample_seed(s.seed, i as u64, sample));
+                        let mut rng = Xoshiro256PlusPlus::seed_from_u64(sample_seed(
+                            s.seed, i as u64, sample,
+                        ));
                         let wl = SampledWavelengths::sample_visible(rng.random());
                         let film_pos = Vec2::new(
                             (x as f32 + rng.random::<f32>()) / w as f32,
@@ -243,7 +244,14 @@ fn render_passes(scene: &Scene, s: &RenderSettings) -> Result<(Film, RenderStats
                         let (o, d) = scene.camera.generate_ray(film_pos, aspect, lens);
                         let l = radiance(scene, &s.path, o, d, &wl, &mut rng, &mut tile_rays);
                         // A non-finite sample would poison the pixel: drop it (counted as black).
-                        out.push((i, if l.is_finite() { wl.to_xyz(&l) } else { [0.0; 3] }));
+                        out.push((
+                            i,
+                            if l.is_finite() {
+                                wl.to_xyz(&l)
+                            } else {
+                                [0.0; 3]
+                            },
+                        ));
                     }
                 }
                 rays.fetch_add(tile_rays, Ordering::Relaxed);
@@ -260,7 +268,11 @@ fn render_passes(scene: &Scene, s: &RenderSettings) -> Result<(Film, RenderStats
             converged = acc.update_active(&mut active, target, s.min_spp);
         }
         let elapsed = start.elapsed();
-        let noise = if done >= 2 { acc.noise_estimate() } else { f64::INFINITY };
+        let noise = if done >= 2 {
+            acc.noise_estimate()
+        } else {
+            f64::INFINITY
+        };
         if s.noise.is_some() {
             bar.set_position(converged as u64);
         } else {

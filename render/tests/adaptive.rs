@@ -84,7 +84,10 @@ fn adaptive_mean_equals_fixed_mean() {
     let (mf, ef) = mean_and_stderr(&fixed);
     let (ma, ea) = mean_and_stderr(&adaptive);
     let tol = 4.0 * ef.hypot(ea);
-    assert!((mf - ma).abs() <= tol, "fixed {mf} ± {ef}, adaptive {ma} ± {ea}");
+    assert!(
+        (mf - ma).abs() <= tol,
+        "fixed {mf} ± {ef}, adaptive {ma} ± {ea}"
+    );
     assert!(stats.mean_spp < 256.0 && stats.converged > 0, "{stats:?}");
 }
 

@@ -66,7 +66,11 @@ fn sphere_normals_and_mask() {
     assert!((p.depth[c] - 400.0).abs() < 1.0, "{}", p.depth[c]);
     assert!(p.normal[c][2] > 0.999, "{:?}", p.normal[c]);
     assert_eq!(p.skin[c], 1.0);
-    assert!(p.albedo[c].iter().all(|&v| v > 0.0 && v < 1.0), "{:?}", p.albedo[c]);
+    assert!(
+        p.albedo[c].iter().all(|&v| v > 0.0 && v < 1.0),
+        "{:?}",
+        p.albedo[c]
+    );
     // Corner: misses the sphere (it spans ±11.4° of the 40° field).
     assert_eq!(p.depth[0], NO_DEPTH);
     assert_eq!(p.skin[0], 0.0);
@@ -83,7 +87,10 @@ fn sphere_normals_and_mask() {
             let (o, d) = s.camera.generate_ray(ndc, 1.0, Vec2::splat(0.5));
             let want = (o + d * p.depth[i]).normalize();
             let got = Vec3::from_array(p.normal[i]);
-            assert!((got - want).length() < 0.02, "pixel ({x}, {y}): {got} vs {want}");
+            assert!(
+                (got - want).length() < 0.02,
+                "pixel ({x}, {y}): {got} vs {want}"
+            );
             hits += 1;
         }
     }
