@@ -27,6 +27,8 @@ pub struct Film {
     spp: u32,
     /// Samples dropped per pixel, for the pixels that dropped any (normally none).
     dropped: BTreeMap<usize, u32>,
+    /// Estimated variance of each pixel's mean luminance Y (zero when not estimated).
+    variance_y: Vec<f64>,
 }
 
 impl Film {
@@ -39,7 +41,37 @@ impl Film {
             sum_xyz: vec![[0.0; 3]; width * height],
             spp: 0,
             dropped: BTreeMap::new(),
+            variance_y: vec![0.0; width * height],
         }
+    }
+
+    /// A film from each pixel's mean XYZ and the variance of its mean luminance (row-major), for
+    /// renders whose pixels took different sample counts; `spp` is the largest count.
+    #[must_use]
+    pub fn from_means(
+        width: usize,
+        height: usize,
+        mean_xyz: Vec<[f64; 3]>,
+        variance_y: Vec<f64>,
+        spp: u32,
+    ) -> Self {
+        debug_assert_eq!(mean_xyz.len(), width * height);
+        debug_assert_eq!(variance_y.len(), width * height);
+        let n = f64::from(spp.max(1));
+        Self {
+            width,
+            height,
+            sum_xyz: mean_xyz.into_iter().map(|m| m.map(|v| v * n)).collect(),
+            spp,
+            variance_y,
+            dropped: BTreeMap::new(),
+        }
+    }
+
+    /// Estimated variance of pixel (x, y)'s mean luminance Y (the `variance` pass).
+    #[must_use]
+    pub fn variance(&self, x: usize, y: usize) -> f64 {
+        self.variance_y[y * self.width + x]
     }
 
     /// Width and height, pixels.

@@ -1,6 +1,7 @@
 #![doc = include_str!("../README.md")]
 
 pub mod accel;
+pub mod adaptive;
 pub mod atomic;
 pub mod bssrdf;
 pub mod builtin;
@@ -15,6 +16,8 @@ pub mod integrator;
 pub mod light;
 pub mod material;
 pub mod mesh;
+pub mod noise;
+pub mod passes;
 pub mod plot;
 pub mod renderer;
 pub mod sampling;

@@ -1,10 +1,14 @@
 //! The render loop: passes of one sample per pixel, each split into tiles rendered in parallel with
 //! rayon, until the sample count or the time limit is reached (stopping at the last finished pass).
+//! With a noise target, each pass samples only the pixels whose estimated noise is still above it
+//! (see [`crate::adaptive`]); the decision is taken between passes from the film alone, so it
+//! does not depend on the thread count either.
 //!
 //! Every pixel sample has its own RNG seeded from (seed, pixel, sample index), and passes are added
 //! to the film in order, so the image for a given seed and sample count does not depend on the
 //! number of threads or on the tile schedule.
 
+use crate::adaptive::{Accumulator, MIN_SPP};
 use crate::error::RenderError;
 use crate::film::Film;
 use crate::integrator::{PathSettings, radiance};
@@ -37,8 +41,13 @@ pub struct RenderOptions {
     pub width: usize,
     /// Image height, pixels, in [1, [`MAX_SIDE`]].
     pub height: usize,
-    /// Samples (paths) per pixel, ≥ 1.
+    /// Samples (paths) per pixel, ≥ 1; with a noise target, the most any pixel takes.
     pub spp: u32,
+    /// Per-pixel relative noise target in (0, 1) (0.02 = 2%): a pixel stops once its estimated
+    /// noise is below it (None = every pixel takes `spp` samples).
+    pub noise: Option<f64>,
+    /// Fewest samples a pixel takes before the noise target may stop it, ≥ 2.
+    pub min_spp: u32,
     /// Wall-clock budget: no pass is started that would end past it (None = no limit; at least
     /// one pass is always rendered).
     pub time_limit: Option<Duration>,
@@ -58,6 +67,8 @@ impl Default for RenderOptions {
             width: 512,
             height: 512,
             spp: 64,
+            noise: None,
+            min_spp: MIN_SPP,
             time_limit: None,
             seed: 1,
             threads: None,
@@ -92,6 +103,14 @@ impl RenderOptions {
         if self.spp == 0 {
             return Err(bad("spp", "0".into(), "[1, 2^32)"));
         }
+        if let Some(n) = self.noise
+            && !(n > 0.0 && n < 1.0)
+        {
+            return Err(bad("noise", n.to_string(), "(0, 1) relative"));
+        }
+        if self.min_spp < 2 {
+            return Err(bad("min_spp", self.min_spp.to_string(), "[2, 2^32)"));
+        }
         if let Some(t) = self.threads
             && !(1..=MAX_THREADS).contains(&t)
         {
@@ -123,8 +142,14 @@ impl std::ops::Deref for RenderSettings {
 /// How the render went.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RenderStats {
-    /// Samples per pixel actually rendered.
+    /// Most samples any pixel took.
     pub spp: u32,
+    /// Mean samples per pixel.
+    pub mean_spp: f64,
+    /// Estimated RMS relative noise over the lit pixels (the two-seed metric, predicted).
+    pub noise: f64,
+    /// Pixels stopped by the noise target.
+    pub converged: usize,
     /// Wall-clock time of the passes.
     pub elapsed: Duration,
     /// Rays traced (closest-hit and shadow).
@@ -138,15 +163,15 @@ impl RenderStats {
         self.rays as f64 / self.elapsed.as_secs_f64().max(1e-9)
     }
 
-    /// Seconds per sample per pixel (wall-clock time of one full-image pass).
+    /// Seconds per mean sample per pixel (wall-clock time of one full-image pass).
     #[must_use]
     pub fn seconds_per_spp(&self) -> f64 {
-        self.elapsed.as_secs_f64() / f64::from(self.spp.max(1))
+        self.elapsed.as_secs_f64() / self.mean_spp.max(1e-9)
     }
 }
 
-/// A tile's top-left pixel and its pixels' XYZ, row by row.
-type TileResult = ((usize, usize), Vec<[f32; 3]>);
+/// A tile's sampled pixels (row-major index) and their XYZ.
+type TileResult = Vec<(usize, [f32; 3])>;
 
 /// Seed of pixel `pixel`'s sample `sample`: a SplitMix64-style mix, decorrelated per sample.
 fn sample_seed(seed: u64, pixel: u64, sample: u32) -> u64 {
@@ -174,18 +199,18 @@ pub fn render(
 
 fn render_passes(scene: &Scene, s: &RenderSettings) -> Result<(Film, RenderStats), RenderError> {
     let (w, h) = (s.width, s.height);
-    let mut film = Film::new(w, h);
+    let mut acc = Accumulator::new(w, h);
+    let mut active = vec![true; w * h];
+    let mut converged = 0usize;
     let tiles: Vec<(usize, usize)> = (0..h.div_ceil(TILE))
         .flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| (tx * TILE, ty * TILE)))
         .collect();
     let bar = if s.progress {
-        let b = ProgressBar::new(u64::from(s.spp) * (w * h) as u64);
+        let b = ProgressBar::new((w * h) as u64);
         b.set_style(
-            ProgressStyle::with_template(
-                "{elapsed_precise} [{bar:30}] {percent:>3}% {msg} ETA {eta}",
-            )
-            .unwrap_or_else(|_| ProgressStyle::default_bar())
-            .progress_chars("=> "),
+            ProgressStyle::with_template("{elapsed_precise} [{bar:30}] {percent:>3}% {msg}")
+                .unwrap_or_else(|_| ProgressStyle::default_bar())
+                .progress_chars("=> "),
         );
         b
     } else {
@@ -194,7 +219,6 @@ fn render_passes(scene: &Scene, s: &RenderSettings) -> Result<(Film, RenderStats
     let rays = AtomicU64::new(0);
     let start = Instant::now();
     let aspect = w as f32 / h as f32;
-    let mut pass = vec![[0.0f32; 3]; w * h];
     let mut last = Duration::ZERO;
     for sample in 0..s.spp {
         let results: Vec<TileResult> = tiles
@@ -204,9 +228,13 @@ fn render_passes(scene: &Scene, s: &RenderSettings) -> Result<(Film, RenderStats
                 let mut out = Vec::with_capacity(TILE * TILE);
                 for y in y0..(y0 + TILE).min(h) {
                     for x in x0..(x0 + TILE).min(w) {
-                        let pixel = (y * w + x) as u64;
-                        let mut rng =
-                            Xoshiro256PlusPlus::seed_from_u64(sample_seed(s.seed, pixel, sample));
+                        let i = y * w + x;
+                        if !active[i] {
+                            continue;
+                        }
+                        let mut rng = Xoshiro256PlusPlus::seed_from_u64(sample_seed(
+                            s.seed, i as u64, sample,
+                        ));
                         let wl = SampledWavelengths::sample_visible(rng.random());
                         let film_pos = Vec2::new(
                             (x as f32 + rng.random::<f32>()) / w as f32,
@@ -216,46 +244,69 @@ fn render_passes(scene: &Scene, s: &RenderSettings) -> Result<(Film, RenderStats
                         let (o, d) = scene.camera.generate_ray(film_pos, aspect, lens);
                         let l = radiance(scene, &s.path, o, d, &wl, &mut rng, &mut tile_rays);
                         // A non-finite sample would poison the pixel: drop it (counted as black).
-                        out.push(if l.is_finite() {
-                            wl.to_xyz(&l)
-                        } else {
-                            [0.0; 3]
-                        });
+                        out.push((
+                            i,
+                            if l.is_finite() {
+                                wl.to_xyz(&l)
+                            } else {
+                                [0.0; 3]
+                            },
+                        ));
                     }
                 }
                 rays.fetch_add(tile_rays, Ordering::Relaxed);
-                bar.inc(out.len() as u64);
-                ((x0, y0), out)
+                out
             })
             .collect();
-        for ((x0, y0), out) in results {
-            let tw = (x0 + TILE).min(w) - x0;
-            for (i, v) in out.into_iter().enumerate() {
-                pass[(y0 + i / tw) * w + x0 + i % tw] = v;
-            }
+        for (i, v) in results.into_iter().flatten() {
+            acc.add(i, v);
         }
-        film.add_pass(&pass);
+        let done = sample + 1;
+        if let Some(target) = s.noise
+            && done >= s.min_spp
+        {
+            converged = acc.update_active(&mut active, target, s.min_spp);
+        }
         let elapsed = start.elapsed();
+        let noise = if done >= 2 {
+            acc.noise_estimate()
+        } else {
+            f64::INFINITY
+        };
+        if s.noise.is_some() {
+            bar.set_position(converged as u64);
+        } else {
+            bar.set_position((w * h) as u64 * u64::from(done) / u64::from(s.spp));
+        }
         bar.set_message(format!(
-            "{}/{} spp, {:.2} Mrays/s",
-            sample + 1,
+            "{done}/{} spp, noise {:.2}%, {converged}/{} px converged, {:.2} Mrays/s",
             s.spp,
+            100.0 * noise,
+            w * h,
             rays.load(Ordering::Relaxed) as f64 / elapsed.as_secs_f64().max(1e-9) / 1e6
         ));
-        // Stop when the next pass would end past the limit (passes take about equally long).
+        if converged == w * h {
+            break;
+        }
+        // Stop when the next pass would end past the limit (passes shrink as pixels converge, so
+        // the last one is a safe guess).
         let pass_time = elapsed.checked_sub(last).unwrap_or_default();
         last = elapsed;
         if let Some(limit) = s.time_limit
             && elapsed + pass_time > limit
-            && sample + 1 < s.spp
+            && done < s.spp
         {
-            bar.println(format!("time limit reached after {} spp", sample + 1));
+            bar.println(format!("time limit reached after {done} passes"));
             break;
         }
     }
     bar.finish_and_clear();
+    let film = acc.to_film();
     let stats = RenderStats {
         spp: film.spp(),
+        mean_spp: acc.mean_spp(),
+        noise: acc.noise_estimate(),
+        converged,
         elapsed: start.elapsed(),
         rays: rays.load(Ordering::Relaxed),
     };

@@ -1,5 +1,5 @@
 //! `skin render`: load a scene (the built-in three-head scene by default), path trace it, and write
-//! OUT/render.exr (linear sRGB, f32) and OUT/render.png (sRGB, exposure + filmic tone curve).
+//! OUT/render.exr (linear sRGB, f32, with the passes of `render::passes`) and OUT/render.png (sRGB, exposure + filmic tone curve).
 
 use crate::renderer::{RenderOptions, SettingError, render};
 use crate::scene::{Scene, SceneOptions};
@@ -16,14 +16,19 @@ pub struct RenderArgs {
     /// Output folder for render.exr and render.png.
     #[arg(long, value_name = "DIR", default_value = "out")]
     pub out: PathBuf,
-    /// Samples (paths) per pixel.
-    #[arg(long, value_name = "N", default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..))]
+    /// Samples (paths) per pixel: the most any pixel takes (all take it with --noise 0).
+    #[arg(long, value_name = "N", default_value_t = 4096, value_parser = clap::value_parser!(u32).range(1..))]
     pub spp: u32,
+    /// Per-pixel relative noise target (0.02 = 2%, relative to the pixel's luminance, or to 15%
+    /// of the 95th percentile in the dark): a pixel stops sampling once its noise estimated from
+    /// its own samples is below it. 0 = off: every pixel takes --spp samples.
+    #[arg(long, value_name = "REL", default_value_t = 0.02)]
+    pub noise: f64,
     /// Image width, pixels.
-    #[arg(long, value_name = "W", default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    #[arg(long, value_name = "W", default_value_t = 768, value_parser = clap::value_parser!(u32).range(1..=16384))]
     pub width: u32,
     /// Image height, pixels.
-    #[arg(long, value_name = "H", default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    #[arg(long, value_name = "H", default_value_t = 384, value_parser = clap::value_parser!(u32).range(1..=16384))]
     pub height: u32,
     /// Wall-clock budget in seconds: no pass starts that would end past it (0 = no limit).
     #[arg(long, value_name = "SECONDS", default_value_t = 60.0)]
@@ -71,6 +76,9 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     if !(args.time_limit.is_finite() && args.time_limit >= 0.0) {
         anyhow::bail!("--time-limit = {} outside [0, ∞) seconds", args.time_limit);
     }
+    if !(args.noise.is_finite() && (0.0..1.0).contains(&args.noise)) {
+        anyhow::bail!("--noise = {} outside [0, 1) (0 = off)", args.noise);
+    }
     if !args.exposure.is_finite() {
         anyhow::bail!(
             "--exposure = {} is not a finite number of stops",
@@ -82,6 +90,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         width: args.width as usize,
         height: args.height as usize,
         spp: args.spp,
+        noise: (args.noise > 0.0).then_some(args.noise),
         time_limit: (args.time_limit > 0.0).then(|| Duration::from_secs_f64(args.time_limit)),
         seed: args.seed,
         threads: args.threads.map(|t| t as usize),
@@ -90,6 +99,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
             ..Default::default()
         },
         progress: !args.quiet,
+        ..Default::default()
     }
     .validate()
     .map_err(flag_error)?;
@@ -114,17 +124,26 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     let (film, stats) = render(&scene, &settings)?;
     let exr = args.out.join("render.exr");
     let png = args.out.join("render.png");
-    film.write_exr(&exr)?;
+    let passes = crate::passes::Passes::first_hit(&scene, settings.width, settings.height);
+    passes.write_exr(&film, &exr)?;
     film.write_png(&png, scene.exposure_stops + args.exposure)?;
     println!(
-        "rendered {}×{} at {} spp in {:.1} s ({} threads): {:.2} M rays/s, {:.3} s per sample per pixel",
+        "rendered {}×{} at {:.1} spp (mean; at most {}) in {:.1} s ({} threads): {:.2} M rays/s, {:.3} s per sample per pixel",
         settings.width,
         settings.height,
+        stats.mean_spp,
         stats.spp,
         stats.elapsed.as_secs_f64(),
         rayon_threads(settings.threads),
         stats.rays_per_second() / 1e6,
         stats.seconds_per_spp()
+    );
+    println!(
+        "estimated noise {:.2}% over the lit pixels; {} of {} pixels reached the target; skin covers {:.1}% of the frame",
+        100.0 * stats.noise,
+        stats.converged,
+        settings.width * settings.height,
+        100.0 * passes.skin.iter().sum::<f32>() / passes.skin.len().max(1) as f32
     );
     println!(
         "total {:.1} s; wrote {} and {}",
@@ -141,6 +160,7 @@ fn flag_error(e: SettingError) -> anyhow::Error {
         "width" => "--width",
         "height" => "--height",
         "spp" => "--spp",
+        "noise" => "--noise",
         "threads" => "--threads",
         "path.max_depth" => "--max-depth",
         other => other,

@@ -33,6 +33,17 @@ enum Command {
     Mc(McArgs),
     /// Only the exact-versus-multipole study (totals over C_m, light/dark profiles) into --out.
     Exact(ExactArgs),
+    /// Per-pixel relative luminance noise of one render, from two renders with different seeds:
+    /// sqrt(mean((L₁ − L₂)² / (2 L̄²))) over pixels with L̄ ≥ 15% of the 95th percentile.
+    Noise(NoiseArgs),
+}
+
+#[derive(Args, Debug)]
+struct NoiseArgs {
+    /// First render (RGB OpenEXR).
+    a: PathBuf,
+    /// Second render of the same scene with another seed (RGB OpenEXR).
+    b: PathBuf,
 }
 
 #[derive(Args, Debug)]
@@ -126,6 +137,7 @@ fn main() {
     let result = match &cli.command {
         Some(Command::Mc(args)) => run_mc(args),
         Some(Command::Exact(args)) => validation::compare::run_exact(args.quick, &args.out),
+        Some(Command::Noise(args)) => run_noise(args),
         None => validation::compare::run_comparison(cli.quick, &cli.out),
     };
     if let Err(e) = result {
@@ -179,6 +191,19 @@ fn run_mc(args: &McArgs) -> anyhow::Result<()> {
     if let Some(path) = &args.profile {
         write_profile(path, &result)?;
     }
+    Ok(())
+}
+
+fn run_noise(args: &NoiseArgs) -> anyhow::Result<()> {
+    let r = render::noise::compare_exr(&args.a, &args.b)?;
+    println!(
+        "relative noise {:.4} ({:.2}%) over {} of {} pixels (lit: luminance ≥ {:.4e})",
+        r.relative_noise,
+        100.0 * r.relative_noise,
+        r.lit_pixels,
+        r.pixels,
+        r.threshold
+    );
     Ok(())
 }
 
