@@ -76,6 +76,10 @@ fn check_slab(preset: &str, wi: Vec3, wo: Vec3, spp: u32, rel: f64) {
     let film = run(&slab(preset, wi, wo * 500.0), 32, 32, spp, SEED);
     let want = slab_closed_form(preset, wi, wo);
     let got = mean_xyz(&film);
+    eprintln!(
+        "{preset}, ωi {wi}, ωo {wo}: rendered / closed form − 1 = {:?}",
+        [0, 1, 2].map(|c| got[c] / want[c] - 1.0)
+    );
     for c in 0..3 {
         assert!(
             (got[c] - want[c]).abs() <= rel * want[c],
@@ -140,6 +144,7 @@ fn skin_sphere_in_a_white_furnace_never_exceeds_the_environment() {
         let y = xyz_of(|_| 1.0)[1];
         let env = xyz_of(|_| 1.0 / y);
         let got = mean_xyz(&film);
+        eprintln!("radius {radius}: mean {got:?}, environment {env:?}");
         for c in 0..3 {
             assert!(
                 got[c] <= env[c] * 1.01,
@@ -162,6 +167,7 @@ fn skin_sphere_in_a_white_furnace_never_exceeds_the_environment() {
                 .unwrap()
                     / y
             });
+            eprintln!("R_tot floor {floor:?}");
             for c in 0..3 {
                 assert!(
                     got[c] >= floor[c] * 0.99,
