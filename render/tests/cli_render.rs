@@ -105,7 +105,7 @@ fn unknown_method_is_a_usage_error() {
 }
 
 /// Mean linear RGB of an EXR written by the renderer, after checking its size and that every
-/// pixel is finite and non-negative.
+/// pixel is finite (a single noisy sample may leave the sRGB gamut, so a channel may dip below 0).
 fn exr_mean(path: &Path, w: usize, h: usize) -> [f64; 3] {
     let img = exr::prelude::read_first_rgba_layer_from_file(
         path,
@@ -120,7 +120,7 @@ fn exr_mean(path: &Path, w: usize, h: usize) -> [f64; 3] {
     let mut sum = [0.0f64; 3];
     for p in px {
         for c in 0..3 {
-            assert!(p[c].is_finite() && p[c] >= 0.0, "pixel {p:?}");
+            assert!(p[c].is_finite(), "pixel {p:?}");
             sum[c] += f64::from(p[c]);
         }
     }

@@ -198,7 +198,11 @@ fn time_limit_stops_after_whole_passes() {
         ..limited
     };
     let (reference, _) = render(&s, &fixed.validate().unwrap()).unwrap();
-    assert!(film == reference, "{} spp: limited image differs", stats.spp);
+    assert!(
+        film == reference,
+        "{} spp: limited image differs",
+        stats.spp
+    );
 }
 
 /// The default scene renders at 64×48, 2 spp: finite, not all alike.
