@@ -48,8 +48,15 @@ fn defaults_match_the_library_quadrature() {
         // 6 printed decimals; the CLI's 96-node rule is within 1.1e-5 of the reference.
         assert!((a - expected).abs() < 2e-5, "{t}°: {a} vs {expected}");
     }
-    // At normal incidence a rough lobe still reflects ≈ ρ_s F(0) = 0.25 × 0.02778.
-    assert!((rows[0].1 - 0.25 * 0.027_834).abs() < 2e-6, "{}", rows[0].1);
+    // At normal incidence a rough lobe reflects ≈ ρ_s F(0), F(0) = ((1.4 − 1)/(1.4 + 1))² = 0.027 778:
+    // the microfacets tilt by ~atan(m) = 17° at m = 0.3, where F is 0.4% above F(0), and masking
+    // removes a little, so the albedo sits within 1% of ρ_s F(0) (measured +0.2%).
+    let fresnel_0 = (0.4f64 / 2.4).powi(2);
+    assert!(
+        (rows[0].1 - 0.25 * fresnel_0).abs() < 0.01 * 0.25 * fresnel_0,
+        "{}",
+        rows[0].1
+    );
 }
 
 #[test]

@@ -7,70 +7,106 @@ use render::bssrdf::{Directional, EnergySplit};
 mod common;
 
 use common::{mean_xyz, run, scene, xyz_of};
+use glam::Vec3;
 use skin_optics::color::d65;
 use skin_optics::{Preset, SkinParams, Wavelength};
 
 /// Seed of every render in this file.
 const SEED: u64 = 7;
 
-/// A 2 m wide slab of skin under a distant D65 light of irradiance E (luminance 1) at normal
-/// incidence, seen head-on, has radiance E(λ) [f_s(n, n) + T(0°) R_tot(λ) T(0°) / (π c)]
-/// (separable BSSRDF with the specular-lobe split, `render::bssrdf::separable`): within 2% per
-/// XYZ channel, for the light and the dark presets.
+/// A 2 m wide slab of skin of `preset` at z = 0 under a distant D65 light of irradiance 1 (luminance)
+/// from the unit direction `to_light`, seen from `camera` (mm) with a 2° field of view.
+fn slab(preset: &str, to_light: Vec3, camera: Vec3) -> render::scene::Scene {
+    scene(&format!(
+        r#"
+        [camera]
+        position_mm = [{}, {}, {}]
+        look_at_mm = [0, 0, 0]
+        fov_deg = 2
+        [materials.skin]
+        type = "skin"
+        preset = "{preset}"
+        [[meshes]]
+        shape = "quad"
+        material = "skin"
+        scale = 1000
+        [[lights]]
+        type = "distant"
+        direction = [{}, {}, {}]
+        spectrum = "d65"
+        intensity = 1
+        "#,
+        camera.x, camera.y, camera.z, to_light.x, to_light.y, to_light.z
+    ))
+}
+
+/// The closed-form XYZ of that slab seen from `wo` and lit from `wi` (unit vectors, z the normal):
+/// E(λ) cos θ_i [f_s(ω_o, ω_i) + T(θ_i) T(θ_o) R_tot(λ) / (π c)] (separable BSSRDF with the
+/// specular-lobe split, `render::bssrdf::separable`; R_tot from `multipole::skin` with the default
+/// method, as the scene's tables use).
+fn slab_closed_form(preset: &str, wi: Vec3, wo: Vec3) -> [f64; 3] {
+    let skin = SkinParams::preset(preset.parse::<Preset>().unwrap());
+    let ts = brdf::TorranceSparrow::new(
+        brdf::DEFAULT_ROUGHNESS,
+        skin.oiliness() as f32,
+        skin.eta() as f32,
+    )
+    .unwrap();
+    let dir = Directional::new(ts.clone(), EnergySplit::default());
+    let cos_i = f64::from(wi.z);
+    let specular = f64::from(ts.eval(wo, wi));
+    let split = f64::from(
+        dir.transmittance(wi.z) * dir.transmittance(wo.z)
+            / (std::f32::consts::PI * dir.normalisation()),
+    );
+    let d65_y = xyz_of(d65)[1];
+    xyz_of(|nm| {
+        let rd = multipole::skin::total_reflectance(
+            &skin,
+            Wavelength::new(nm).unwrap(),
+            multipole::Method::default(),
+        )
+        .unwrap();
+        d65(nm) / d65_y * cos_i * (specular + split * rd)
+    })
+}
+
+/// Render the slab at 32×32 and compare its mean XYZ with the closed form within `rel` per channel.
+fn check_slab(preset: &str, wi: Vec3, wo: Vec3, spp: u32, rel: f64) {
+    let film = run(&slab(preset, wi, wo * 500.0), 32, 32, spp, SEED);
+    let want = slab_closed_form(preset, wi, wo);
+    let got = mean_xyz(&film);
+    for c in 0..3 {
+        assert!(
+            (got[c] - want[c]).abs() <= rel * want[c],
+            "{preset}, ωi {wi}, ωo {wo}: channel {c}: {got:?} vs {want:?}"
+        );
+    }
+}
+
+/// At normal incidence, seen head-on, the slab renders to the closed form within 2% per XYZ channel,
+/// for the light and the dark presets. Measured (1,024 pixels × 48 paths, seed 7): dark within 0.3%;
+/// 2% is the Monte Carlo noise of this mean plus the f32 tables' 5-nm interpolation of R_tot, with
+/// headroom over the worst deviation measured in the oblique case below (0.8%).
 #[test]
 fn flat_slab_renders_to_the_total_diffuse_reflectance_plus_specular() {
     for preset in ["light", "dark"] {
-        let s = scene(&format!(
-            r#"
-            [camera]
-            position_mm = [0, 0, 500]
-            look_at_mm = [0, 0, 0]
-            fov_deg = 2
-            [materials.skin]
-            type = "skin"
-            preset = "{preset}"
-            [[meshes]]
-            shape = "quad"
-            material = "skin"
-            scale = 1000
-            [[lights]]
-            type = "distant"
-            direction = [0, 0, 1]
-            spectrum = "d65"
-            intensity = 1
-            "#
-        ));
-        let film = run(&s, 32, 32, 48, SEED);
-        let skin = SkinParams::preset(preset.parse::<Preset>().unwrap());
-        let ts = brdf::TorranceSparrow::new(
-            brdf::DEFAULT_ROUGHNESS,
-            skin.oiliness() as f32,
-            skin.eta() as f32,
-        )
-        .unwrap();
-        let dir = Directional::new(ts.clone(), EnergySplit::default());
-        let n = glam::Vec3::Z;
-        let specular = f64::from(ts.eval(n, n));
-        let split = f64::from(
-            dir.transmittance(1.0).powi(2) / (std::f32::consts::PI * dir.normalisation()),
-        );
-        let d65_y = xyz_of(d65)[1];
-        let want = xyz_of(|nm| {
-            let rd = multipole::skin::total_reflectance(
-                &skin,
-                Wavelength::new(nm).unwrap(),
-                multipole::Method::default(),
-            )
-            .unwrap();
-            d65(nm) / d65_y * (specular + split * rd)
-        });
-        let got = mean_xyz(&film);
-        for c in 0..3 {
-            assert!(
-                (got[c] - want[c]).abs() <= 0.02 * want[c],
-                "{preset}: channel {c}: {got:?} vs {want:?}"
-            );
-        }
+        check_slab(preset, Vec3::Z, Vec3::Z, 48, 0.02);
+    }
+}
+
+/// Oblique incidence (45°) and oblique view (30°), the light and camera in perpendicular planes so the
+/// sign convention of the light's direction cannot matter: the slab still renders to
+/// E cos θ_i [f_s + T(θ_i) T(θ_o) R_tot / (π c)] within 2% per channel, two-sided, so a loss or a gain
+/// of subsurface energy away from normal incidence fails. Measured: light within 0.5%, dark within
+/// 0.8% (X); tolerance as above.
+#[test]
+fn flat_slab_at_oblique_incidence_and_view_matches_the_closed_form() {
+    let s = std::f32::consts::FRAC_1_SQRT_2;
+    let wi = Vec3::new(s, 0.0, s);
+    let wo = Vec3::new(0.0, 0.5, 0.75f32.sqrt());
+    for preset in ["light", "dark"] {
+        check_slab(preset, wi, wo, 48, 0.02);
     }
 }
 
@@ -111,6 +147,32 @@ fn skin_sphere_in_a_white_furnace_never_exceeds_the_environment() {
                 got[c] <= env[c] * 1.01,
                 "radius {radius}: channel {c}: {got:?} vs environment {env:?}"
             );
+        }
+        if radius > 50.0 {
+            // Far larger than the profiles' reach, each point of the sphere reflects the uniform
+            // environment like a flat slab: ρ_dr(θ_o) + T(θ_o) R_tot = R_tot + ρ_dr (1 − R_tot) ≥ R_tot.
+            // Measured: the render falls 1.0% (Y) to 1.7% (Z) below R_tot alone, i.e. about 3% short
+            // of the flat-slab value: the curved surface loses energy the flat slab does not (probe
+            // rays that miss it, most in the red where the profiles reach furthest). The floor is
+            // R_tot − 3%, so that known deficit passes and any larger loss fails.
+            let light = SkinParams::preset(Preset::Light);
+            let bloodless =
+                SkinParams::new(0.0, light.eumelanin_blend(), 0.0, light.oiliness()).unwrap();
+            let floor = xyz_of(|nm| {
+                multipole::skin::total_reflectance(
+                    &bloodless,
+                    Wavelength::new(nm).unwrap(),
+                    multipole::Method::default(),
+                )
+                .unwrap()
+                    / y
+            });
+            for c in 0..3 {
+                assert!(
+                    got[c] >= floor[c] * 0.97,
+                    "channel {c}: {got:?} below the R_tot floor {floor:?}"
+                );
+            }
         }
         let (w, h) = film.size();
         for py in 0..h {

@@ -5,7 +5,7 @@
 mod common;
 
 use common::{assert_close, mean_xyz, run, scene, xyz_of};
-use render::renderer::{RenderOptions, render};
+use render::renderer::{RenderOptions, TILE, render};
 use render::scene::{Scene, SceneOptions};
 
 /// Seed of every render in this file.
@@ -113,7 +113,9 @@ fn d65_white_plane_is_srgb_white() {
     assert!((mean - expect).abs() <= 2.0, "png {mean} vs {expect}");
 }
 
-/// The same seed gives the same image on one thread and on two.
+/// The same seed gives the same image on 1, 2 and 4 threads, with 5 × 3 = 15 tiles of 16 px, more
+/// tiles than threads, so the tile schedule differs between runs: bit for bit, since every pixel
+/// sample has its own seeded stream and the film adds passes in pixel order.
 #[test]
 fn image_does_not_depend_on_thread_count() {
     let s = scene(
@@ -140,16 +142,67 @@ fn image_does_not_depend_on_thread_count() {
         "#,
     );
     let mut settings = RenderOptions {
-        width: 24,
-        height: 16,
+        width: 72,
+        height: 40,
         spp: 3,
         threads: Some(1),
         ..Default::default()
     };
-    let a = render(&s, &settings.clone().validate().unwrap()).unwrap().0;
-    settings.threads = Some(2);
-    let b = render(&s, &settings.clone().validate().unwrap()).unwrap().0;
-    assert_eq!(a, b);
+    let one = render(&s, &settings.clone().validate().unwrap()).unwrap().0;
+    assert!(72usize.div_ceil(TILE) * 40usize.div_ceil(TILE) > 4);
+    for threads in [2, 4] {
+        settings.threads = Some(threads);
+        let many = render(&s, &settings.clone().validate().unwrap()).unwrap().0;
+        assert!(one == many, "{threads} threads differ from one");
+    }
+}
+
+/// The time-limited path (the CLI's default) stops after whole passes: with a 0.3 s budget and a
+/// million passes requested it stops early, reports the passes it made, and its image is bit for bit
+/// the fixed-count render of that many passes with the same seed, i.e. the same unbiased estimator
+/// the closed-form tests above check, never a partly added pass.
+#[test]
+fn time_limit_stops_after_whole_passes() {
+    let s = scene(
+        r#"
+        [camera]
+        position_mm = [0, 0, 300]
+        look_at_mm = [0, 0, 0]
+        fov_deg = 20
+        [environment]
+        spectrum = "constant"
+        intensity = 1
+        [materials.white]
+        type = "diffuse"
+        albedo = 1
+        [[meshes]]
+        shape = "sphere"
+        material = "white"
+        scale = 100
+        "#,
+    );
+    let limited = RenderOptions {
+        width: 16,
+        height: 16,
+        spp: 1_000_000,
+        time_limit: Some(std::time::Duration::from_millis(300)),
+        seed: SEED,
+        ..Default::default()
+    };
+    let (film, stats) = render(&s, &limited.clone().validate().unwrap()).unwrap();
+    assert!(stats.spp >= 1 && stats.spp < 1_000_000, "{} spp", stats.spp);
+    assert_eq!(film.spp(), stats.spp);
+    let fixed = RenderOptions {
+        spp: stats.spp,
+        time_limit: None,
+        ..limited
+    };
+    let (reference, _) = render(&s, &fixed.validate().unwrap()).unwrap();
+    assert!(
+        film == reference,
+        "{} spp: limited image differs",
+        stats.spp
+    );
 }
 
 /// The default scene renders at 64×48, 2 spp: finite, not all alike.

@@ -148,24 +148,13 @@ mod tests {
         }
     }
 
-    /// c for the Fresnel split is docs/physics.md §8's ≈ 0.923 at η = 1.4 (0.919 with the exact moment).
+    /// c for the Fresnel split at η = 1.4 is 1 − 2·m1 with the exact first moment m1 = 0.038 405 77
+    /// (400-point Gauss–Legendre, see `brdf::fresnel`'s tests): c = 0.923 188 5. pbrt-v3's polynomial
+    /// fit gives 0.923 206. The value is stored as f32 (ulp 6e-8), so 1e-6.
     #[test]
-    fn fresnel_normalisation_matches_physics_md() {
+    fn fresnel_normalisation_is_one_minus_twice_the_first_moment() {
         let c = Directional::new(lobe(), EnergySplit::Fresnel).normalisation();
-        assert!((c - 0.92).abs() < 0.01, "c = {c}");
-    }
-
-    /// Surface plus subsurface never reflect more than arrives: ρ_dr(θ) + T(θ) ≤ 1 at every angle
-    /// for the lobe split (equality by construction), even with a white body (R_tot = 1).
-    #[test]
-    fn lobe_split_conserves_energy() {
-        let ts = TorranceSparrow::new(0.3, 0.8, 1.4).unwrap();
-        let d = Directional::new(ts.clone(), EnergySplit::SpecularLobe);
-        for i in 1..=50 {
-            let mu = i as f32 / 50.0;
-            let sum = ts.directional_albedo(mu) + d.transmittance(mu);
-            assert!(sum <= 1.0 + 1e-6 && sum > 1.0 - 1e-5, "μ {mu}: {sum}");
-        }
+        assert!((f64::from(c) - 0.923_188_5).abs() < 1e-6, "c = {c}");
     }
 
     #[test]

@@ -281,7 +281,6 @@ impl ProfileTable {
 mod tests {
     use super::*;
     use skin_optics::Preset;
-    use std::time::Instant;
 
     fn light_table() -> ProfileTable {
         ProfileTable::build(
@@ -358,30 +357,6 @@ mod tests {
                 );
             }
         }
-    }
-
-    /// Table building time for the default scene's three presets (reported, not asserted).
-    #[test]
-    fn build_time_for_three_presets() {
-        let start = Instant::now();
-        for p in [Preset::Light, Preset::Medium, Preset::Dark] {
-            let t = ProfileTable::build(
-                &SkinParams::preset(p),
-                Method::default(),
-                &TableOptions::default(),
-            )
-            .unwrap();
-            eprintln!(
-                "{p:?}: r_max(450 nm) = {:.2} mm, r_max(650 nm) = {:.2} mm, R_tot(650) = {:.3}",
-                t.r_max_mm(450.0),
-                t.r_max_mm(650.0),
-                t.total(650.0)
-            );
-        }
-        eprintln!(
-            "three presets' profile tables: {:.3} s",
-            start.elapsed().as_secs_f64()
-        );
     }
 
     #[test]

@@ -1,8 +1,10 @@
 //! Agreement with independent exact-transport totals ([XT]: other Monte Carlo and adding-doubling
 //! runs of the same model; index 1.4, g = 0.9, σs = σs'/(1 − g)).
 //!
-//! Tolerance: 4 standard errors of this run plus the reference's stated ±0.0008 (the skin rows) or
-//! its last printed digit (the half-space rows), so a 1% bias at these photon counts fails.
+//! Tolerance: 4 standard errors of this run (a false-failure rate of 6e-5 per row for Gaussian batch
+//! means) plus the reference's stated ±0.0008 (the skin rows) or its last printed digit (the
+//! half-space rows). At these photon counts that is 1.1–3.4% of R_d in release builds (3.5–11% in
+//! debug builds, which trace a tenth of the photons): a bias fails when it exceeds that, not below.
 
 use super::photons;
 use skin_optics::{Preset, SkinParams, Wavelength};

@@ -8,10 +8,11 @@ use skin_optics::{SkinParams, Wavelength};
 use validation::montecarlo::{Layer, LayeredMedium, McOptions, run};
 
 #[test]
-fn high_albedo_half_space_matches_the_dipole_within_5_percent() {
-    // Reduced albedo 0.99 (σa 0.01, σs' 0.99 mm⁻¹), η 1.4, g 0.9: diffusion's home ground. Within 5%:
-    // the dipole's own bias here is about 1% ([XT]: 0.6040 exact against 0.597 for the dipole at
-    // σs' = 1) and the Monte Carlo's noise at 20,000 photons well under 1%.
+fn high_albedo_half_space_matches_the_dipole() {
+    // Reduced albedo 0.99 (σa 0.01, σs' 0.99 mm⁻¹), η 1.4, g 0.9: diffusion's home ground. The
+    // dipole's own bias here is about 1.2% ([XT]: 0.6040 exact against 0.597 for the dipole at
+    // σs' = 1), so the bound is 1.5% for the model plus 4 standard errors of this run (20,000
+    // photons in release, a tenth in debug builds).
     let (sigma_a, sigma_s_prime, eta) = (0.01, 0.99, 1.4);
     let dipole = Dipole::new(Medium::new(sigma_a, sigma_s_prime).unwrap(), eta).unwrap();
     let expected = observable_reflectance(dipole.total_reflectance(), eta);
@@ -19,9 +20,10 @@ fn high_albedo_half_space_matches_the_dipole_within_5_percent() {
     let stack = LayeredMedium::new(vec![layer], 1.0, 1.0).unwrap();
     let r = run(&stack, &McOptions::new(photons(20_000), 10, 99).unwrap());
     let rel = (r.diffuse_reflectance.mean - expected) / expected;
+    let tol = 0.015 + 4.0 * r.diffuse_reflectance.stderr / expected;
     assert!(
-        rel.abs() < 0.05,
-        "MC {:?} vs dipole {expected}: {rel:+.4}",
+        rel.abs() < tol,
+        "MC {:?} vs dipole {expected}: {rel:+.4} (tolerance {tol:.4})",
         r.diffuse_reflectance
     );
 }

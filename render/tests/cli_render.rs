@@ -1,0 +1,172 @@
+//! `skin render` run as a binary: flag errors (exit code 2, one line naming the flag, nothing
+//! written), and tiny end-to-end renders with `--method multipole` and `--no-subsurface` whose
+//! outputs are a valid EXR and PNG of the requested size.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// A flat slab of skin under a distant light, seen head-on: small enough to load in well under a
+/// second with the multipole method.
+const SLAB: &str = r#"
+[camera]
+position_mm = [0, 0, 500]
+look_at_mm = [0, 0, 0]
+fov_deg = 2
+[materials.skin]
+type = "skin"
+preset = "light"
+[[meshes]]
+shape = "quad"
+material = "skin"
+scale = 1000
+[[lights]]
+type = "distant"
+direction = [0, 0, 1]
+spectrum = "d65"
+intensity = 1
+"#;
+
+/// A scratch folder holding the slab scene; `out` inside it does not exist yet.
+struct Scratch {
+    dir: tempfile::TempDir,
+}
+
+impl Scratch {
+    fn new() -> Self {
+        let dir = tempfile::tempdir().expect("temp dir");
+        std::fs::write(dir.path().join("slab.toml"), SLAB).expect("write scene");
+        Self { dir }
+    }
+
+    fn scene(&self) -> String {
+        self.dir.path().join("slab.toml").display().to_string()
+    }
+
+    fn out(&self) -> PathBuf {
+        self.dir.path().join("out")
+    }
+
+    /// `skin render` on the slab into `out` with a tiny image and `extra` flags.
+    fn render(&self, extra: &[&str]) -> Output {
+        let (scene, out) = (self.scene(), self.out().display().to_string());
+        let mut args = vec![
+            "render",
+            "--scene",
+            &scene,
+            "--out",
+            &out,
+            "--width",
+            "8",
+            "--height",
+            "8",
+            "--spp",
+            "4",
+            "--time-limit",
+            "0",
+            "--threads",
+            "1",
+            "--quiet",
+        ];
+        args.extend_from_slice(extra);
+        Command::new(env!("CARGO_BIN_EXE_skin"))
+            .args(&args)
+            .output()
+            .expect("run skin")
+    }
+}
+
+/// The bad flag fails with clap's usage exit code 2, one `error:` line naming the flag, no panic,
+/// and no output folder.
+fn assert_flag_error(extra: &[&str], flag: &str) {
+    let s = Scratch::new();
+    let out = s.render(extra);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{extra:?}: {stderr}");
+    let errors: Vec<&str> = stderr.lines().filter(|l| l.starts_with("error")).collect();
+    assert_eq!(errors.len(), 1, "{extra:?}: {stderr}");
+    assert!(errors[0].contains(flag), "{extra:?}: {}", errors[0]);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert!(!s.out().exists(), "{extra:?} wrote {}", s.out().display());
+}
+
+#[test]
+fn zero_samples_per_pixel_is_a_usage_error() {
+    assert_flag_error(&["--spp", "0"], "--spp");
+}
+
+#[test]
+fn zero_threads_is_a_usage_error() {
+    assert_flag_error(&["--threads", "0"], "--threads");
+}
+
+#[test]
+fn unknown_method_is_a_usage_error() {
+    assert_flag_error(&["--method", "bogus"], "--method");
+}
+
+/// Mean linear RGB of an EXR written by the renderer, after checking its size and that every
+/// pixel is finite (a single noisy sample may leave the sRGB gamut, so a channel may dip below 0).
+fn exr_mean(path: &Path, w: usize, h: usize) -> [f64; 3] {
+    let img = exr::prelude::read_first_rgba_layer_from_file(
+        path,
+        |_, _| Vec::new(),
+        |v: &mut Vec<[f32; 3]>, _, (r, g, b, _a): (f32, f32, f32, f32)| v.push([r, g, b]),
+    )
+    .expect("readable EXR");
+    let size = img.layer_data.size;
+    assert_eq!((size.width(), size.height()), (w, h));
+    let px = &img.layer_data.channel_data.pixels;
+    assert_eq!(px.len(), w * h);
+    let mut sum = [0.0f64; 3];
+    for p in px {
+        for c in 0..3 {
+            assert!(p[c].is_finite(), "pixel {p:?}");
+            sum[c] += f64::from(p[c]);
+        }
+    }
+    sum.map(|v| v / (w * h) as f64)
+}
+
+/// A successful render wrote a decodable 8×8 PNG and EXR and nothing else; returns the EXR's mean.
+fn assert_outputs(s: &Scratch, out: &Output) -> [f64; 3] {
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    let png = image::open(s.out().join("render.png")).expect("readable PNG");
+    assert_eq!((png.width(), png.height()), (8, 8));
+    let mut names: Vec<String> = std::fs::read_dir(s.out())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    assert_eq!(names, ["render.exr", "render.png"], "no temporaries left");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("rendered 8×8 at 4 spp"), "{stdout}");
+    exr_mean(&s.out().join("render.exr"), 8, 8)
+}
+
+/// On a flat slab under a distant light the BSSRDF and the Lambertian stand-in render the same
+/// radiance by construction of the energy split (`render::material`): both are
+/// E [f_s + T(0°)² R_tot / (π c)] with the same R_tot. With 64 pixels × 4 paths the per-channel
+/// means agree within 3% (the subsurface branch's only noise on this uniform slab is the branch
+/// choice and the probe-ray misses at the image edge; measured difference below 1%).
+#[test]
+fn multipole_render_with_and_without_subsurface_agree_on_a_slab() {
+    let with = Scratch::new();
+    let bssrdf = assert_outputs(&with, &with.render(&["--method", "multipole"]));
+    let without = Scratch::new();
+    let lambert = assert_outputs(
+        &without,
+        &without.render(&["--method", "multipole", "--no-subsurface"]),
+    );
+    eprintln!(
+        "BSSRDF / Lambertian − 1 = {:?}",
+        [0, 1, 2].map(|c| bssrdf[c] / lambert[c] - 1.0)
+    );
+    for c in 0..3 {
+        assert!(bssrdf[c] > 0.0, "{bssrdf:?}");
+        assert!(
+            (bssrdf[c] - lambert[c]).abs() <= 0.03 * lambert[c],
+            "channel {c}: BSSRDF {bssrdf:?} vs Lambertian {lambert:?}"
+        );
+    }
+}
