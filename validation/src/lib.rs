@@ -3,3 +3,5 @@
 pub mod compare;
 /// The layered Monte Carlo (owned by `multipole`, which uses it for exact profile shapes).
 pub use multipole::montecarlo;
+pub mod measured;
+pub mod measured_report;

@@ -32,6 +32,67 @@ enum Command {
     Mc(McArgs),
     /// Only the exact-versus-multipole study (totals over C_m, light/dark profiles) into --out.
     Exact(ExactArgs),
+    /// Fit the measured ISSA spectra (explore or held-out subjects) with the seed model and a
+    /// chosen one; residual bands and fitted parameters as CSV and PNG into --out.
+    Measured(MeasuredArgs),
+}
+
+#[derive(Args, Debug)]
+struct MeasuredArgs {
+    /// Which subjects: `heldout` (report these) or `explore`.
+    #[arg(long, default_value = "heldout", value_parser = ["heldout", "explore"])]
+    set: String,
+    /// Instrument geometry: `sci` (what ISSA measured) or `sce`.
+    #[arg(long, default_value = "sci", value_parser = parse_geometry)]
+    geometry: multipole::fit::Geometry,
+    /// Model compared with the seed: `seed`, `full` or `auto`.
+    #[arg(long, default_value = "auto", value_parser = parse_model)]
+    model: multipole::fit::ModelChoice,
+    /// Forward model: `exact` or `multipole`.
+    #[arg(long, default_value = "exact", value_parser = parse_method)]
+    method: multipole::Method,
+    /// Noise σ of one reflectance for the criterion, (0, 1).
+    #[arg(long, default_value_t = 0.005)]
+    noise: f64,
+    /// Fit at most this many records, spread evenly over the subset.
+    #[arg(long)]
+    limit: Option<usize>,
+    /// Output folder.
+    #[arg(long, value_name = "DIR", default_value = "out/measured")]
+    out: PathBuf,
+}
+
+fn parse_geometry(s: &str) -> Result<multipole::fit::Geometry, String> {
+    s.parse().map_err(|e: multipole::fit::FitError| e.to_string())
+}
+
+fn parse_model(s: &str) -> Result<multipole::fit::ModelChoice, String> {
+    s.parse().map_err(|e: multipole::fit::FitError| e.to_string())
+}
+
+fn parse_method(s: &str) -> Result<multipole::Method, String> {
+    s.parse().map_err(|e: multipole::MultipoleError| e.to_string())
+}
+
+fn run_measured(args: &MeasuredArgs) -> anyhow::Result<()> {
+    use validation::measured_report::Subset;
+    let subset = if args.set == "explore" {
+        Subset::Explore
+    } else {
+        Subset::Heldout
+    };
+    let opts = multipole::fit::MeasuredOptions {
+        geometry: args.geometry,
+        model: args.model,
+        noise: args.noise,
+        fit: multipole::fit::FitOptions {
+            method: args.method,
+            beta_scan: 0,
+            ..multipole::fit::FitOptions::default()
+        },
+        ..multipole::fit::MeasuredOptions::default()
+    };
+    validation::measured_report::run_measured(subset, args.limit, &opts, &args.out)
 }
 
 #[derive(Args, Debug)]
@@ -113,6 +174,7 @@ fn main() {
     let result = match &cli.command {
         Some(Command::Mc(args)) => run_mc(args),
         Some(Command::Exact(args)) => validation::compare::run_exact(args.quick, &args.out),
+        Some(Command::Measured(args)) => run_measured(args),
         None => validation::compare::run_comparison(cli.quick, &cli.out),
     };
     if let Err(e) = result {
