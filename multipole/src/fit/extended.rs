@@ -168,7 +168,16 @@ pub fn fit_measured(
                 let Some((p, s, _)) = best else { break };
                 let mut trial = params.clone();
                 trial.push(p);
-                let (s, r) = problem.refine(s, &trial)?;
+                // Two starts for the new parameter: where the trial left it, and mid-range (a
+                // parameter that trades off against the seed's, like blood near the surface
+                // against C_h, can sit in a long valley).
+                let [lo, hi] = p.range();
+                let mid = p.set(s, 0.5 * (lo + hi))?;
+                let (s, r) = {
+                    let a = problem.refine(s, &trial)?;
+                    let b = problem.refine(mid, &trial)?;
+                    if b.1 < a.1 { b } else { a }
+                };
                 let delta = criterion(r, trial.len(), chosen + 1)
                     - criterion(rms, params.len(), chosen);
                 let accepted = delta < 0.0;
