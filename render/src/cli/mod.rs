@@ -5,6 +5,7 @@
 pub mod args;
 pub mod brdf;
 pub mod fit;
+mod fit_measured;
 pub mod profile;
 pub mod render;
 pub mod spectrum;
