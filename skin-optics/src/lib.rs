@@ -4,6 +4,7 @@ pub mod chromophores;
 pub mod color;
 pub mod error;
 pub mod lab;
+pub mod measured;
 pub mod params;
 pub mod physiology;
 pub mod spectrum;

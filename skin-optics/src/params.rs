@@ -40,14 +40,14 @@ impl fmt::Display for Preset {
 
 /// Error for an unknown preset name.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error("unknown skin preset '{0}' (valid: light, medium, dark)")]
+#[error("unknown skin preset '{0}' (valid: light or paper, medium, dark)")]
 pub struct UnknownPreset(pub String);
 
 impl FromStr for Preset {
     type Err = UnknownPreset;
     fn from_str(s: &str) -> Result<Self, Self::Err> {
         match s.to_ascii_lowercase().as_str() {
-            "light" => Ok(Preset::Light),
+            "light" | "paper" => Ok(Preset::Light),
             "medium" => Ok(Preset::Medium),
             "dark" => Ok(Preset::Dark),
             _ => Err(UnknownPreset(s.to_string())),
@@ -399,10 +399,11 @@ mod tests {
             assert_eq!(p.to_string(), p.name());
         }
         assert_eq!("DARK".parse::<Preset>().unwrap(), Preset::Dark);
+        assert_eq!("paper".parse::<Preset>().unwrap(), Preset::Light);
         let e = "tan".parse::<Preset>().unwrap_err();
         assert_eq!(
             e.to_string(),
-            "unknown skin preset 'tan' (valid: light, medium, dark)"
+            "unknown skin preset 'tan' (valid: light or paper, medium, dark)"
         );
     }
 }

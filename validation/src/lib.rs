@@ -5,3 +5,4 @@ pub mod compare;
 pub use multipole::montecarlo;
 pub mod measured;
 pub mod measured_report;
+pub mod presets;

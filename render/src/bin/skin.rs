@@ -24,6 +24,8 @@ enum Command {
     Render(cli::render::RenderArgs),
     /// Fit skin parameters to an sRGB colour or a measured reflectance spectrum.
     Fit(cli::fit::FitArgs),
+    /// The named skins (paper, medium, dark, measured group/site and ITA° presets) with colour and ITA°.
+    Presets(cli::presets::PresetsArgs),
 }
 
 fn main() -> ExitCode {
@@ -34,6 +36,7 @@ fn main() -> ExitCode {
         Command::Brdf(a) => cli::brdf::run(a),
         Command::Render(a) => cli::render::run(a),
         Command::Fit(a) => cli::fit::run(a),
+        Command::Presets(a) => cli::presets::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

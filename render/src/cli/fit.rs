@@ -6,7 +6,7 @@ use anyhow::Context;
 use clap::{ArgGroup, Args};
 use multipole::Method;
 use multipole::fit::{
-    BetaRange, FitOptions, Geometry, MeasuredFit, MeasuredOptions, MeasuredSpectrum, ModelChoice,
+    BetaRange, FitOptions, Geometry, MeasuredOptions, MeasuredSpectrum, ModelChoice,
     fit_colour, fit_measured, fit_spectrum,
 };
 use skin_optics::SkinParams;

@@ -35,6 +35,18 @@ enum Command {
     /// Fit the measured ISSA spectra (explore or held-out subjects) with the seed model and a
     /// chosen one; residual bands and fitted parameters as CSV and PNG into --out.
     Measured(MeasuredArgs),
+    /// Fit the ISSA group/site medians (SCI, model auto) and write the measured-preset table.
+    Presets(PresetArgs),
+}
+
+#[derive(Args, Debug)]
+struct PresetArgs {
+    /// Noise σ of one reflectance for the criterion, (0, 1).
+    #[arg(long, default_value_t = 0.005)]
+    noise: f64,
+    /// Output table.
+    #[arg(long, value_name = "FILE.csv", default_value = "skin-optics/data/measured_presets.csv")]
+    out: PathBuf,
 }
 
 #[derive(Args, Debug)]
@@ -175,6 +187,7 @@ fn main() {
         Some(Command::Mc(args)) => run_mc(args),
         Some(Command::Exact(args)) => validation::compare::run_exact(args.quick, &args.out),
         Some(Command::Measured(args)) => run_measured(args),
+        Some(Command::Presets(args)) => validation::presets::run_presets(args.noise, &args.out),
         None => validation::compare::run_comparison(cli.quick, &cli.out),
     };
     if let Err(e) = result {
