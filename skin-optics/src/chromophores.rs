@@ -173,7 +173,8 @@ impl SkinParams {
                 sigma_s_prime: s,
             },
             dermis: LayerCoefficients {
-                sigma_a: dermis_sigma_a(self, lambda) + physiology::dermis_extra_sigma_a(&x, lambda),
+                sigma_a: dermis_sigma_a(self, lambda)
+                    + physiology::dermis_extra_sigma_a(&x, lambda),
                 sigma_s_prime: s * self.dermis_scattering_scale(),
             },
         }
@@ -378,7 +379,11 @@ mod tests {
                 .unwrap();
             for i in 0..=60 {
                 let l = wl(400.0 + 5.0 * f64::from(i));
-                assert_eq!(skin.extended_coefficients(l), skin.coefficients(l), "{preset} {l:?}");
+                assert_eq!(
+                    skin.extended_coefficients(l),
+                    skin.coefficients(l),
+                    "{preset} {l:?}"
+                );
             }
         }
     }

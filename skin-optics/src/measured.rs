@@ -61,10 +61,12 @@ pub fn ita_presets() -> Vec<(String, &'static MeasuredPreset)> {
 #[must_use]
 pub fn find_measured(name: &str) -> Option<&'static MeasuredPreset> {
     let n = name.trim().to_ascii_lowercase();
-    measured_presets()
-        .iter()
-        .find(|p| p.name == n)
-        .or_else(|| ita_presets().into_iter().find(|(k, _)| *k == n).map(|(_, p)| p))
+    measured_presets().iter().find(|p| p.name == n).or_else(|| {
+        ita_presets()
+            .into_iter()
+            .find(|(k, _)| *k == n)
+            .map(|(_, p)| p)
+    })
 }
 
 /// Parse the embedded table; a malformed row is a build-time defect the unit tests catch, so it
@@ -118,7 +120,11 @@ mod tests {
         assert_eq!(all.len(), 24);
         for p in all {
             assert!(p.rms < 0.02, "{}: rms {}", p.name, p.rms);
-            assert!(p.skin.melanin() <= 0.5 && p.skin.hemoglobin() <= 0.1, "{}", p.name);
+            assert!(
+                p.skin.melanin() <= 0.5 && p.skin.hemoglobin() <= 0.1,
+                "{}",
+                p.name
+            );
             assert!(p.skin.epidermis_thickness_mm() >= 0.04, "{}", p.name);
             assert!(p.n_records > 0);
         }

@@ -165,9 +165,8 @@ fn positive_scale(name: &'static str, value: f64) -> Result<f64, OpticsError> {
 
 fn bilirubin_table() -> &'static UniformTable {
     static TABLE: OnceLock<UniformTable> = OnceLock::new();
-    TABLE.get_or_init(|| {
-        UniformTable::parse(include_str!("../data/bilirubin_molar_extinction.csv"))
-    })
+    TABLE
+        .get_or_init(|| UniformTable::parse(include_str!("../data/bilirubin_molar_extinction.csv")))
 }
 
 /// Molar extinction of bilirubin, cm⁻¹/M decadic, linearly interpolated in the 2-nm table

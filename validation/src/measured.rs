@@ -90,12 +90,10 @@ pub struct RecordFit {
 }
 
 /// Fit every record (rayon across records, with a progress bar on stderr).
-pub fn fit_records(
-    records: &[Record],
-    opts: &MeasuredOptions,
-) -> Result<Vec<RecordFit>, FitError> {
+pub fn fit_records(records: &[Record], opts: &MeasuredOptions) -> Result<Vec<RecordFit>, FitError> {
     let bar = ProgressBar::new(records.len() as u64);
-    if let Ok(style) = ProgressStyle::with_template("{msg} {bar:40} {pos}/{len} [{elapsed}<{eta}]") {
+    if let Ok(style) = ProgressStyle::with_template("{msg} {bar:40} {pos}/{len} [{elapsed}<{eta}]")
+    {
         bar.set_style(style);
     }
     bar.set_message(format!("fit {} {}", opts.geometry, opts.model));

@@ -1,7 +1,9 @@
 //! `skin-validate measured`: fit a subset of measured spectra with the seed model and with a
 //! chosen one, and write the residual bands and fitted parameters as CSV and PNG charts.
 
-use crate::measured::{EXPLORE_CSV, HELDOUT_CSV, RecordFit, fit_records, parse_records, quantile, residual_bands};
+use crate::measured::{
+    EXPLORE_CSV, HELDOUT_CSV, RecordFit, fit_records, parse_records, quantile, residual_bands,
+};
 use anyhow::Context;
 use multipole::fit::{MeasuredOptions, ModelChoice, Parameter};
 use render::plot::{LineChart, Panel, Series, palette_color, save_png};
@@ -32,7 +34,9 @@ pub fn run_measured(
     let mut records = parse_records(text)?;
     if let Some(n) = limit.filter(|&n| n > 0 && n < records.len()) {
         let stride = records.len() as f64 / n as f64;
-        records = (0..n).map(|i| records[(i as f64 * stride) as usize].clone()).collect();
+        records = (0..n)
+            .map(|i| records[(i as f64 * stride) as usize].clone())
+            .collect();
     }
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let name = match subset {
@@ -54,7 +58,10 @@ pub fn run_measured(
     };
     let t_chosen = start.elapsed().as_secs_f64();
     let mut summary = String::new();
-    for (label, fits, t) in [("seed", &seed, t_seed), (&*opts.model.to_string(), &chosen, t_chosen)] {
+    for (label, fits, t) in [
+        ("seed", &seed, t_seed),
+        (&*opts.model.to_string(), &chosen, t_chosen),
+    ] {
         let rms: Vec<f64> = fits.iter().map(|f| f.fit.rms).collect();
         let pinned = fits
             .iter()
@@ -78,7 +85,15 @@ pub fn run_measured(
     if opts.model == ModelChoice::Auto {
         let mut counts: Vec<(Parameter, usize)> = Parameter::CANDIDATES
             .iter()
-            .map(|&p| (p, chosen.iter().filter(|f| f.fit.parameters.contains(&p)).count()))
+            .map(|&p| {
+                (
+                    p,
+                    chosen
+                        .iter()
+                        .filter(|f| f.fit.parameters.contains(&p))
+                        .count(),
+                )
+            })
             .collect();
         counts.sort_by(|a, b| b.1.cmp(&a.1));
         let text: Vec<String> = counts.iter().map(|(p, c)| format!("{p} {c}")).collect();
@@ -147,7 +162,9 @@ fn residual_chart(
     chosen: &[RecordFit],
     label: &str,
 ) -> anyhow::Result<()> {
-    let mut csv = String::from("wavelength_nm,seed_p10,seed_median,seed_p90,seed_mean,model_p10,model_median,model_p90,model_mean\n");
+    let mut csv = String::from(
+        "wavelength_nm,seed_p10,seed_median,seed_p90,seed_mean,model_p10,model_median,model_p90,model_mean\n",
+    );
     let (a, b) = (residual_bands(seed), residual_bands(chosen));
     for ((nm, s), (_, m)) in a.iter().zip(&b) {
         let _ = writeln!(
@@ -171,7 +188,8 @@ fn residual_chart(
             .with_series(Series::dashed(format!("{name} p90"), pick(2)).with_color(colour));
     }
     let path = out.join(format!("residuals_{tag}.png"));
-    save_png(&path, &[Panel::Line(panel)], 900, 560).with_context(|| format!("writing {}", path.display()))
+    save_png(&path, &[Panel::Line(panel)], 900, 560)
+        .with_context(|| format!("writing {}", path.display()))
 }
 
 fn parameter_chart(out: &Path, tag: &str, fits: &[RecordFit]) -> anyhow::Result<()> {

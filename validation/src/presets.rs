@@ -2,7 +2,9 @@
 //! as the table `skin_optics::measured` embeds (docs/physics.md §13).
 
 use anyhow::Context;
-use multipole::fit::{ColourModel, Geometry, MeasuredOptions, MeasuredSpectrum, ModelChoice, fit_measured};
+use multipole::fit::{
+    ColourModel, Geometry, MeasuredOptions, MeasuredSpectrum, ModelChoice, fit_measured,
+};
 use rayon::prelude::*;
 use std::fmt::Write as _;
 use std::path::Path;

@@ -178,8 +178,8 @@ pub fn fit_measured(
                     let b = problem.refine(mid, &trial)?;
                     if b.1 < a.1 { b } else { a }
                 };
-                let delta = criterion(r, trial.len(), chosen + 1)
-                    - criterion(rms, params.len(), chosen);
+                let delta =
+                    criterion(r, trial.len(), chosen + 1) - criterion(rms, params.len(), chosen);
                 let accepted = delta < 0.0;
                 steps.push(SelectionStep {
                     parameter: p,
@@ -277,7 +277,11 @@ impl<'a> Problem<'a> {
     }
 
     fn rms(&self, model: &[f64]) -> f64 {
-        self.residuals(model).iter().map(|r| r * r).sum::<f64>().sqrt()
+        self.residuals(model)
+            .iter()
+            .map(|r| r * r)
+            .sum::<f64>()
+            .sqrt()
     }
 
     /// √(wᵢ / Σw) (model − measured): their squares sum to the weighted mean square.
@@ -376,7 +380,14 @@ impl<'a> Problem<'a> {
         skin: SkinParams,
         params: &[Parameter],
     ) -> Result<(SkinParams, f64), FitError> {
-        let s = self.run(skin, params, LmBudget { max_iterations: 15, ..LM })?;
+        let s = self.run(
+            skin,
+            params,
+            LmBudget {
+                max_iterations: 15,
+                ..LM
+            },
+        )?;
         let forward = self.search.unwrap_or(self.full);
         let mut m = self.seen(&forward, &s)?;
         for (v, b) in m.iter_mut().zip(&self.shift) {

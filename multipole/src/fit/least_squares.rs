@@ -70,11 +70,14 @@ pub(crate) fn minimize(
             };
             jac.push(rj.iter().zip(&r).map(|(a, b)| (a - b) / step).collect());
         }
-        let jtj = |a: usize, b: usize| -> f64 { jac[a].iter().zip(&jac[b]).map(|(x, y)| x * y).sum() };
+        let jtj =
+            |a: usize, b: usize| -> f64 { jac[a].iter().zip(&jac[b]).map(|(x, y)| x * y).sum() };
         let grad: Vec<f64> = (0..k)
             .map(|j| jac[j].iter().zip(&r).map(|(x, y)| x * y).sum())
             .collect();
-        let normal: Vec<Vec<f64>> = (0..k).map(|a| (0..k).map(|b| jtj(a, b)).collect()).collect();
+        let normal: Vec<Vec<f64>> = (0..k)
+            .map(|a| (0..k).map(|b| jtj(a, b)).collect())
+            .collect();
         let mut improved = false;
         while lambda < 1e10 {
             let Some(trial) = damped_step(&normal, &grad, &u, lambda) else {
@@ -187,7 +190,10 @@ mod tests {
         // r = (u0 − 0.3, 2(u1 − 0.6), u0 + u1 − 0.9): minimum at (0.3, 0.6), cost 0.
         let mut f = |u: &[f64]| Some(vec![u[0] - 0.3, 2.0 * (u[1] - 0.6), u[0] + u[1] - 0.9]);
         let m = minimize(&mut f, &[0.9, 0.1], LM);
-        assert!((m.u[0] - 0.3).abs() < 1e-6 && (m.u[1] - 0.6).abs() < 1e-6, "{m:?}");
+        assert!(
+            (m.u[0] - 0.3).abs() < 1e-6 && (m.u[1] - 0.6).abs() < 1e-6,
+            "{m:?}"
+        );
         // Unconstrained minimum at u0 = −0.5: held at 0, u1 free at 0.7.
         let mut g = |u: &[f64]| Some(vec![u[0] + 0.5, u[1] - 0.7]);
         let m = minimize(&mut g, &[0.5, 0.5], LM);
@@ -203,7 +209,17 @@ mod tests {
             let (x, y) = (2.0 * u[0] - 0.5, 2.0 * u[1] - 0.5);
             Some(vec![10.0 * (y - x * x), 1.0 - x])
         };
-        let m = minimize(&mut f, &[0.1, 0.9], LmBudget { max_iterations: 500, ..LM });
-        assert!((m.u[0] - 0.75).abs() < 1e-4 && (m.u[1] - 0.75).abs() < 1e-4, "{m:?}");
+        let m = minimize(
+            &mut f,
+            &[0.1, 0.9],
+            LmBudget {
+                max_iterations: 500,
+                ..LM
+            },
+        );
+        assert!(
+            (m.u[0] - 0.75).abs() < 1e-4 && (m.u[1] - 0.75).abs() < 1e-4,
+            "{m:?}"
+        );
     }
 }

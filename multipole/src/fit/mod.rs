@@ -58,8 +58,8 @@ pub use colour::{ColourFit, ColourModel, fit_colour};
 pub use error::FitError;
 pub use extended::{MeasuredFit, MeasuredOptions, SelectionStep, fit_measured};
 pub use geometry::Geometry;
-pub use model::{ModelChoice, Parameter};
 pub use measured::{MAX_NM, MIN_NM, MIN_POINTS, MeasuredSpectrum};
+pub use model::{ModelChoice, Parameter};
 pub use spectrum::{SpectrumFit, fit_spectrum};
 
 use crate::Method;

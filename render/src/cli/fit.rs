@@ -6,8 +6,8 @@ use anyhow::Context;
 use clap::{ArgGroup, Args};
 use multipole::Method;
 use multipole::fit::{
-    BetaRange, FitOptions, Geometry, MeasuredOptions, MeasuredSpectrum, ModelChoice,
-    fit_colour, fit_measured, fit_spectrum,
+    BetaRange, FitOptions, Geometry, MeasuredOptions, MeasuredSpectrum, ModelChoice, fit_colour,
+    fit_measured, fit_spectrum,
 };
 use skin_optics::SkinParams;
 use skin_optics::color::{Srgb, Xyz};
@@ -164,7 +164,9 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
             );
         }
         if args.geometry != Geometry::Sce {
-            anyhow::bail!("--geometry applies to --spectrum only (a colour is the diffuse reflectance's)");
+            anyhow::bail!(
+                "--geometry applies to --spectrum only (a colour is the diffuse reflectance's)"
+            );
         }
         let target = Lab::from_srgb(hex.srgb);
         let fit = fit_colour(target, &opts)?;

@@ -14,7 +14,8 @@ pub(crate) fn report(
     fit: &MeasuredFit,
     opts: &FitOptions,
 ) -> anyhow::Result<()> {
-    let lab = multipole::fit::ColourModel::new(opts.step_nm, opts.method, fit.skin)?.lab(&fit.skin)?;
+    let lab =
+        multipole::fit::ColourModel::new(opts.step_nm, opts.method, fit.skin)?.lab(&fit.skin)?;
     let hex = lab.to_srgb().to_hex();
     let free: Vec<&str> = fit.parameters.iter().map(|p| p.name()).collect();
     let values: serde_json::Map<String, serde_json::Value> = fit
@@ -100,7 +101,13 @@ fn print_text(
         "{:<9}RMS reflectance = {:.5} (seed model {:.5}); surface term {:.4}",
         "residual", fit.rms, fit.seed_rms, fit.surface_reflectance
     );
-    println!("{:<9}{} ({}): {}", "model", args.model, free.len(), free.join(", "));
+    println!(
+        "{:<9}{} ({}): {}",
+        "model",
+        args.model,
+        free.len(),
+        free.join(", ")
+    );
     for s in &fit.steps {
         println!(
             "{:<9}{} {}: RMS {:.5} → {:.5}, Δcriterion {:+.1} at σ = {}",

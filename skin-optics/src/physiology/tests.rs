@@ -74,9 +74,17 @@ fn bilirubin_adds_to_the_dermis_only() {
     let l = wl(460.0);
     let skin = SkinParams::default();
     let x = Physiology::SEED.with(Extension::Bilirubin, 0.1).unwrap();
-    let (a, b) = (skin.coefficients(l), skin.with_physiology(x).coefficients(l));
+    let (a, b) = (
+        skin.coefficients(l),
+        skin.with_physiology(x).coefficients(l),
+    );
     assert_eq!(a.epidermis, b.epidermis);
-    assert!(rel(b.dermis.sigma_a - a.dermis.sigma_a, bilirubin_sigma_a(l, 0.1)) < 1e-10);
+    assert!(
+        rel(
+            b.dermis.sigma_a - a.dermis.sigma_a,
+            bilirubin_sigma_a(l, 0.1)
+        ) < 1e-10
+    );
 }
 
 #[test]

@@ -45,7 +45,11 @@ struct PresetArgs {
     #[arg(long, default_value_t = 0.005)]
     noise: f64,
     /// Output table.
-    #[arg(long, value_name = "FILE.csv", default_value = "skin-optics/data/measured_presets.csv")]
+    #[arg(
+        long,
+        value_name = "FILE.csv",
+        default_value = "skin-optics/data/measured_presets.csv"
+    )]
     out: PathBuf,
 }
 
@@ -75,15 +79,18 @@ struct MeasuredArgs {
 }
 
 fn parse_geometry(s: &str) -> Result<multipole::fit::Geometry, String> {
-    s.parse().map_err(|e: multipole::fit::FitError| e.to_string())
+    s.parse()
+        .map_err(|e: multipole::fit::FitError| e.to_string())
 }
 
 fn parse_model(s: &str) -> Result<multipole::fit::ModelChoice, String> {
-    s.parse().map_err(|e: multipole::fit::FitError| e.to_string())
+    s.parse()
+        .map_err(|e: multipole::fit::FitError| e.to_string())
 }
 
 fn parse_method(s: &str) -> Result<multipole::Method, String> {
-    s.parse().map_err(|e: multipole::MultipoleError| e.to_string())
+    s.parse()
+        .map_err(|e: multipole::MultipoleError| e.to_string())
 }
 
 fn run_measured(args: &MeasuredArgs) -> anyhow::Result<()> {

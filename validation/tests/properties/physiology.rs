@@ -30,7 +30,11 @@ fn extensions_change_every_method_and_exact_agrees_with_monte_carlo() {
         for method in [Method::Multipole, Method::Exact] {
             let a = diffuse_reflectance(&base, l, method).unwrap();
             let b = diffuse_reflectance(&skin, l, method).unwrap();
-            assert!(sign * (b - a) > 0.005 * a, "{} {method}: {a} → {b}", e.name());
+            assert!(
+                sign * (b - a) > 0.005 * a,
+                "{} {method}: {a} → {b}",
+                e.name()
+            );
         }
         let exact = skin_totals(&skin, l, &AddingDoublingOptions::default())
             .unwrap()

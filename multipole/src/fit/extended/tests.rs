@@ -83,7 +83,11 @@ fn auto_keeps_the_seed_model_on_seed_spectra_plus_noise() {
         assert_eq!(fit.parameters, expect, "{truth:?}: {:?}", fit.steps);
         assert!(fit.steps.len() == 1 && !fit.steps[0].accepted);
         // The noise floor: the RMS of 31 draws of σ, within a factor 1.5 either way.
-        assert!(fit.rms > sigma / 1.5 && fit.rms < sigma * 1.5, "rms {}", fit.rms);
+        assert!(
+            fit.rms > sigma / 1.5 && fit.rms < sigma * 1.5,
+            "rms {}",
+            fit.rms
+        );
     }
 }
 
@@ -117,7 +121,10 @@ fn auto_adds_epidermis_blood_where_the_spectrum_needs_it() {
     let blood = Parameter::Extended(Extension::EpidermisBlood);
     let msg = format!("truth rms {truth_rms}\n{:?}\n{:?}", fit.steps, fit.skin);
     assert_eq!(fit.steps[0].parameter, blood, "{msg}");
-    assert!(fit.steps[0].accepted && fit.steps[0].delta_criterion < -100.0, "{msg}");
+    assert!(
+        fit.steps[0].accepted && fit.steps[0].delta_criterion < -100.0,
+        "{msg}"
+    );
     assert!(fit.rms <= 1.02 * truth_rms, "{msg}");
     for (a, b) in fit.model.iter().zip(clean.reflectance()) {
         assert!((a - b).abs() < 1.5 * sigma, "{a} vs {b}: {msg}");
