@@ -163,12 +163,14 @@ fn solve(mut a: Vec<Vec<f64>>, mut b: Vec<f64>) -> Option<Vec<f64>> {
         }
         a.swap(c, p);
         b.swap(c, p);
-        for row in c + 1..n {
-            let f = a[row][c] / a[c][c];
-            for col in c..n {
-                a[row][col] -= f * a[c][col];
+        let (pivot_rows, rest) = a.split_at_mut(c + 1);
+        let pivot = &pivot_rows[c];
+        for (k, row) in rest.iter_mut().enumerate() {
+            let f = row[c] / pivot[c];
+            for (x, p) in row[c..].iter_mut().zip(&pivot[c..]) {
+                *x -= f * p;
             }
-            b[row] -= f * b[c];
+            b[c + 1 + k] -= f * b[c];
         }
     }
     let mut x = vec![0.0; n];
