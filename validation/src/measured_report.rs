@@ -95,7 +95,7 @@ pub fn run_measured(
                 )
             })
             .collect();
-        counts.sort_by(|a, b| b.1.cmp(&a.1));
+        counts.sort_by_key(|c| std::cmp::Reverse(c.1));
         let text: Vec<String> = counts.iter().map(|(p, c)| format!("{p} {c}")).collect();
         writeln!(summary, "auto chose: {}", text.join(", "))?;
     }
