@@ -59,18 +59,23 @@ fn sci_full_fit_of_a_generated_spectrum_reports_its_model() {
     let path = std::env::temp_dir().join(format!("skin-cli-measured-{}.csv", std::process::id()));
     std::fs::write(&path, csv).unwrap();
     let p = path.to_str().unwrap();
-    let out = skin(&[
-        "fit",
-        "--spectrum",
-        p,
-        "--geometry",
-        "sci",
-        "--model",
-        "full",
-        "--method",
-        "multipole",
-        "--json",
-    ]);
+    let fit = |model: &str, json: bool| {
+        let mut a = vec![
+            "fit",
+            "--spectrum",
+            p,
+            "--geometry",
+            "sci",
+            "--model",
+            model,
+        ];
+        a.extend(["--method", "multipole"]);
+        if json {
+            a.push("--json");
+        }
+        skin(&a)
+    };
+    let out = fit("full", true);
     assert!(out.status.success(), "{}", text(&out.stderr));
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["geometry"], "sci");
@@ -80,17 +85,7 @@ fn sci_full_fit_of_a_generated_spectrum_reports_its_model() {
     assert!(v["free_parameters"]["oiliness"].is_f64());
     assert!(v["free_parameters"]["epidermis_blood"].is_f64());
     // Text output names the model and its parameters.
-    let out = skin(&[
-        "fit",
-        "--spectrum",
-        p,
-        "--geometry",
-        "sci",
-        "--model",
-        "auto",
-        "--method",
-        "multipole",
-    ]);
+    let out = fit("auto", false);
     assert!(out.status.success(), "{}", text(&out.stderr));
     let s = text(&out.stdout);
     assert!(s.contains("model    auto"), "{s}");

@@ -12,7 +12,7 @@ use multipole::fit::{
 use skin_optics::SkinParams;
 use skin_optics::color::{Srgb, Xyz};
 use skin_optics::lab::Lab;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Arguments of `skin fit`.
 #[derive(Args, Debug, Clone)]
@@ -268,12 +268,15 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
             println!("{l}");
         }
     }
-    if !fit.within_tolerance {
+    within_tolerance(path, fit.rms, opts.max_rms)
+}
+
+/// Fail when a spectrum fit's RMS exceeds the tolerance: no skin reproduces the spectrum.
+pub(crate) fn within_tolerance(path: &Path, rms: f64, max_rms: f64) -> anyhow::Result<()> {
+    if rms > max_rms {
         anyhow::bail!(
-            "{}: no skin reproduces this spectrum; the nearest skin (above) has RMS reflectance error {:.3} (threshold {})",
-            path.display(),
-            fit.rms,
-            opts.max_rms
+            "{}: no skin reproduces this spectrum; the nearest skin (above) has RMS reflectance error {rms:.3} (threshold {max_rms})",
+            path.display()
         );
     }
     Ok(())

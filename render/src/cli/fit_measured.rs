@@ -1,7 +1,7 @@
 //! `skin fit --spectrum` output for a fit with the instrument's geometry and a chosen model
 //! (`--geometry sci` or `--model full|auto`): the free parameters, the surface term, the selection.
 
-use super::fit::{FitArgs, colour_line, lab_json, params_json, skin_line};
+use super::fit::{FitArgs, colour_line, lab_json, params_json, skin_line, within_tolerance};
 use multipole::fit::{FitOptions, MeasuredFit, MeasuredSpectrum};
 use skin_optics::lab::Lab;
 use std::path::Path;
@@ -57,15 +57,7 @@ pub(crate) fn report(
     } else {
         print_text(args, path, measured, fit, lab, &hex, &free);
     }
-    if fit.rms > opts.max_rms {
-        anyhow::bail!(
-            "{}: no skin reproduces this spectrum; the nearest skin (above) has RMS reflectance error {:.3} (threshold {})",
-            path.display(),
-            fit.rms,
-            opts.max_rms
-        );
-    }
-    Ok(())
+    within_tolerance(path, fit.rms, opts.max_rms)
 }
 
 fn print_text(
