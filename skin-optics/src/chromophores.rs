@@ -3,6 +3,7 @@
 //! The only home of these laws in the workspace: everyone else calls them.
 
 use crate::params::SkinParams;
+use crate::physiology;
 use crate::table::UniformTable;
 use crate::units::Wavelength;
 use std::sync::OnceLock;
@@ -37,12 +38,27 @@ fn hemoglobin_table() -> &'static UniformTable {
     })
 }
 
+/// Absorption, mm⁻¹, of a chromophore at `g_per_l` (g/L) with molar mass `g_per_mol` from its decadic
+/// molar extinction ε in cm⁻¹/M ([Prahl]): σa = ln(10) · ε · c / M / 10.
+#[must_use]
+pub fn sigma_a_from_molar_extinction(
+    epsilon_per_cm_per_molar: f64,
+    g_per_l: f64,
+    g_per_mol: f64,
+) -> f64 {
+    // Prahl's recipe uses 2.303 for ln 10; keep it so the check values match the published table.
+    2.303 * epsilon_per_cm_per_molar * g_per_l / g_per_mol / 10.0
+}
+
 /// Whole-blood absorption, mm⁻¹, from a decadic molar extinction ε in cm⁻¹/M ([Prahl]):
 /// σa = ln(10) · ε · 150 g/L / 64 500 g/mol / 10.
 #[must_use]
 pub fn blood_sigma_a_from_molar_extinction(epsilon_per_cm_per_molar: f64) -> f64 {
-    // Prahl's recipe uses 2.303 for ln 10; keep it so the check values match the published table.
-    2.303 * epsilon_per_cm_per_molar * BLOOD_HEMOGLOBIN_G_PER_L / HEMOGLOBIN_G_PER_MOL / 10.0
+    sigma_a_from_molar_extinction(
+        epsilon_per_cm_per_molar,
+        BLOOD_HEMOGLOBIN_G_PER_L,
+        HEMOGLOBIN_G_PER_MOL,
+    )
 }
 
 /// Molar extinction of oxy-hemoglobin, cm⁻¹/M decadic, linearly interpolated in Prahl's 2-nm table.
@@ -118,6 +134,9 @@ impl SkinParams {
     /// Both layers' coefficients at one wavelength ([DJ06] eqs 1–6), mm⁻¹.
     #[must_use]
     pub fn coefficients(&self, lambda: Wavelength) -> SkinCoefficients {
+        if !self.physiology().is_seed() {
+            return self.extended_coefficients(lambda);
+        }
         let s = reduced_scattering(lambda);
         SkinCoefficients {
             lambda,
@@ -127,6 +146,35 @@ impl SkinParams {
             },
             dermis: LayerCoefficients {
                 sigma_a: dermis_sigma_a(self, lambda),
+                sigma_s_prime: s * self.dermis_scattering_scale(),
+            },
+        }
+    }
+}
+
+impl SkinParams {
+    /// [`SkinParams::coefficients`] with the extensions of docs/physics.md §13 (module
+    /// `physiology`): blood in the epidermis, bilirubin in the dermis, scaled scattering terms.
+    fn extended_coefficients(&self, lambda: Wavelength) -> SkinCoefficients {
+        let x = self.physiology();
+        let bm = self.eumelanin_blend();
+        let melanin = bm * eumelanin_sigma_a(lambda) + (1.0 - bm) * pheomelanin_sigma_a(lambda);
+        let s = physiology::reduced_scattering(&x, lambda);
+        SkinCoefficients {
+            lambda,
+            epidermis: LayerCoefficients {
+                sigma_a: physiology::epidermis_sigma_a(
+                    melanin,
+                    self.melanin(),
+                    &x,
+                    self.oxygenation(),
+                    lambda,
+                ),
+                sigma_s_prime: s,
+            },
+            dermis: LayerCoefficients {
+                sigma_a: dermis_sigma_a(self, lambda)
+                    + physiology::dermis_extra_sigma_a(&x, lambda),
                 sigma_s_prime: s * self.dermis_scattering_scale(),
             },
         }
@@ -318,6 +366,27 @@ mod tests {
         assert_eq!(c.dermis.sigma_a, dermis_sigma_a(&skin, l));
         assert_eq!(c.epidermis.sigma_s_prime, reduced_scattering(l));
         assert_eq!(c.dermis.sigma_s_prime, 0.5 * reduced_scattering(l));
+    }
+
+    /// The extended laws with every extension off reduce to eqs 1–6 exactly: `coefficients` takes
+    /// the seed path then, and the extended path would give the same bits.
+    #[test]
+    fn extended_path_with_everything_off_is_bit_identical() {
+        for preset in crate::Preset::ALL {
+            let skin = SkinParams::preset(preset)
+                .with_oxygenation(0.83)
+                .unwrap()
+                .with_dermis_scattering_scale(0.5)
+                .unwrap();
+            for i in 0..=60 {
+                let l = wl(400.0 + 5.0 * f64::from(i));
+                assert_eq!(
+                    skin.extended_coefficients(l),
+                    skin.coefficients(l),
+                    "{preset} {l:?}"
+                );
+            }
+        }
     }
 
     proptest! {

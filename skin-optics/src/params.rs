@@ -1,6 +1,7 @@
 //! The four physical parameters of skin ([DJ06]) and the constants the seed fixes, validated.
 
 use crate::error::{OpticsError, check_positive, check_range};
+use crate::physiology::Physiology;
 use std::fmt;
 use std::str::FromStr;
 
@@ -39,14 +40,14 @@ impl fmt::Display for Preset {
 
 /// Error for an unknown preset name (the name as given, cut by [`crate::echo::text`]).
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error("unknown skin preset '{0}' (valid: light, medium, dark)")]
+#[error("unknown skin preset '{0}' (valid: light or paper, medium, dark)")]
 pub struct UnknownPreset(pub String);
 
 impl FromStr for Preset {
     type Err = UnknownPreset;
     fn from_str(s: &str) -> Result<Self, Self::Err> {
         match s.to_ascii_lowercase().as_str() {
-            "light" => Ok(Preset::Light),
+            "light" | "paper" => Ok(Preset::Light),
             "medium" => Ok(Preset::Medium),
             "dark" => Ok(Preset::Dark),
             _ => Err(UnknownPreset(crate::echo::text(s))),
@@ -69,6 +70,7 @@ pub struct SkinParams {
     epidermis_thickness_mm: f64,
     eta: f64,
     dermis_scattering_scale: f64,
+    physiology: Physiology,
 }
 
 impl SkinParams {
@@ -102,6 +104,7 @@ impl SkinParams {
             epidermis_thickness_mm: Self::DEFAULT_EPIDERMIS_THICKNESS_MM,
             eta: Self::DEFAULT_ETA,
             dermis_scattering_scale: 1.0,
+            physiology: Physiology::SEED,
         })
     }
 
@@ -147,6 +150,37 @@ impl SkinParams {
     pub fn with_oiliness(mut self, rho_s: f64) -> Result<Self, OpticsError> {
         self.oiliness = check_range("oiliness ρ_s", rho_s, 0.0, 1.0, "[0, 1]")?;
         Ok(self)
+    }
+
+    /// Same skin with melanin fraction C_m in [0, 1].
+    pub fn with_melanin(mut self, c_m: f64) -> Result<Self, OpticsError> {
+        self.melanin = check_range("melanin fraction C_m", c_m, 0.0, 1.0, "[0, 1]")?;
+        Ok(self)
+    }
+
+    /// Same skin with eumelanin blend β_m in [0, 1].
+    pub fn with_eumelanin_blend(mut self, beta_m: f64) -> Result<Self, OpticsError> {
+        self.eumelanin_blend = check_range("eumelanin blend β_m", beta_m, 0.0, 1.0, "[0, 1]")?;
+        Ok(self)
+    }
+
+    /// Same skin with hemoglobin fraction C_h in [0, 1].
+    pub fn with_hemoglobin(mut self, c_h: f64) -> Result<Self, OpticsError> {
+        self.hemoglobin = check_range("hemoglobin fraction C_h", c_h, 0.0, 1.0, "[0, 1]")?;
+        Ok(self)
+    }
+
+    /// Same skin with the extended physiology of docs/physics.md §13 (validated by its builders).
+    #[must_use]
+    pub fn with_physiology(mut self, physiology: Physiology) -> Self {
+        self.physiology = physiology;
+        self
+    }
+
+    /// The extended physiology ([`Physiology::SEED`] unless set: the seed's model).
+    #[must_use]
+    pub fn physiology(&self) -> Physiology {
+        self.physiology
     }
 
     /// Melanin volume fraction C_m of the epidermis, in [0, 1].
@@ -351,10 +385,11 @@ mod tests {
             assert_eq!(p.to_string(), p.name());
         }
         assert_eq!("DARK".parse::<Preset>().unwrap(), Preset::Dark);
+        assert_eq!("paper".parse::<Preset>().unwrap(), Preset::Light);
         let e = "tan".parse::<Preset>().unwrap_err();
         assert_eq!(
             e.to_string(),
-            "unknown skin preset 'tan' (valid: light, medium, dark)"
+            "unknown skin preset 'tan' (valid: light or paper, medium, dark)"
         );
     }
 }

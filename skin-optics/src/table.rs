@@ -80,6 +80,13 @@ mod tests {
                 3,
             ),
             (include_str!("../data/cie_d65.csv"), 300.0, 1.0, 531, 1),
+            (
+                include_str!("../data/bilirubin_molar_extinction.csv"),
+                250.0,
+                2.0,
+                226,
+                1,
+            ),
         ];
         for (text, start, step, rows, cols) in shapes {
             let t = UniformTable::parse(text);

@@ -85,6 +85,19 @@ pub enum FitError {
         /// Valid range.
         range: &'static str,
     },
+    /// A name (geometry, model, parameter) that is not one of the valid ones.
+    #[error("unknown {what} '{found}' (valid: {valid})")]
+    Unknown {
+        /// What was being named, e.g. `"geometry"`.
+        what: &'static str,
+        /// The text given.
+        found: String,
+        /// The valid names.
+        valid: &'static str,
+    },
+    /// The surface lobe of the SCI geometry could not be built or integrated.
+    #[error("surface lobe: {0}")]
+    Surface(#[from] brdf::BrdfError),
     /// The forward model (diffuse reflectance) failed for a candidate skin.
     #[error("forward model: {0}")]
     Model(#[from] MultipoleError),

@@ -46,14 +46,21 @@
 
 mod colour;
 mod error;
+mod extended;
 mod forward;
+pub mod geometry;
+mod least_squares;
 mod measured;
+pub mod model;
 mod nelder_mead;
 mod spectrum;
 
 pub use colour::{ColourFit, ColourModel, fit_colour};
 pub use error::FitError;
+pub use extended::{MeasuredFit, MeasuredOptions, SelectionStep, fit_measured};
+pub use geometry::Geometry;
 pub use measured::{MAX_NM, MIN_NM, MIN_POINTS, MeasuredSpectrum};
+pub use model::{ModelChoice, Parameter};
 pub use spectrum::{SpectrumFit, fit_spectrum};
 
 use crate::Method;
@@ -282,13 +289,12 @@ pub(crate) fn prior_penalty2(p: [f64; 3], weight: f64, opts: &FitOptions) -> f64
     weight * weight * (beta + blood)
 }
 
-/// `base` with its chromophore fractions replaced, every other constant kept.
+/// `base` with its chromophore fractions replaced, every other constant (and the extended
+/// physiology) kept.
 pub(crate) fn with_chromophores(base: &SkinParams, p: [f64; 3]) -> Result<SkinParams, OpticsError> {
-    SkinParams::new(p[0], p[1], p[2], base.oiliness())?
-        .with_oxygenation(base.oxygenation())?
-        .with_epidermis_thickness_mm(base.epidermis_thickness_mm())?
-        .with_eta(base.eta())?
-        .with_dermis_scattering_scale(base.dermis_scattering_scale())
+    base.with_melanin(p[0])?
+        .with_eumelanin_blend(p[1])?
+        .with_hemoglobin(p[2])
 }
 
 /// Budget of the main refinement: 1e-4 of the unit box is below every reported digit.

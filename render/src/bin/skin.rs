@@ -26,6 +26,8 @@ enum Command {
     Fit(cli::fit::FitArgs),
     /// Write the skin for another renderer or simulator (OpenPBR, Unreal, HDRP, pbrt, Mitsuba, MCML, ...).
     Export(cli::export::ExportArgs),
+    /// The named skins (paper, medium, dark, measured group/site and ITA° presets) with colour and ITA°.
+    Presets(cli::presets::PresetsArgs),
 }
 
 fn main() -> ExitCode {
@@ -37,6 +39,7 @@ fn main() -> ExitCode {
         Command::Render(a) => cli::render::run(a),
         Command::Fit(a) => cli::fit::run(a),
         Command::Export(a) => cli::export::run(a),
+        Command::Presets(a) => cli::presets::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

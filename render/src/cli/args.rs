@@ -4,6 +4,7 @@
 use clap::Args;
 use clap::builder::TypedValueParser;
 use skin_optics::echo::{Num, Text};
+use skin_optics::measured::find_measured;
 use skin_optics::{OpticsError, Preset, SkinParams};
 use std::ffi::OsStr;
 
@@ -51,6 +52,31 @@ pub fn parse_whole(s: &str, lo: u64, hi: u64, range: &str) -> Result<u64, String
     Ok(v as u64)
 }
 
+/// A named skin: one of the seed's presets (`paper` = `light`, the paper's Figure 1; `medium`,
+/// `dark`) or a measured one (`skin presets` lists them: `ca-forehead`, …, `ita-tan`, …).
+#[derive(Debug, Clone, PartialEq)]
+pub struct NamedSkin {
+    /// The name as given.
+    pub name: String,
+    /// Its skin.
+    pub skin: SkinParams,
+}
+
+/// Parse a preset name (clap value parser).
+pub fn parse_preset(s: &str) -> Result<NamedSkin, String> {
+    let skin = match s.parse::<Preset>() {
+        Ok(p) => SkinParams::preset(p),
+        Err(e) => match find_measured(s) {
+            Some(m) => m.skin,
+            None => return Err(format!("{e}, or a measured preset (see `skin presets`)")),
+        },
+    };
+    Ok(NamedSkin {
+        name: s.to_string(),
+        skin,
+    })
+}
+
 /// Parse a volume fraction in [0, 1] (clap value parser: bad values exit with code 2).
 pub fn parse_fraction(s: &str) -> Result<f64, String> {
     let v = parse_number(s, "[0, 1]")?;
@@ -60,17 +86,13 @@ pub fn parse_fraction(s: &str) -> Result<f64, String> {
     Ok(v)
 }
 
-/// Parse a skin preset name.
-pub fn parse_preset(s: &str) -> Result<Preset, String> {
-    s.parse::<Preset>().map_err(|e| e.to_string())
-}
-
 /// The skin being described: a preset and/or explicit fractions (explicit values win).
 #[derive(Args, Debug, Clone, Default)]
 pub struct SkinArgs {
-    /// Named skin preset: light (the paper's Figure 1), medium or dark. Explicit fractions override it.
+    /// Named skin preset: paper (= light, the paper's Figure 1), medium, dark, or a measured one
+    /// (`skin presets` lists them, e.g. ca-forehead, ita-tan). Explicit fractions override it.
     #[arg(long, value_name = "NAME", value_parser = Checked(parse_preset))]
-    pub preset: Option<Preset>,
+    pub preset: Option<NamedSkin>,
     /// Melanin volume fraction C_m of the epidermis, [0, 1] (physical: 0-0.5).
     #[arg(long, value_name = "C_M", value_parser = Checked(parse_fraction), allow_hyphen_values = true)]
     pub melanin: Option<f64>,
@@ -88,13 +110,14 @@ pub struct SkinArgs {
 impl SkinArgs {
     /// The validated skin: the preset (light if none) with any explicit fraction replacing its value.
     pub fn to_params(&self) -> Result<SkinParams, OpticsError> {
-        let base = SkinParams::preset(self.preset.unwrap_or(Preset::Light));
-        SkinParams::new(
-            self.melanin.unwrap_or(base.melanin()),
-            self.eumelanin.unwrap_or(base.eumelanin_blend()),
-            self.hemoglobin.unwrap_or(base.hemoglobin()),
-            self.oil.unwrap_or(base.oiliness()),
-        )
+        let base = self
+            .preset
+            .as_ref()
+            .map_or_else(|| SkinParams::preset(Preset::Light), |p| p.skin);
+        base.with_melanin(self.melanin.unwrap_or(base.melanin()))?
+            .with_eumelanin_blend(self.eumelanin.unwrap_or(base.eumelanin_blend()))?
+            .with_hemoglobin(self.hemoglobin.unwrap_or(base.hemoglobin()))?
+            .with_oiliness(self.oil.unwrap_or(base.oiliness()))
     }
 }
 

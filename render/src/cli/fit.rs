@@ -6,13 +6,16 @@ use crate::cli::args::{Checked, parse_number};
 use anyhow::Context;
 use clap::{ArgGroup, Args};
 use multipole::Method;
-use multipole::fit::{BetaRange, FitOptions, MeasuredSpectrum, fit_colour, fit_spectrum};
+use multipole::fit::{
+    BetaRange, FitOptions, Geometry, MeasuredOptions, MeasuredSpectrum, ModelChoice, fit_colour,
+    fit_measured, fit_spectrum,
+};
 use skin_optics::SkinParams;
 use skin_optics::WavelengthGrid;
 use skin_optics::color::{Srgb, Xyz};
 use skin_optics::echo::{Num, Text};
 use skin_optics::lab::Lab;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Arguments of `skin fit`.
 #[derive(Args, Debug, Clone)]
@@ -32,6 +35,20 @@ pub struct FitArgs {
     /// so its melanin is fitted too high).
     #[arg(long, value_name = "METHOD", default_value = "exact", value_parser = Checked(parse_method), allow_hyphen_values = true)]
     pub method: Method,
+    /// Instrument geometry of a --spectrum: `sce` (d/8, specular component excluded: the model's
+    /// diffuse reflectance as is) or `sci` (d/8, specular included: adds the oily layer's surface
+    /// reflection at 8°, with ρ_s fitted).
+    #[arg(long, value_name = "GEOMETRY", default_value = "sce", value_parser = parse_geometry)]
+    pub geometry: Geometry,
+    /// Parameters to fit: `seed` (C_m, β_m, C_h, plus ρ_s under sci), `full` (also blood near the
+    /// surface, epidermis thickness, γ, scattering scales, bilirubin) or `auto` (the seed's plus
+    /// what the information criterion accepts at --noise). A colour has three coordinates, so
+    /// with --srgb `auto` keeps the seed's three and `full` is refused.
+    #[arg(long, value_name = "MODEL", default_value = "seed", value_parser = parse_model)]
+    pub model: ModelChoice,
+    /// Noise σ of one measured reflectance, for `--model auto`'s criterion, in (0, 1).
+    #[arg(long, value_name = "SIGMA", default_value_t = 0.005)]
+    pub noise: f64,
     /// Wavelength step of the model spectrum behind a colour, nm, in [0.01, 100].
     #[arg(long = "step-nm", value_name = "NM", default_value_t = 10.0, value_parser = Checked(parse_step), allow_hyphen_values = true)]
     pub step_nm: f64,
@@ -66,6 +83,14 @@ fn parse_method(s: &str) -> Result<Method, String> {
     s.parse::<Method>().map_err(|e| e.to_string())
 }
 
+fn parse_geometry(s: &str) -> Result<Geometry, String> {
+    s.parse::<Geometry>().map_err(|e| e.to_string())
+}
+
+fn parse_model(s: &str) -> Result<ModelChoice, String> {
+    s.parse::<ModelChoice>().map_err(|e| e.to_string())
+}
+
 fn parse_step(s: &str) -> Result<f64, String> {
     let v = parse_number(s, "[0.01, 100] nm")?;
     // The lower bound is the finest wavelength grid the colour model accepts.
@@ -79,14 +104,14 @@ fn hex_of(xyz: Xyz) -> String {
     xyz.to_linear_srgb().to_srgb().to_hex()
 }
 
-fn lab_json(lab: Lab) -> serde_json::Value {
+pub(crate) fn lab_json(lab: Lab) -> serde_json::Value {
     serde_json::json!({
         "l": lab.l, "a": lab.a, "b": lab.b,
         "ita_deg": lab.ita_deg(), "ita_category": lab.ita_category().name(),
     })
 }
 
-fn colour_line(label: &str, hex: &str, lab: Lab) -> String {
+pub(crate) fn colour_line(label: &str, hex: &str, lab: Lab) -> String {
     format!(
         "{label:<9}{hex}  L*a*b* ({:.2}, {:.2}, {:.2})  ITA° {:.1} ({})",
         lab.l,
@@ -97,7 +122,7 @@ fn colour_line(label: &str, hex: &str, lab: Lab) -> String {
     )
 }
 
-fn skin_line(skin: &SkinParams, method: Method) -> String {
+pub(crate) fn skin_line(skin: &SkinParams, method: Method) -> String {
     format!(
         "{:<9}C_m = {:.4}  β_m = {:.3}  C_h = {:.4}  (method {method})",
         "skin",
@@ -122,7 +147,7 @@ fn beta_json(range: Option<BetaRange>) -> serde_json::Value {
     })
 }
 
-fn params_json(skin: &SkinParams) -> serde_json::Value {
+pub(crate) fn params_json(skin: &SkinParams) -> serde_json::Value {
     serde_json::json!({
         "melanin": skin.melanin(),
         "eumelanin_blend": skin.eumelanin_blend(),
@@ -205,6 +230,16 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
         ..FitOptions::default()
     };
     if let Some(hex) = &args.srgb {
+        if args.model == ModelChoice::Full {
+            anyhow::bail!(
+                "--model full needs --spectrum: a colour has three coordinates and cannot determine more than the seed's three parameters"
+            );
+        }
+        if args.geometry != Geometry::Sce {
+            anyhow::bail!(
+                "--geometry applies to --spectrum only (a colour is the diffuse reflectance's)"
+            );
+        }
         let target = Lab::from_srgb(hex.srgb);
         let fit = fit_colour(target, &opts)?;
         let fitted_hex = hex_of(fit.xyz);
@@ -220,6 +255,12 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
         } else {
             println!("{}", colour_line("target", &hex.text, target));
             found.print(&format!("ΔE2000 = {:.3}", fit.delta_e), "ΔE2000");
+            if args.model == ModelChoice::Auto {
+                println!(
+                    "{:<9}auto: the seed's C_m, β_m, C_h (three colour coordinates determine three parameters)",
+                    "model"
+                );
+            }
         }
         if !fit.in_gamut {
             anyhow::bail!(
@@ -238,6 +279,17 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
     let text = crate::input::SPECTRUM.read_text(path)?;
     let measured =
         MeasuredSpectrum::parse_csv(&text).with_context(|| path.display().to_string())?;
+    if args.geometry != Geometry::Sce || args.model != ModelChoice::Seed {
+        let m = MeasuredOptions {
+            geometry: args.geometry,
+            model: args.model,
+            noise: args.noise,
+            fit: opts,
+            ..MeasuredOptions::default()
+        };
+        let fit = fit_measured(&measured, &m)?;
+        return super::fit_measured::report(args, path, &measured, &fit, &opts);
+    }
     let fit = fit_spectrum(&measured, &opts)?;
     let fitted_hex = fit.lab.to_srgb().to_hex();
     let found = found!(fit, &fitted_hex, opts);
@@ -261,12 +313,15 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
         );
         found.print(&format!("RMS reflectance = {:.5}", fit.rms), "RMS");
     }
-    if !fit.within_tolerance {
+    within_tolerance(path, fit.rms, opts.max_rms)
+}
+
+/// Fail when a spectrum fit's RMS exceeds the tolerance: no skin reproduces the spectrum.
+pub(crate) fn within_tolerance(path: &Path, rms: f64, max_rms: f64) -> anyhow::Result<()> {
+    if rms > max_rms {
         anyhow::bail!(
-            "{}: no skin reproduces this spectrum; the nearest skin (above) has RMS reflectance error {:.3} (threshold {})",
-            path.display(),
-            fit.rms,
-            opts.max_rms
+            "{}: no skin reproduces this spectrum; the nearest skin (above) has RMS reflectance error {rms:.3} (threshold {max_rms})",
+            path.display()
         );
     }
     Ok(())

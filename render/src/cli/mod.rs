@@ -6,6 +6,8 @@ pub mod args;
 pub mod brdf;
 pub mod export;
 pub mod fit;
+mod fit_measured;
+pub mod presets;
 pub mod profile;
 pub mod render;
 pub mod spectrum;

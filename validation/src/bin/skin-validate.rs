@@ -36,6 +36,11 @@ enum Command {
     /// Per-pixel relative luminance noise of one render, from two renders with different seeds:
     /// sqrt(mean((L₁ − L₂)² / (2 L̄²))) over pixels with L̄ ≥ 15% of the 95th percentile.
     Noise(NoiseArgs),
+    /// Fit the measured ISSA spectra (explore or held-out subjects) with the seed model and a
+    /// chosen one; residual bands and fitted parameters as CSV and PNG into --out.
+    Measured(MeasuredArgs),
+    /// Fit the ISSA group/site medians (SCI, model auto) and write the measured-preset table.
+    Presets(PresetArgs),
 }
 
 #[derive(Args, Debug)]
@@ -44,6 +49,81 @@ struct NoiseArgs {
     a: PathBuf,
     /// Second render of the same scene with another seed (RGB OpenEXR).
     b: PathBuf,
+}
+
+#[derive(Args, Debug)]
+struct PresetArgs {
+    /// Noise σ of one reflectance for the criterion, (0, 1).
+    #[arg(long, default_value_t = 0.005)]
+    noise: f64,
+    /// Output table.
+    #[arg(
+        long,
+        value_name = "FILE.csv",
+        default_value = "skin-optics/data/measured_presets.csv"
+    )]
+    out: PathBuf,
+}
+
+#[derive(Args, Debug)]
+struct MeasuredArgs {
+    /// Which subjects: `heldout` (report these) or `explore`.
+    #[arg(long, default_value = "heldout", value_parser = ["heldout", "explore"])]
+    set: String,
+    /// Instrument geometry: `sci` (what ISSA measured) or `sce`.
+    #[arg(long, default_value = "sci", value_parser = parse_geometry)]
+    geometry: multipole::fit::Geometry,
+    /// Model compared with the seed: `seed`, `full` or `auto`.
+    #[arg(long, default_value = "auto", value_parser = parse_model)]
+    model: multipole::fit::ModelChoice,
+    /// Forward model: `exact` or `multipole`.
+    #[arg(long, default_value = "exact", value_parser = parse_method)]
+    method: multipole::Method,
+    /// Noise σ of one reflectance for the criterion, (0, 1).
+    #[arg(long, default_value_t = 0.005)]
+    noise: f64,
+    /// Fit at most this many records, spread evenly over the subset.
+    #[arg(long)]
+    limit: Option<usize>,
+    /// Output folder.
+    #[arg(long, value_name = "DIR", default_value = "out/measured")]
+    out: PathBuf,
+}
+
+fn parse_geometry(s: &str) -> Result<multipole::fit::Geometry, String> {
+    s.parse()
+        .map_err(|e: multipole::fit::FitError| e.to_string())
+}
+
+fn parse_model(s: &str) -> Result<multipole::fit::ModelChoice, String> {
+    s.parse()
+        .map_err(|e: multipole::fit::FitError| e.to_string())
+}
+
+fn parse_method(s: &str) -> Result<multipole::Method, String> {
+    s.parse()
+        .map_err(|e: multipole::MultipoleError| e.to_string())
+}
+
+fn run_measured(args: &MeasuredArgs) -> anyhow::Result<()> {
+    use validation::measured_report::Subset;
+    let subset = if args.set == "explore" {
+        Subset::Explore
+    } else {
+        Subset::Heldout
+    };
+    let opts = multipole::fit::MeasuredOptions {
+        geometry: args.geometry,
+        model: args.model,
+        noise: args.noise,
+        fit: multipole::fit::FitOptions {
+            method: args.method,
+            beta_scan: 0,
+            ..multipole::fit::FitOptions::default()
+        },
+        ..multipole::fit::MeasuredOptions::default()
+    };
+    validation::measured_report::run_measured(subset, args.limit, &opts, &args.out)
 }
 
 #[derive(Args, Debug)]
@@ -138,6 +218,8 @@ fn main() {
         Some(Command::Mc(args)) => run_mc(args),
         Some(Command::Exact(args)) => validation::compare::run_exact(args.quick, &args.out),
         Some(Command::Noise(args)) => run_noise(args),
+        Some(Command::Measured(args)) => run_measured(args),
+        Some(Command::Presets(args)) => validation::presets::run_presets(args.noise, &args.out),
         None => validation::compare::run_comparison(cli.quick, &cli.out),
     };
     if let Err(e) = result {

@@ -2,3 +2,4 @@
 //! where diffusion is valid.
 
 mod diffusion;
+mod physiology;

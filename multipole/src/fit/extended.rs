@@ -1,0 +1,401 @@
+//! Spectrum fit with the instrument modelled (SCE/SCI) and the model chosen by the data
+//! (docs/physics.md §13).
+//!
+//! 1. **Start**: today's seed fit ([`fit_spectrum`]: global search over C_m, β_m, C_h) of the
+//!    measurement minus the surface reflection of the base skin's ρ_s for the geometry.
+//! 2. **Refine** the free parameters together by bounded Levenberg–Marquardt (module
+//!    `least_squares`) on the model the instrument sees: diffuse reflectance plus, for SCI,
+//!    ρ_s a(cos 8°). An exact fit refines on the cheap search quadrature shifted to the full model
+//!    (output space mapping, module `forward`), re-shifted until the full residual stops falling.
+//! 3. **Select** (`auto`): starting from the seed's parameters, each candidate of
+//!    [`Parameter::CANDIDATES`] not yet in is tried; the best one is kept if it lowers the
+//!    criterion, then the next round. The criterion is the extended BIC of Chen & Chen (2008)
+//!    with a known noise level σ ([`MeasuredOptions::noise`]):
+//!    IC = n · rms² / σ² + k ln n + 2 ln C(m, j),
+//!    for n wavelengths, k free parameters, j of the m candidates chosen. The last term charges
+//!    for having picked the best of several candidates; without it a spectrum of the seed model
+//!    plus noise gains a spurious parameter about 40 % of the time (best of 7 χ²₁ draws above ln 31).
+
+use super::forward::Forward;
+use super::geometry::{Geometry, unit_surface_reflectance};
+use super::least_squares::{LM, LmBudget, minimize};
+use super::model::{ModelChoice, Parameter};
+use super::{FitError, FitOptions, MeasuredSpectrum, SpectrumFit, fit_spectrum};
+use skin_optics::{SkinParams, Wavelength};
+
+/// Knobs of [`fit_measured`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MeasuredOptions {
+    /// What the instrument reports (default SCE: the model's diffuse reflectance as is).
+    pub geometry: Geometry,
+    /// Which parameters to free (default `seed`).
+    pub model: ModelChoice,
+    /// Noise σ of one measured reflectance for the criterion, in (0, 1) (default 0.005: an assumed
+    /// repeatability of a d/8 measurement on skin, probe placement included; a knob, not a fact).
+    pub noise: f64,
+    /// Fit ρ_s under SCI (default true); false keeps the base skin's ρ_s.
+    pub fit_oiliness: bool,
+    /// The seed fit's knobs (forward model, search, base skin).
+    pub fit: FitOptions,
+}
+
+impl Default for MeasuredOptions {
+    fn default() -> Self {
+        Self {
+            geometry: Geometry::Sce,
+            model: ModelChoice::Seed,
+            noise: 0.005,
+            fit_oiliness: true,
+            fit: FitOptions::default(),
+        }
+    }
+}
+
+/// One round of the `auto` selection: the best candidate of the round and whether it was kept.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SelectionStep {
+    /// The candidate with the lowest residual this round.
+    pub parameter: Parameter,
+    /// Weighted RMS residual before adding it.
+    pub rms_before: f64,
+    /// Weighted RMS residual with it.
+    pub rms_after: f64,
+    /// Change of the criterion (negative = kept).
+    pub delta_criterion: f64,
+    /// Whether it was kept.
+    pub accepted: bool,
+}
+
+/// Result of [`fit_measured`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct MeasuredFit {
+    /// The fitted skin (free parameters fitted, the rest from the base skin).
+    pub skin: SkinParams,
+    /// The parameters that were free, seed ones first.
+    pub parameters: Vec<Parameter>,
+    /// What the instrument sees for the fitted skin at each measured wavelength.
+    pub model: Vec<f64>,
+    /// Weighted RMS residual of `model` against the measurement.
+    pub rms: f64,
+    /// The reflectance the geometry adds (ρ_s a(cos 8°) for SCI, else 0).
+    pub surface_reflectance: f64,
+    /// The seed model's fit under the same geometry, the reference of the selection.
+    pub seed_rms: f64,
+    /// The criterion of the final model (see the module doc).
+    pub criterion: f64,
+    /// The rounds of the `auto` selection (empty for `seed` and `full`).
+    pub steps: Vec<SelectionStep>,
+    /// The start: today's seed fit of the measurement minus the base surface reflection.
+    pub start: SpectrumFit,
+    /// Full-model spectrum evaluations spent after the start.
+    pub full_evaluations: usize,
+    /// Search-model spectrum evaluations spent after the start.
+    pub search_evaluations: usize,
+}
+
+/// Fit a measured spectrum with the instrument's geometry and the chosen model (module doc).
+pub fn fit_measured(
+    measured: &MeasuredSpectrum,
+    opts: &MeasuredOptions,
+) -> Result<MeasuredFit, FitError> {
+    opts.fit.validate()?;
+    if !(opts.noise > 0.0 && opts.noise < 1.0) {
+        return Err(FitError::Option {
+            name: "noise",
+            value: opts.noise,
+            range: "(0, 1)",
+        });
+    }
+    let base = opts.fit.base;
+    let unit_surface = match opts.geometry {
+        Geometry::Sce => 0.0,
+        Geometry::Sci => unit_surface_reflectance(base.eta())?,
+    };
+    let offset = base.oiliness() * unit_surface;
+    let shifted: Vec<f64> = measured
+        .reflectance()
+        .iter()
+        .map(|r| (r - offset).max(0.0))
+        .collect();
+    let start_data = MeasuredSpectrum::new(
+        measured.lambda_nm().to_vec(),
+        shifted,
+        Some(measured.weights().to_vec()),
+    )?;
+    let start = fit_spectrum(&start_data, &opts.fit)?;
+    let mut seed_params = Parameter::SEED.to_vec();
+    if opts.geometry == Geometry::Sci && opts.fit_oiliness {
+        seed_params.push(Parameter::Oiliness);
+    }
+    let mut problem = Problem::new(measured, opts, unit_surface)?;
+    let n = measured.len() as f64;
+    let m = Parameter::CANDIDATES.len();
+    let criterion = |rms: f64, k: usize, j: usize| {
+        n * (rms / opts.noise).powi(2) + k as f64 * n.ln() + 2.0 * ln_binomial(m, j)
+    };
+    let plain_seed = opts.geometry == Geometry::Sce && opts.model == ModelChoice::Seed;
+    let (mut skin, mut rms) = if plain_seed {
+        // Today's fit, unchanged.
+        (start.skin, start.rms)
+    } else {
+        problem.refine(start.skin, &seed_params)?
+    };
+    let seed_rms = rms;
+    let mut params = seed_params.clone();
+    let mut steps = Vec::new();
+    match opts.model {
+        ModelChoice::Seed => {}
+        ModelChoice::Full => {
+            params.extend(Parameter::CANDIDATES);
+            (skin, rms) = problem.refine(skin, &params)?;
+        }
+        ModelChoice::Auto => {
+            let mut chosen = 0;
+            loop {
+                let remaining: Vec<Parameter> = Parameter::CANDIDATES
+                    .into_iter()
+                    .filter(|p| !params.contains(p))
+                    .collect();
+                let mut best: Option<(Parameter, SkinParams, f64)> = None;
+                for p in remaining {
+                    let mut trial = params.clone();
+                    trial.push(p);
+                    let (s, r) = problem.trial(skin, &trial)?;
+                    if best.as_ref().is_none_or(|b| r < b.2) {
+                        best = Some((p, s, r));
+                    }
+                }
+                let Some((p, s, _)) = best else { break };
+                let mut trial = params.clone();
+                trial.push(p);
+                // Two starts for the new parameter: where the trial left it, and mid-range (a
+                // parameter that trades off against the seed's, like blood near the surface
+                // against C_h, can sit in a long valley).
+                let [lo, hi] = p.range();
+                let mid = p.set(s, 0.5 * (lo + hi))?;
+                let (s, r) = {
+                    let a = problem.refine(s, &trial)?;
+                    let b = problem.refine(mid, &trial)?;
+                    if b.1 < a.1 { b } else { a }
+                };
+                let delta =
+                    criterion(r, trial.len(), chosen + 1) - criterion(rms, params.len(), chosen);
+                let accepted = delta < 0.0;
+                steps.push(SelectionStep {
+                    parameter: p,
+                    rms_before: rms,
+                    rms_after: r,
+                    delta_criterion: delta,
+                    accepted,
+                });
+                if !accepted {
+                    break;
+                }
+                (params, skin, rms, chosen) = (trial, s, r, chosen + 1);
+            }
+        }
+    }
+    let model = problem.full_model(&skin)?;
+    let chosen = params.len() - seed_params.len();
+    Ok(MeasuredFit {
+        surface_reflectance: skin.oiliness() * unit_surface,
+        criterion: criterion(rms, params.len(), chosen),
+        skin,
+        parameters: params,
+        model,
+        rms,
+        seed_rms,
+        steps,
+        start,
+        full_evaluations: problem.full_evals,
+        search_evaluations: problem.search_evals,
+    })
+}
+
+/// ln C(m, j).
+fn ln_binomial(m: usize, j: usize) -> f64 {
+    (0..j).map(|i| ((m - i) as f64 / (i + 1) as f64).ln()).sum()
+}
+
+/// Space-mapping rounds of a refinement at most (each one full-model spectrum and one LM run).
+const MAPPING_ROUNDS: usize = 4;
+
+/// The measurement, the two forward models and the current space-mapping shift.
+struct Problem<'a> {
+    measured: &'a MeasuredSpectrum,
+    lambdas: Vec<Wavelength>,
+    full: Forward,
+    search: Option<Forward>,
+    shift: Vec<f64>,
+    unit_surface: f64,
+    geometry: Geometry,
+    weight_sum: f64,
+    full_evals: usize,
+    search_evals: usize,
+}
+
+impl<'a> Problem<'a> {
+    fn new(
+        measured: &'a MeasuredSpectrum,
+        opts: &MeasuredOptions,
+        unit_surface: f64,
+    ) -> Result<Self, FitError> {
+        let lambdas = measured
+            .lambda_nm()
+            .iter()
+            .map(|&nm| Wavelength::new(nm))
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(Self {
+            measured,
+            shift: vec![0.0; lambdas.len()],
+            lambdas,
+            full: Forward::Method(opts.fit.method),
+            search: Forward::search(opts.fit.method, opts.fit.search_quadrature_points),
+            unit_surface,
+            geometry: opts.geometry,
+            weight_sum: measured.weights().iter().sum(),
+            full_evals: 0,
+            search_evals: 0,
+        })
+    }
+
+    /// What the instrument sees with forward model `f` (no shift).
+    fn seen(&self, f: &Forward, skin: &SkinParams) -> Result<Vec<f64>, FitError> {
+        let surface = match self.geometry {
+            Geometry::Sce => 0.0,
+            Geometry::Sci => skin.oiliness() * self.unit_surface,
+        };
+        Ok(f.spectrum(skin, &self.lambdas)?
+            .into_iter()
+            .map(|r| r + surface)
+            .collect())
+    }
+
+    fn full_model(&mut self, skin: &SkinParams) -> Result<Vec<f64>, FitError> {
+        self.full_evals += 1;
+        self.seen(&self.full, skin)
+    }
+
+    fn rms(&self, model: &[f64]) -> f64 {
+        self.residuals(model)
+            .iter()
+            .map(|r| r * r)
+            .sum::<f64>()
+            .sqrt()
+    }
+
+    /// √(wᵢ / Σw) (model − measured): their squares sum to the weighted mean square.
+    fn residuals(&self, model: &[f64]) -> Vec<f64> {
+        model
+            .iter()
+            .zip(self.measured.reflectance())
+            .zip(self.measured.weights())
+            .map(|((m, r), w)| (w / self.weight_sum).sqrt() * (m - r))
+            .collect()
+    }
+
+    /// LM over `params` from `skin` on the search model with the current shift (or the full model
+    /// when there is no cheaper one); returns the refined skin.
+    fn run(
+        &mut self,
+        skin: SkinParams,
+        params: &[Parameter],
+        budget: LmBudget,
+    ) -> Result<SkinParams, FitError> {
+        let forward = self.search.unwrap_or(self.full);
+        let to_skin = |u: &[f64]| -> Option<SkinParams> {
+            params.iter().zip(u).try_fold(skin, |s, (p, &v)| {
+                let [lo, hi] = p.range();
+                p.set(s, lo + (hi - lo) * v).ok()
+            })
+        };
+        let u0: Vec<f64> = params
+            .iter()
+            .map(|p| {
+                let [lo, hi] = p.range();
+                ((p.get(&skin) - lo) / (hi - lo)).clamp(0.0, 1.0)
+            })
+            .collect();
+        let mut evals = 0;
+        let mut residuals = |u: &[f64]| -> Option<Vec<f64>> {
+            evals += 1;
+            let s = to_skin(u)?;
+            let mut m = self.seen(&forward, &s).ok()?;
+            for (v, b) in m.iter_mut().zip(&self.shift) {
+                *v += b;
+            }
+            Some(self.residuals(&m))
+        };
+        let result = minimize(&mut residuals, &u0, budget);
+        if self.search.is_some() {
+            self.search_evals += evals;
+        } else {
+            self.full_evals += evals;
+        }
+        to_skin(&result.u).ok_or_else(|| {
+            FitError::NotEnoughData("refined parameters left their valid range".to_string())
+        })
+    }
+
+    /// Install the shift that makes the search model equal the full one at `skin`; returns the
+    /// full model's RMS there.
+    fn reshift(&mut self, skin: &SkinParams) -> Result<f64, FitError> {
+        let full = self.full_model(skin)?;
+        if let Some(search) = self.search {
+            self.search_evals += 1;
+            let cheap = self.seen(&search, skin)?;
+            self.shift = full.iter().zip(&cheap).map(|(f, c)| f - c).collect();
+        }
+        Ok(self.rms(&full))
+    }
+
+    /// Refine with space mapping until the full RMS stops falling; returns the best skin and its
+    /// full-model RMS.
+    fn refine(
+        &mut self,
+        skin: SkinParams,
+        params: &[Parameter],
+    ) -> Result<(SkinParams, f64), FitError> {
+        let mut best = (skin, self.reshift(&skin)?);
+        for _ in 0..MAPPING_ROUNDS {
+            let next = self.run(best.0, params, LM)?;
+            let r = self.reshift(&next)?;
+            let gain = best.1 - r;
+            if r < best.1 {
+                best = (next, r);
+            } else {
+                self.reshift(&best.0)?;
+            }
+            if self.search.is_none() || gain <= 1e-3 * best.1 {
+                break;
+            }
+        }
+        Ok(best)
+    }
+
+    /// A quick trial of `params` from `skin` on the current shift (no re-shift): the selection's
+    /// ranking of candidates. Returns the trial skin and its shifted-model RMS.
+    fn trial(
+        &mut self,
+        skin: SkinParams,
+        params: &[Parameter],
+    ) -> Result<(SkinParams, f64), FitError> {
+        let s = self.run(
+            skin,
+            params,
+            LmBudget {
+                max_iterations: 15,
+                ..LM
+            },
+        )?;
+        let forward = self.search.unwrap_or(self.full);
+        let mut m = self.seen(&forward, &s)?;
+        for (v, b) in m.iter_mut().zip(&self.shift) {
+            *v += b;
+        }
+        Ok((s, self.rms(&m)))
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,227 @@
+//! Bounded Levenberg–Marquardt on a unit box, for the extended spectrum fit (module `extended`).
+//!
+//! Minimises Σ rᵢ(u)² over u ∈ [0, 1]^k with a forward-difference Jacobian. Each step solves the
+//! damped normal equations (JᵀJ + λ diag(JᵀJ)) δ = −Jᵀr (Marquardt 1963) and projects onto the box;
+//! a coordinate at a bound whose step points outward is held there for that step (a simple active
+//! set), so parameters whose best value is "off" (a blood fraction of 0) rest on their bound.
+//! k ≤ 12, so the k × k system is solved by Gaussian elimination with partial pivoting here rather
+//! than through a linear-algebra crate.
+
+/// Knobs of one minimisation.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct LmBudget {
+    /// Most iterations (each one Jacobian: k + 1 residual evaluations, plus rejected trials).
+    pub max_iterations: usize,
+    /// Stop when an accepted step lowers the cost by less than this fraction.
+    pub f_rtol: f64,
+    /// Forward-difference step in unit coordinates.
+    pub h: f64,
+}
+
+/// The default budget: 1e-4 of each range per difference step is well above the forward model's
+/// rounding (~1e-12 in reflectance) and well below any reported digit.
+pub(crate) const LM: LmBudget = LmBudget {
+    max_iterations: 60,
+    f_rtol: 1e-7,
+    h: 1e-4,
+};
+
+/// Result of [`minimize`]: the point, its cost Σ r², and the residual evaluations spent.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct LmResult {
+    pub u: Vec<f64>,
+    pub cost: f64,
+    pub evals: usize,
+}
+
+/// Minimise Σ r(u)² from `u0` in [0, 1]^k. `residuals` returns `None` where the model fails,
+/// which counts as an infinitely bad point.
+pub(crate) fn minimize(
+    residuals: &mut impl FnMut(&[f64]) -> Option<Vec<f64>>,
+    u0: &[f64],
+    budget: LmBudget,
+) -> LmResult {
+    let k = u0.len();
+    let mut u: Vec<f64> = u0.iter().map(|v| v.clamp(0.0, 1.0)).collect();
+    let mut evals = 1;
+    let Some(mut r) = residuals(&u) else {
+        return LmResult {
+            u,
+            cost: f64::INFINITY,
+            evals,
+        };
+    };
+    let mut cost = sum_sq(&r);
+    let mut lambda = 1e-3;
+    for _ in 0..budget.max_iterations {
+        // Jacobian columns by forward differences (backward at the upper bound).
+        let mut jac: Vec<Vec<f64>> = Vec::with_capacity(k);
+        for j in 0..k {
+            let step = if u[j] + budget.h <= 1.0 {
+                budget.h
+            } else {
+                -budget.h
+            };
+            let mut up = u.clone();
+            up[j] += step;
+            evals += 1;
+            let Some(rj) = residuals(&up) else {
+                return LmResult { u, cost, evals };
+            };
+            jac.push(rj.iter().zip(&r).map(|(a, b)| (a - b) / step).collect());
+        }
+        let jtj =
+            |a: usize, b: usize| -> f64 { jac[a].iter().zip(&jac[b]).map(|(x, y)| x * y).sum() };
+        let grad: Vec<f64> = (0..k)
+            .map(|j| jac[j].iter().zip(&r).map(|(x, y)| x * y).sum())
+            .collect();
+        let normal: Vec<Vec<f64>> = (0..k)
+            .map(|a| (0..k).map(|b| jtj(a, b)).collect())
+            .collect();
+        let mut improved = false;
+        while lambda < 1e10 {
+            let Some(trial) = damped_step(&normal, &grad, &u, lambda) else {
+                lambda *= 10.0;
+                continue;
+            };
+            evals += 1;
+            match residuals(&trial) {
+                Some(rt) if sum_sq(&rt) < cost => {
+                    let new_cost = sum_sq(&rt);
+                    let gain = (cost - new_cost) / cost.max(f64::MIN_POSITIVE);
+                    (u, r, cost) = (trial, rt, new_cost);
+                    lambda = (lambda / 3.0).max(1e-9);
+                    improved = gain > budget.f_rtol;
+                    break;
+                }
+                _ => lambda *= 4.0,
+            }
+        }
+        if !improved {
+            break;
+        }
+    }
+    LmResult { u, cost, evals }
+}
+
+fn sum_sq(r: &[f64]) -> f64 {
+    r.iter().map(|v| v * v).sum()
+}
+
+/// The projected damped Gauss–Newton point from `u`, holding coordinates at a bound whose step
+/// points outward; `None` if the system is singular.
+fn damped_step(normal: &[Vec<f64>], grad: &[f64], u: &[f64], lambda: f64) -> Option<Vec<f64>> {
+    let k = u.len();
+    let mut free: Vec<usize> = (0..k).collect();
+    for _ in 0..2 {
+        let m = free.len();
+        let a: Vec<Vec<f64>> = free
+            .iter()
+            .map(|&i| {
+                free.iter()
+                    .map(|&j| {
+                        let d = if i == j {
+                            lambda * normal[i][i].max(1e-12)
+                        } else {
+                            0.0
+                        };
+                        normal[i][j] + d
+                    })
+                    .collect()
+            })
+            .collect();
+        let b: Vec<f64> = free.iter().map(|&i| -grad[i]).collect();
+        let delta = solve(a, b)?;
+        let blocked: Vec<usize> = (0..m)
+            .filter(|&q| {
+                let i = free[q];
+                (u[i] <= 0.0 && delta[q] < 0.0) || (u[i] >= 1.0 && delta[q] > 0.0)
+            })
+            .collect();
+        if blocked.is_empty() || m == blocked.len() {
+            let mut out = u.to_vec();
+            for (q, &i) in free.iter().enumerate() {
+                out[i] = (u[i] + delta[q]).clamp(0.0, 1.0);
+            }
+            return Some(out);
+        }
+        free = (0..m)
+            .filter(|q| !blocked.contains(q))
+            .map(|q| free[q])
+            .collect();
+    }
+    None
+}
+
+/// Solve the dense system `a x = b` by Gaussian elimination with partial pivoting.
+fn solve(mut a: Vec<Vec<f64>>, mut b: Vec<f64>) -> Option<Vec<f64>> {
+    let n = b.len();
+    for c in 0..n {
+        let p = (c..n).max_by(|&i, &j| a[i][c].abs().total_cmp(&a[j][c].abs()))?;
+        if a[p][c].abs() < 1e-300 || !a[p][c].is_finite() {
+            return None;
+        }
+        a.swap(c, p);
+        b.swap(c, p);
+        let (pivot_rows, rest) = a.split_at_mut(c + 1);
+        let pivot = &pivot_rows[c];
+        for (k, row) in rest.iter_mut().enumerate() {
+            let f = row[c] / pivot[c];
+            for (x, p) in row[c..].iter_mut().zip(&pivot[c..]) {
+                *x -= f * p;
+            }
+            b[c + 1 + k] -= f * b[c];
+        }
+    }
+    let mut x = vec![0.0; n];
+    for row in (0..n).rev() {
+        let s: f64 = (row + 1..n).map(|col| a[row][col] * x[col]).sum();
+        x[row] = (b[row] - s) / a[row][row];
+    }
+    Some(x)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A linear least-squares problem is solved exactly (to the stopping tolerance), and an optimum
+    /// outside the box lands on the bound with the free coordinate still optimal.
+    #[test]
+    fn solves_linear_problems_and_respects_the_box() {
+        // r = (u0 − 0.3, 2(u1 − 0.6), u0 + u1 − 0.9): minimum at (0.3, 0.6), cost 0.
+        let mut f = |u: &[f64]| Some(vec![u[0] - 0.3, 2.0 * (u[1] - 0.6), u[0] + u[1] - 0.9]);
+        let m = minimize(&mut f, &[0.9, 0.1], LM);
+        assert!(
+            (m.u[0] - 0.3).abs() < 1e-6 && (m.u[1] - 0.6).abs() < 1e-6,
+            "{m:?}"
+        );
+        // Unconstrained minimum at u0 = −0.5: held at 0, u1 free at 0.7.
+        let mut g = |u: &[f64]| Some(vec![u[0] + 0.5, u[1] - 0.7]);
+        let m = minimize(&mut g, &[0.5, 0.5], LM);
+        assert_eq!(m.u[0], 0.0);
+        assert!((m.u[1] - 0.7).abs() < 1e-6, "{m:?}");
+    }
+
+    #[test]
+    fn rosenbrock_valley_is_followed() {
+        // r = (10 (u1 − u0²), 1 − u0) on the box, minimum (1, 1) on the corner... shifted inside:
+        // with v = 2u − 0.5 the minimum is at u = (0.75, 0.75).
+        let mut f = |u: &[f64]| {
+            let (x, y) = (2.0 * u[0] - 0.5, 2.0 * u[1] - 0.5);
+            Some(vec![10.0 * (y - x * x), 1.0 - x])
+        };
+        let m = minimize(
+            &mut f,
+            &[0.1, 0.9],
+            LmBudget {
+                max_iterations: 500,
+                ..LM
+            },
+        );
+        assert!(
+            (m.u[0] - 0.75).abs() < 1e-4 && (m.u[1] - 0.75).abs() < 1e-4,
+            "{m:?}"
+        );
+    }
+}
