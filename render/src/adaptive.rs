@@ -47,8 +47,8 @@ impl Accumulator {
             self.count[i] += 1;
             return;
         }
-        for c in 0..3 {
-            self.sum_xyz[i][c] += f64::from(xyz[c]);
+        for (sum, v) in self.sum_xyz[i].iter_mut().zip(xyz) {
+            *sum += f64::from(v);
         }
         self.sum_y2[i] += f64::from(xyz[1]).powi(2);
         self.count[i] += 1;

@@ -6,7 +6,7 @@ use multipole::Method;
 use multipole::adding_doubling::{AddingDoublingOptions, skin_totals};
 use multipole::skin::diffuse_reflectance;
 use skin_optics::{Extension, Physiology, Preset, SkinParams, Wavelength};
-use validation::montecarlo::{LayerStack, McOptions, run};
+use validation::montecarlo::{LayeredMedium, McOptions, run};
 
 fn extended(e: Extension, v: f64) -> SkinParams {
     let x = Physiology::SEED.with(e, v).unwrap();
@@ -39,7 +39,7 @@ fn extensions_change_every_method_and_exact_agrees_with_monte_carlo() {
         let exact = skin_totals(&skin, l, &AddingDoublingOptions::default())
             .unwrap()
             .diffuse_reflectance;
-        let stack = LayerStack::skin(&skin, l, 0.9).unwrap();
+        let stack = LayeredMedium::skin(&skin, l, 0.9).unwrap();
         let mc = run(&stack, &McOptions::new(photons(100_000), 20, 7).unwrap());
         let rd = mc.diffuse_reflectance;
         let tol = 4.0 * rd.stderr + 0.015 * exact;
@@ -51,7 +51,7 @@ fn extensions_change_every_method_and_exact_agrees_with_monte_carlo() {
             rd.stderr
         );
         let seed_mc = run(
-            &LayerStack::skin(&base, l, 0.9).unwrap(),
+            &LayeredMedium::skin(&base, l, 0.9).unwrap(),
             &McOptions::new(photons(100_000), 20, 7).unwrap(),
         );
         let d = rd.mean - seed_mc.diffuse_reflectance.mean;
