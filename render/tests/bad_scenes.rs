@@ -109,10 +109,10 @@ fn invalid_skin_parameter_is_named() {
 fn non_finite_transform_is_named() {
     let text = GOOD.replace("translate_mm = [0, 0, 0]", "translate_mm = [nan, 0, 0]");
     let e = render_text("nan", &text).unwrap_err();
-    assert_mentions(&e, &["scene.toml", "meshes[0].translate_mm", "finite"]);
+    assert_mentions(&e, &["scene.toml", "translate_mm", "finite"]);
     let text = GOOD.replace("scale = 50", "scale = inf");
     let e = render_text("inf", &text).unwrap_err();
-    assert_mentions(&e, &["meshes[0].scale", "finite"]);
+    assert_mentions(&e, &["scale", "finite"]);
 }
 
 #[test]

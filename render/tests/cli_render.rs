@@ -140,7 +140,7 @@ fn assert_outputs(s: &Scratch, out: &Output) -> [f64; 3] {
     names.sort();
     assert_eq!(names, ["render.exr", "render.png"], "no temporaries left");
     let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(stdout.contains("rendered 8×8 at 4 spp"), "{stdout}");
+    assert!(stdout.contains("rendered 8×8 at 4.0 spp"), "{stdout}");
     exr_mean(&s.out().join("render.exr"), 8, 8)
 }
 
