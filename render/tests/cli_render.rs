@@ -182,3 +182,19 @@ fn multipole_render_with_and_without_subsurface_agree_on_a_slab() {
         );
     }
 }
+
+#[test]
+fn out_in_proc_fails_before_the_scene_loads() {
+    let s = Scratch::new();
+    let out = s.render(&["--out", "/proc/skin-no-such/x"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("--out") && stderr.contains("writable"),
+        "{stderr}"
+    );
+    assert!(
+        !stderr.contains("loaded in"),
+        "the scene was loaded: {stderr}"
+    );
+}

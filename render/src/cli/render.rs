@@ -99,6 +99,12 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     }
     .validate()
     .map_err(flag_error)?;
+    // Checked before any work, so an unwritable --out does not waste the scene load and render.
+    std::fs::create_dir_all(&args.out)
+        .and_then(|()| tempfile::tempfile_in(&args.out))
+        .map_err(|e| {
+            anyhow::anyhow!("--out {}: not a writable folder ({e})", args.out.display())
+        })?;
     let t0 = Instant::now();
     let scene = Scene::load(
         &args.scene,
@@ -118,6 +124,12 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         load.as_secs_f64()
     );
     let (film, stats) = render(&scene, &settings)?;
+    if film.dropped_samples() > 0 {
+        eprintln!(
+            "dropped {} non-finite samples (not averaged into any pixel)",
+            film.dropped_samples()
+        );
+    }
     let exr = args.out.join("render.exr");
     let png = args.out.join("render.png");
     let passes = crate::passes::Passes::first_hit(&scene, settings.width, settings.height);
