@@ -109,10 +109,47 @@ fn invalid_skin_parameter_is_named() {
 fn non_finite_transform_is_named() {
     let text = GOOD.replace("translate_mm = [0, 0, 0]", "translate_mm = [nan, 0, 0]");
     let e = render_text("nan", &text).unwrap_err();
-    assert_mentions(&e, &["scene.toml", "translate_mm", "finite"]);
+    // Refused while parsing, on one line with its position.
+    assert_mentions(&e, &["scene.toml", "line 15, column 16", "finite"]);
+    assert!(!e.contains('\n'), "{e}");
     let text = GOOD.replace("scale = 50", "scale = inf");
     let e = render_text("inf", &text).unwrap_err();
-    assert_mentions(&e, &["scale", "finite"]);
+    assert_mentions(&e, &["line 14, column 9", "finite"]);
+}
+
+#[test]
+fn geometry_placed_beyond_2e19_mm_is_named() {
+    for (case, placement) in [
+        ("scale", "scale = 1e25"),
+        ("translate", "scale = 50\ntranslate_mm = [3e38, 0, 0]"),
+        ("units", "scale = 50\nunits_mm = 2e19"),
+    ] {
+        let text = GOOD
+            .replace("translate_mm = [0, 0, 0]", "")
+            .replace("scale = 50", placement);
+        let e = render_text(case, &text).unwrap_err();
+        assert_mentions(&e, &["scene.toml", "meshes[0]", "±1e9 mm"]);
+    }
+}
+
+#[test]
+fn dev_zero_as_scene_mesh_texture_or_environment_is_refused_before_reading() {
+    let cli = Cli::parse_from(["render", "--scene", "/dev/zero", "--quiet"]);
+    let e = format!("{:#}", run(&cli.args).unwrap_err());
+    assert_mentions(&e, &["/dev/zero", ".toml"]);
+    let mesh = GOOD.replace("shape = \"sphere\"", "file = \"/dev/zero\"");
+    let e = render_text("zero-mesh", &mesh).unwrap_err();
+    assert_mentions(&e, &["/dev/zero", ".glb or .obj"]);
+    let env = format!("{GOOD}\n[environment]\nexr = \"/dev/zero\"\nintensity = 1\n");
+    let e = render_text("zero-env", &env).unwrap_err();
+    assert_mentions(&e, &["/dev/zero", ".exr"]);
+}
+
+#[test]
+fn toml_errors_take_one_line() {
+    let e = render_text("toml", "[camera\n").unwrap_err();
+    assert_mentions(&e, &["scene.toml", "line 1"]);
+    assert!(!e.contains('\n'), "{e}");
 }
 
 #[test]

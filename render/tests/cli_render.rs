@@ -46,27 +46,25 @@ impl Scratch {
         self.dir.path().join("out")
     }
 
-    /// `skin render` on the slab into `out` with a tiny image and `extra` flags.
+    /// `skin render` on the slab into `out` with a tiny image and `extra` flags (which replace the
+    /// defaults set here: clap refuses a flag given twice).
     fn render(&self, extra: &[&str]) -> Output {
         let (scene, out) = (self.scene(), self.out().display().to_string());
-        let mut args = vec![
-            "render",
-            "--scene",
-            &scene,
-            "--out",
-            &out,
-            "--width",
-            "8",
-            "--height",
-            "8",
-            "--spp",
-            "4",
-            "--time-limit",
-            "0",
-            "--threads",
-            "1",
-            "--quiet",
+        let defaults = [
+            ["--scene", scene.as_str()],
+            ["--out", out.as_str()],
+            ["--width", "8"],
+            ["--height", "8"],
+            ["--spp", "4"],
+            ["--time-limit", "0"],
+            ["--threads", "1"],
         ];
+        let mut args = vec!["render", "--quiet"];
+        for [flag, value] in defaults {
+            if !extra.contains(&flag) {
+                args.extend([flag, value]);
+            }
+        }
         args.extend_from_slice(extra);
         Command::new(env!("CARGO_BIN_EXE_skin"))
             .args(&args)
@@ -97,6 +95,20 @@ fn zero_samples_per_pixel_is_a_usage_error() {
 #[test]
 fn zero_threads_is_a_usage_error() {
     assert_flag_error(&["--threads", "0"], "--threads");
+}
+
+#[test]
+fn time_limit_1e20_names_the_flag_and_range() {
+    assert_flag_error(&["--time-limit", "1e20"], "[0, 1e9] seconds");
+}
+
+#[test]
+fn width_minus_one_names_the_flag_range() {
+    assert_flag_error(&["--width", "-1"], "[1, 16384] pixels");
+    assert_flag_error(&["--height", "-inf"], "--height");
+    assert_flag_error(&["--spp", "-1"], "--spp");
+    assert_flag_error(&["--max-depth", "-3"], "[1, 1024]");
+    assert_flag_error(&["--noise", "-0.5"], "[0, 1)");
 }
 
 #[test]
@@ -169,4 +181,20 @@ fn multipole_render_with_and_without_subsurface_agree_on_a_slab() {
             "channel {c}: BSSRDF {bssrdf:?} vs Lambertian {lambert:?}"
         );
     }
+}
+
+#[test]
+fn out_in_proc_fails_before_the_scene_loads() {
+    let s = Scratch::new();
+    let out = s.render(&["--out", "/proc/skin-no-such/x"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("--out") && stderr.contains("writable"),
+        "{stderr}"
+    );
+    assert!(
+        !stderr.contains("loaded in"),
+        "the scene was loaded: {stderr}"
+    );
 }

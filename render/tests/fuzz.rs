@@ -358,11 +358,8 @@ fn print_and_check(rows: &[(&str, Tally)]) {
     }
 }
 
-/// Scenes, loaded and rendered. Ignored for now: placement values that put geometry beyond
-/// about 2e19 mm (`scale = 3e38`, `translate_mm = [3e38, 0, 0]`) still panic in the BVH build,
-/// because the loader checks coordinates before the placement transform, not after.
+/// Scenes, loaded and rendered.
 #[test]
-#[ignore = "placement can still overflow the BVH build"]
 fn fuzzed_scenes_load_and_render_or_give_a_one_line_error() {
     std::panic::set_hook(Box::new(|info| eprintln!("panic: {info}")));
     let rows = [(

@@ -1,9 +1,11 @@
 //! `skin render`: load a scene (the built-in three-head scene by default), path trace it, and write
 //! OUT/render.exr (linear sRGB, f32, with the passes of `render::passes`) and OUT/render.png (sRGB, exposure + filmic tone curve).
 
+use crate::cli::args::{Checked, parse_number, parse_whole};
 use crate::renderer::{RenderOptions, SettingError, render};
 use crate::scene::{Scene, SceneOptions};
 use clap::Args;
+use skin_optics::echo::Num;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
@@ -17,27 +19,27 @@ pub struct RenderArgs {
     #[arg(long, value_name = "DIR", default_value = "out")]
     pub out: PathBuf,
     /// Samples (paths) per pixel: the most any pixel takes (all take it with --noise 0).
-    #[arg(long, value_name = "N", default_value_t = 4096, value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, value_name = "N", default_value_t = 4096, value_parser = Checked(parse_spp), allow_hyphen_values = true)]
     pub spp: u32,
     /// Per-pixel relative noise target (0.02 = 2%, relative to the pixel's luminance, or to 15%
     /// of the 95th percentile in the dark): a pixel stops sampling once its noise estimated from
     /// its own samples is below it. 0 = off: every pixel takes --spp samples.
-    #[arg(long, value_name = "REL", default_value_t = 0.02)]
+    #[arg(long, value_name = "REL", default_value_t = 0.02, value_parser = Checked(parse_noise), allow_hyphen_values = true)]
     pub noise: f64,
     /// Image width, pixels.
-    #[arg(long, value_name = "W", default_value_t = 768, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    #[arg(long, value_name = "W", default_value_t = 768, value_parser = Checked(parse_pixels), allow_hyphen_values = true)]
     pub width: u32,
     /// Image height, pixels.
-    #[arg(long, value_name = "H", default_value_t = 384, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    #[arg(long, value_name = "H", default_value_t = 384, value_parser = Checked(parse_pixels), allow_hyphen_values = true)]
     pub height: u32,
-    /// Wall-clock budget in seconds: no pass starts that would end past it (0 = no limit).
-    #[arg(long, value_name = "SECONDS", default_value_t = 60.0)]
+    /// Wall-clock budget in seconds, in [0, 1e9]: no pass starts that would end past it (0 = no limit).
+    #[arg(long, value_name = "SECONDS", default_value_t = 60.0, value_parser = Checked(parse_time_limit), allow_hyphen_values = true)]
     pub time_limit: f64,
     /// Seed of all random numbers (same seed and spp give the same image on any thread count).
     #[arg(long, value_name = "S", default_value_t = 1)]
     pub seed: u64,
     /// Worker threads (default: all cores).
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=1024))]
+    #[arg(long, value_name = "N", value_parser = Checked(parse_small_count), allow_hyphen_values = true)]
     pub threads: Option<u32>,
     /// Skin reflectance method (the BSSRDF's radial profiles and the totals): exact (adding-doubling
     /// totals, layered Monte Carlo profile shapes) or multipole (the paper's diffusion).
@@ -48,7 +50,7 @@ pub struct RenderArgs {
     /// energy-weighted shape error), instead of the default shapes from the universal table
     /// (exact transport, 1–3% against a 10⁶-photon Monte Carlo, no run-time photons).
     #[arg(long, value_name = "N",
-          value_parser = clap::value_parser!(u64).range(100..=1_000_000_000))]
+          value_parser = Checked(parse_escapes), allow_hyphen_values = true)]
     pub shape_escapes: Option<u64>,
     /// Shade skin's body with a Lambertian term of its total diffuse reflectance instead of the
     /// BSSRDF (no light transport under the skin; for comparisons and timing).
@@ -64,7 +66,7 @@ pub struct RenderArgs {
     pub exposure: f32,
     /// Maximum scattering events per path, in [1, 1024].
     #[arg(long, value_name = "N", default_value_t = 16,
-          value_parser = clap::value_parser!(u32).range(1..=1024))]
+          value_parser = Checked(parse_small_count), allow_hyphen_values = true)]
     pub max_depth: u32,
     /// No progress bar.
     #[arg(long)]
@@ -73,12 +75,6 @@ pub struct RenderArgs {
 
 /// Run `skin render`.
 pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
-    if !(args.time_limit.is_finite() && args.time_limit >= 0.0) {
-        anyhow::bail!("--time-limit = {} outside [0, ∞) seconds", args.time_limit);
-    }
-    if !(args.noise.is_finite() && (0.0..1.0).contains(&args.noise)) {
-        anyhow::bail!("--noise = {} outside [0, 1) (0 = off)", args.noise);
-    }
     if !args.exposure.is_finite() {
         anyhow::bail!(
             "--exposure = {} is not a finite number of stops",
@@ -103,6 +99,12 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     }
     .validate()
     .map_err(flag_error)?;
+    // Checked before any work, so an unwritable --out does not waste the scene load and render.
+    std::fs::create_dir_all(&args.out)
+        .and_then(|()| tempfile::tempfile_in(&args.out))
+        .map_err(|e| {
+            anyhow::anyhow!("--out {}: not a writable folder ({e})", args.out.display())
+        })?;
     let t0 = Instant::now();
     let scene = Scene::load(
         &args.scene,
@@ -122,6 +124,12 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         load.as_secs_f64()
     );
     let (film, stats) = render(&scene, &settings)?;
+    if film.dropped_samples() > 0 {
+        eprintln!(
+            "dropped {} non-finite samples (not averaged into any pixel)",
+            film.dropped_samples()
+        );
+    }
     let exr = args.out.join("render.exr");
     let png = args.out.join("render.png");
     let passes = crate::passes::Passes::first_hit(&scene, settings.width, settings.height);
@@ -166,6 +174,44 @@ fn flag_error(e: SettingError) -> anyhow::Error {
         other => other,
     };
     anyhow::anyhow!("{flag} = {} outside {}", e.value, e.range)
+}
+
+/// The longest `--time-limit`, seconds (about 32 years): far inside what `Duration` holds.
+const MAX_TIME_LIMIT_S: f64 = 1e9;
+
+fn parse_time_limit(s: &str) -> Result<f64, String> {
+    let v = parse_number(s, "[0, 1e9] seconds")?;
+    if !(0.0..=MAX_TIME_LIMIT_S).contains(&v) {
+        return Err(format!(
+            "{} outside [0, 1e9] seconds (0 = no limit)",
+            Num(v)
+        ));
+    }
+    Ok(v)
+}
+
+fn parse_noise(s: &str) -> Result<f64, String> {
+    let v = parse_number(s, "[0, 1)")?;
+    if !(0.0..1.0).contains(&v) {
+        return Err(format!("{} outside [0, 1) (0 = off)", Num(v)));
+    }
+    Ok(v)
+}
+
+fn parse_pixels(s: &str) -> Result<u32, String> {
+    parse_whole(s, 1, 16384, "[1, 16384] pixels").map(|v| v as u32)
+}
+
+fn parse_spp(s: &str) -> Result<u32, String> {
+    parse_whole(s, 1, u64::from(u32::MAX), "[1, 4294967295]").map(|v| v as u32)
+}
+
+fn parse_small_count(s: &str) -> Result<u32, String> {
+    parse_whole(s, 1, 1024, "[1, 1024]").map(|v| v as u32)
+}
+
+fn parse_escapes(s: &str) -> Result<u64, String> {
+    parse_whole(s, 100, 1_000_000_000, "[100, 1e9]")
 }
 
 fn rayon_threads(requested: Option<usize>) -> usize {

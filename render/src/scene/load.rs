@@ -5,7 +5,8 @@ use super::Scene;
 use crate::builtin;
 use crate::camera::Camera;
 use crate::error::RenderError;
-use crate::geometry::Geometry;
+use crate::geometry::{Geometry, MAX_COORD_MM, within_scene};
+use crate::input::{self, InputKind};
 use crate::light::{
     DistantLight, EmissionShape, Environment, Light, PointLight, QuadLight, SphereLight, SpotLight,
 };
@@ -15,6 +16,7 @@ use crate::scene_file::{EnvironmentDesc, LightDesc, MeshDesc, SceneDesc, ShapeKi
 use crate::spectrum::SpectrumTable;
 use crate::texture::Texture;
 use glam::Vec3;
+use skin_optics::echo::Num;
 use std::borrow::Cow;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -55,12 +57,14 @@ impl Loader<'_> {
         }
     }
 
-    /// Bytes of a referenced file (or built-in asset) and its resolved path.
+    /// Bytes of a referenced file (or built-in asset) and its resolved path, read through the
+    /// guarded reader of `kind` (extension, regular file, size cap).
     pub(super) fn read(
         &self,
-        what: &'static str,
+        kind: InputKind,
         spec: &str,
     ) -> Result<(Cow<'static, [u8]>, PathBuf), RenderError> {
+        let what = kind.what;
         if let Some(name) = spec.strip_prefix(builtin::PREFIX) {
             return builtin::asset(name)
                 .map(|b| (Cow::Borrowed(b), PathBuf::from(spec)))
@@ -77,9 +81,8 @@ impl Loader<'_> {
             Some(dir) => dir.join(spec),
             None => PathBuf::from(spec),
         };
-        std::fs::read(&path)
-            .map(|b| (Cow::Owned(b), path.clone()))
-            .map_err(|source| RenderError::MissingFile { what, path, source })
+        let bytes = kind.read(&path)?;
+        Ok((Cow::Owned(bytes), path))
     }
 
     fn emission(
@@ -176,6 +179,20 @@ impl Loader<'_> {
                 translate_mm: self.vec3(&format!("{key}.translate_mm"), m.translate_mm)?,
             };
             mesh.transform(&placement.to_affine());
+            // The BVH builder needs finite bounds well inside f32 range: check after placement,
+            // where units_mm × scale and translate_mm may push an in-range model out of it.
+            if let Some(p) = mesh.positions.iter().find(|&&p| !within_scene(p)) {
+                return Err(self.err(
+                    &key,
+                    format!(
+                        "a vertex lands at [{}, {}, {}] mm after units_mm, scale, rotate_deg and \
+                         translate_mm; every coordinate must lie within ±{MAX_COORD_MM:e} mm",
+                        Num(p.x.into()),
+                        Num(p.y.into()),
+                        Num(p.z.into())
+                    ),
+                ));
+            }
             if m.flip_v
                 && let Some(uvs) = &mut mesh.uvs
             {
@@ -225,7 +242,7 @@ impl Loader<'_> {
                 if let Some(mesh) = cache.get(file) {
                     return Ok(mesh.clone());
                 }
-                let (bytes, path) = self.read("mesh", file)?;
+                let (bytes, path) = self.read(input::MESH, file)?;
                 let lower = file.to_ascii_lowercase();
                 let mesh = if lower.ends_with(".glb") {
                     TriangleMesh::from_glb(&bytes, &path)?
@@ -347,7 +364,7 @@ impl Loader<'_> {
         match &e.exr {
             Some(file) => {
                 let scale = self.non_negative("environment.intensity", e.intensity)?;
-                let (bytes, path) = self.read("environment map", file)?;
+                let (bytes, path) = self.read(input::ENVIRONMENT, file)?;
                 Ok(Environment::LatLong {
                     map: Texture::from_exr_bytes(&bytes, &path)?,
                     scale,

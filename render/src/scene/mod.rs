@@ -77,11 +77,7 @@ impl Scene {
             return Scene::from_toml(text, spec, None, opts);
         }
         let path = Path::new(spec);
-        let text = std::fs::read_to_string(path).map_err(|source| RenderError::MissingFile {
-            what: "scene",
-            path: path.to_path_buf(),
-            source,
-        })?;
+        let text = crate::input::SCENE.read_text(path)?;
         Scene::from_toml(&text, spec, path.parent(), opts)
     }
 
@@ -92,10 +88,11 @@ impl Scene {
         base_dir: Option<&Path>,
         opts: &SceneOptions,
     ) -> Result<Scene, RenderError> {
-        let desc: SceneDesc = toml::from_str(text).map_err(|e| RenderError::SceneSyntax {
-            file: file.to_string(),
-            message: e.to_string().trim_end().to_string(),
-        })?;
+        let desc: SceneDesc =
+            crate::scene_file::parse(text).map_err(|message| RenderError::SceneSyntax {
+                file: file.to_string(),
+                message,
+            })?;
         Loader {
             file,
             base_dir,
