@@ -152,23 +152,35 @@ fn assert_outputs(s: &Scratch, out: &Output) -> [f64; 3] {
     names.sort();
     assert_eq!(names, ["render.exr", "render.png"], "no temporaries left");
     let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(stdout.contains("rendered 8×8 at 4.0 spp"), "{stdout}");
+    assert!(stdout.contains("rendered 8×8 at "), "{stdout}");
     exr_mean(&s.out().join("render.exr"), 8, 8)
 }
 
 /// On a flat slab under a distant light the BSSRDF and the Lambertian stand-in render the same
 /// radiance by construction of the energy split (`render::material`): both are
-/// E [f_s + T(0°)² R_tot / (π c)] with the same R_tot. With 64 pixels × 4 paths the per-channel
-/// means agree within 3% (the subsurface branch's only noise on this uniform slab is the branch
-/// choice and the probe-ray misses at the image edge; measured difference below 1%).
+/// E [f_s + T(0°)² R_tot / (π c)] with the same R_tot. Tolerance: the renderer estimates 64%
+/// per-pixel noise at 4 spp here, so at a fixed 1024 spp (no noise target) a pixel carries 4%,
+/// the 64-pixel mean 0.5% and the difference of two renders 0.7%: 3% is about 4σ. Measured:
+/// −0.9 / −0.1 / +0.8% (R, G, B).
 #[test]
 fn multipole_render_with_and_without_subsurface_agree_on_a_slab() {
     let with = Scratch::new();
-    let bssrdf = assert_outputs(&with, &with.render(&["--method", "multipole"]));
+    let bssrdf = assert_outputs(
+        &with,
+        &with.render(&["--method", "multipole", "--spp", "1024", "--noise", "0"]),
+    );
     let without = Scratch::new();
     let lambert = assert_outputs(
         &without,
-        &without.render(&["--method", "multipole", "--no-subsurface"]),
+        &without.render(&[
+            "--method",
+            "multipole",
+            "--no-subsurface",
+            "--spp",
+            "1024",
+            "--noise",
+            "0",
+        ]),
     );
     eprintln!(
         "BSSRDF / Lambertian − 1 = {:?}",
