@@ -13,7 +13,8 @@
 //!
 //! [materials.face]
 //! type = "skin"
-//! preset = "light"         # light, medium, dark; melanin, eumelanin, hemoglobin, oil override it
+//! preset = "light"         # light (= paper), medium, dark, or a measured preset (`skin presets`:
+//!                          # ca-forehead, ..., ita-tan); melanin, eumelanin, hemoglobin, oil override it
 //! albedo_texture = "builtin:Map-COL.jpg"
 //!
 //! [materials.wall]
@@ -237,7 +238,7 @@ pub struct EnvironmentDesc {
 pub enum MaterialDesc {
     /// Skin: a preset with optional explicit fractions.
     Skin {
-        /// light, medium or dark (default light).
+        /// A seed preset (light = paper, medium, dark) or a measured one (`skin presets`); default light.
         preset: Option<String>,
         /// Melanin fraction C_m, [0, 1].
         melanin: Option<f64>,

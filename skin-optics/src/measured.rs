@@ -6,7 +6,7 @@
 //! colour is its fitted skin's diffuse (SCE) reflectance under D65.
 
 use crate::lab::{ItaCategory, Lab};
-use crate::params::SkinParams;
+use crate::params::{Preset, SkinParams};
 use crate::physiology::{Extension, Physiology};
 use std::sync::OnceLock;
 
@@ -67,6 +67,26 @@ pub fn find_measured(name: &str) -> Option<&'static MeasuredPreset> {
             .find(|(k, _)| *k == n)
             .map(|(_, p)| p)
     })
+}
+
+/// Error for a skin name that is neither a seed preset nor a measured one (the name as given, cut
+/// by [`crate::echo::text`]).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error(
+    "unknown skin preset '{0}' (valid: light or paper, medium, dark, or a measured preset such as ca-forehead or ita-tan; `skin presets` lists them)"
+)]
+pub struct UnknownSkin(pub String);
+
+/// The skin called `name` (case-insensitive): a seed [`Preset`] (`light` = `paper`, `medium`,
+/// `dark`) or a measured preset ([`find_measured`]). The one resolver of skin names, for the
+/// command line and scene files alike.
+pub fn named_skin(name: &str) -> Result<SkinParams, UnknownSkin> {
+    match name.parse::<Preset>() {
+        Ok(p) => Ok(SkinParams::preset(p)),
+        Err(_) => find_measured(name)
+            .map(|m| m.skin)
+            .ok_or_else(|| UnknownSkin(crate::echo::text(name))),
+    }
 }
 
 /// Parse the embedded table; a malformed row is a build-time defect the unit tests catch, so it
@@ -140,6 +160,26 @@ mod tests {
             assert!((30.0..70.0).contains(&p.lab.l), "{}: {:?}", p.name, p.lab);
             assert!(p.lab.b > 12.0, "{}: {:?}", p.name, p.lab);
         }
+    }
+
+    #[test]
+    fn named_skin_resolves_seed_and_measured_names() {
+        assert_eq!(
+            named_skin("Paper").unwrap(),
+            SkinParams::preset(Preset::Light)
+        );
+        assert_eq!(
+            named_skin("ita-dark").unwrap(),
+            find_measured("ita-dark").unwrap().skin
+        );
+        // A measured preset keeps its extended physiology.
+        let p = named_skin("ca-inner-arm").unwrap();
+        assert_eq!(
+            p.physiology(),
+            find_measured("ca-inner-arm").unwrap().skin.physiology()
+        );
+        let e = named_skin("tan").unwrap_err().to_string();
+        assert!(e.contains("'tan'") && e.contains("skin presets"), "{e}");
     }
 
     #[test]

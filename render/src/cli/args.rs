@@ -4,7 +4,7 @@
 use clap::Args;
 use clap::builder::TypedValueParser;
 use skin_optics::echo::{Num, Text};
-use skin_optics::measured::find_measured;
+use skin_optics::measured::named_skin;
 use skin_optics::{OpticsError, Preset, SkinParams};
 use std::ffi::OsStr;
 
@@ -64,13 +64,7 @@ pub struct NamedSkin {
 
 /// Parse a preset name (clap value parser).
 pub fn parse_preset(s: &str) -> Result<NamedSkin, String> {
-    let skin = match s.parse::<Preset>() {
-        Ok(p) => SkinParams::preset(p),
-        Err(e) => match find_measured(s) {
-            Some(m) => m.skin,
-            None => return Err(format!("{e}, or a measured preset (see `skin presets`)")),
-        },
-    };
+    let skin = named_skin(s).map_err(|e| e.to_string())?;
     Ok(NamedSkin {
         name: s.to_string(),
         skin,

@@ -8,6 +8,7 @@ use crate::material::{DiffuseMaterial, Material, SkinBuildError, SkinMaterial, T
 use crate::scene_file::MaterialDesc;
 use crate::spectrum::{SpectrumTable, linear_srgb_to_spectrum};
 use crate::texture::{Texture, luminance};
+use skin_optics::measured::named_skin;
 use skin_optics::{Preset, SkinParams};
 use std::collections::{BTreeMap, HashMap};
 
@@ -149,7 +150,10 @@ impl Loader<'_> {
         }))
     }
 
-    /// The preset with explicit fractions replacing its values; an invalid one is reported by its key.
+    /// The named skin (a seed or a measured preset, [`skin_optics::measured::named_skin`]) with
+    /// explicit fractions replacing its values; its other parameters (a measured preset's
+    /// oxygenation, epidermis thickness, scattering scales, extended physiology) are kept. An
+    /// invalid value is reported by its key.
     fn skin_params(
         &self,
         key: &str,
@@ -157,32 +161,27 @@ impl Loader<'_> {
         overrides: [Option<f64>; 4],
     ) -> Result<SkinParams, RenderError> {
         let base = match preset {
-            Some(p) => SkinParams::preset(
-                p.parse::<Preset>()
-                    .map_err(|e| self.err(format!("{key}.preset"), e.to_string()))?,
-            ),
+            Some(p) => {
+                named_skin(p).map_err(|e| self.err(format!("{key}.preset"), e.to_string()))?
+            }
             None => SkinParams::preset(Preset::Light),
         };
-        let names = ["melanin", "eumelanin", "hemoglobin", "oil"];
-        let values = |o: [Option<f64>; 4]| {
-            [
-                o[0].unwrap_or(base.melanin()),
-                o[1].unwrap_or(base.eumelanin_blend()),
-                o[2].unwrap_or(base.hemoglobin()),
-                o[3].unwrap_or(base.oiliness()),
-            ]
+        let [melanin, eumelanin, hemoglobin, oil] = overrides;
+        let named = |name: &str, r: Result<SkinParams, skin_optics::OpticsError>| {
+            r.map_err(|e| self.err(format!("{key}.{name}"), e.to_string()))
         };
-        // Check each override alone first, so the error names the offending key.
-        for (i, name) in names.iter().enumerate() {
-            if overrides[i].is_some() {
-                let mut one = [None; 4];
-                one[i] = overrides[i];
-                let v = values(one);
-                SkinParams::new(v[0], v[1], v[2], v[3])
-                    .map_err(|e| self.err(format!("{key}.{name}"), e.to_string()))?;
-            }
-        }
-        let v = values(overrides);
-        SkinParams::new(v[0], v[1], v[2], v[3]).map_err(|e| self.err(key, e.to_string()))
+        let s = named(
+            "melanin",
+            base.with_melanin(melanin.unwrap_or(base.melanin())),
+        )?;
+        let s = named(
+            "eumelanin",
+            s.with_eumelanin_blend(eumelanin.unwrap_or(base.eumelanin_blend())),
+        )?;
+        let s = named(
+            "hemoglobin",
+            s.with_hemoglobin(hemoglobin.unwrap_or(base.hemoglobin())),
+        )?;
+        named("oil", s.with_oiliness(oil.unwrap_or(base.oiliness())))
     }
 }

@@ -1,0 +1,103 @@
+//! Skin presets in scene files: seed and measured names resolve to the same skins as on the command
+//! line, overrides keep a measured preset's extended parameters, and the default scene's three
+//! skins are measured ones.
+
+use render::material::Material;
+use render::scene::{Scene, SceneOptions};
+use skin_optics::SkinParams;
+use skin_optics::measured::find_measured;
+
+fn scene_text(skin_keys: &str) -> String {
+    format!(
+        r#"
+[camera]
+position_mm = [0, 0, 300]
+look_at_mm = [0, 0, 0]
+fov_deg = 30
+
+[materials.skin]
+type = "skin"
+{skin_keys}
+
+[[meshes]]
+shape = "sphere"
+material = "skin"
+scale = 50
+"#
+    )
+}
+
+fn opts() -> SceneOptions {
+    // The diffusion method and no BSSRDF keep the load cheap; the parameters do not depend on it.
+    SceneOptions {
+        method: multipole::Method::Multipole,
+        no_subsurface: true,
+        ..SceneOptions::default()
+    }
+}
+
+fn skins(scene: &Scene) -> Vec<(String, SkinParams)> {
+    scene
+        .material_names
+        .iter()
+        .zip(&scene.materials)
+        .filter_map(|(n, m)| match m {
+            Material::Skin(s) => Some((n.clone(), s.params)),
+            Material::Diffuse(_) => None,
+        })
+        .collect()
+}
+
+fn load(text: &str) -> Result<Scene, String> {
+    Scene::from_toml(text, "scene.toml", None, &opts()).map_err(|e| e.to_string())
+}
+
+#[test]
+fn a_measured_preset_keeps_its_physiology_and_takes_overrides() {
+    let preset = find_measured("ca-inner-arm").unwrap().skin;
+    let scene = load(&scene_text("preset = \"CA-Inner-Arm\"")).unwrap();
+    assert_eq!(skins(&scene), vec![("skin".to_string(), preset)]);
+    // An explicit fraction replaces only its own value.
+    let scene = load(&scene_text("preset = \"ca-inner-arm\"\nhemoglobin = 0.03")).unwrap();
+    let want = preset.with_hemoglobin(0.03).unwrap();
+    assert_eq!(skins(&scene)[0].1, want);
+    assert_eq!(want.physiology(), preset.physiology());
+    assert_eq!(
+        want.epidermis_thickness_mm(),
+        preset.epidermis_thickness_mm()
+    );
+}
+
+#[test]
+fn unknown_preset_and_bad_override_name_their_key() {
+    let e = load(&scene_text("preset = \"tan\"")).err().unwrap();
+    assert!(
+        e.contains("materials.skin.preset") && e.contains("'tan'") && e.contains("ita-tan"),
+        "{e}"
+    );
+    let e = load(&scene_text("preset = \"ita-dark\"\nmelanin = 1.5"))
+        .err()
+        .unwrap();
+    assert!(
+        e.contains("materials.skin.melanin") && e.contains("[0, 1]"),
+        "{e}"
+    );
+}
+
+/// The default scene shows measured skins (ITA° light, tan and dark cheeks), not the paper's
+/// Figure 1 set, whose colour (L* 74, b* 6.5) lies outside every measured median.
+#[test]
+fn the_default_scene_uses_measured_cheeks() {
+    let scene = Scene::load("builtin:three-heads", &opts()).unwrap();
+    let got = skins(&scene);
+    let want = [
+        ("dark", "af-cheek"),
+        ("light", "jp-cheek"),
+        ("medium", "sa-cheek"),
+    ];
+    assert_eq!(got.len(), 3);
+    for ((name, skin), (n, p)) in got.iter().zip(want) {
+        assert_eq!(name, n);
+        assert_eq!(*skin, find_measured(p).unwrap().skin, "{name}");
+    }
+}
