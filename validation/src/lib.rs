@@ -6,5 +6,6 @@ pub mod shape_error;
 /// The layered Monte Carlo (owned by `multipole`, which uses it for exact profile shapes).
 pub use multipole::montecarlo;
 pub mod measured;
+pub mod measured_colour;
 pub mod measured_report;
 pub mod presets;

@@ -4,6 +4,7 @@
 use crate::measured::{
     EXPLORE_CSV, HELDOUT_CSV, RecordFit, fit_records, parse_records, quantile, residual_bands,
 };
+use crate::measured_colour::{bounds_summary, bounds_text, colour_summary, colours_csv};
 use anyhow::Context;
 use multipole::fit::{MeasuredOptions, ModelChoice, Parameter};
 use render::plot::{LineChart, Panel, Series, palette_color, save_png};
@@ -82,6 +83,10 @@ pub fn run_measured(
             t
         )?;
     }
+    for (label, fits) in [("seed", &seed), (&*opts.model.to_string(), &chosen)] {
+        writeln!(summary, "{}", colour_summary(label, fits)?)?;
+        writeln!(summary, "{}", bounds_summary(label, fits))?;
+    }
     if opts.model == ModelChoice::Auto {
         let mut counts: Vec<(Parameter, usize)> = Parameter::CANDIDATES
             .iter()
@@ -103,6 +108,11 @@ pub fn run_measured(
     let tag = format!("{name}_{}_{}", opts.geometry, opts.model);
     write(out, &format!("summary_{tag}.txt"), &summary)?;
     write(out, &format!("fits_{tag}.csv"), &fits_csv(&seed, &chosen))?;
+    write(
+        out,
+        &format!("colours_{tag}.csv"),
+        &colours_csv(&seed, &chosen)?,
+    )?;
     residual_chart(out, &tag, &seed, &chosen, &opts.model.to_string())?;
     parameter_chart(out, &tag, &chosen)?;
     Ok(())
@@ -130,7 +140,7 @@ const PARAMS: [Parameter; 11] = [
 ];
 
 fn fits_csv(seed: &[RecordFit], chosen: &[RecordFit]) -> String {
-    let mut csv = String::from("record,group,site,seed_rms,rms,free");
+    let mut csv = String::from("record,group,site,seed_rms,rms,free,at_bounds");
     for p in PARAMS {
         let _ = write!(csv, ",{p}");
     }
@@ -139,13 +149,14 @@ fn fits_csv(seed: &[RecordFit], chosen: &[RecordFit]) -> String {
         let free: Vec<&str> = c.fit.parameters.iter().map(|p| p.name()).collect();
         let _ = write!(
             csv,
-            "{},{},{},{:.5},{:.5},{}",
+            "{},{},{},{:.5},{:.5},{},{}",
             c.record.id,
             c.record.group,
             c.record.site,
             s.fit.rms,
             c.fit.rms,
-            free.join(" ")
+            free.join(" "),
+            bounds_text(c)
         );
         for p in PARAMS {
             let _ = write!(csv, ",{:.5}", p.get(&c.fit.skin));

@@ -1,6 +1,7 @@
 //! Measured presets: the ISSA group/site median spectra (SCI) fitted with `--model auto`, written
 //! as the table `skin_optics::measured` embeds (docs/physics.md §13).
 
+use crate::measured_colour::lab_of;
 use anyhow::Context;
 use multipole::fit::{
     ColourModel, Geometry, MeasuredOptions, MeasuredSpectrum, ModelChoice, fit_measured,
@@ -70,15 +71,23 @@ pub fn run_presets(noise: f64, path: &Path) -> anyhow::Result<()> {
         csv,
         "# Criterion noise sigma {noise}. Colour: the fitted skin's diffuse (SCE) reflectance under D65, 400-700 nm at 10 nm. Regenerate with `cargo run --release -p validation --bin skin-validate -- presets`."
     );
-    csv.push_str("name,group_code,site,n_records,melanin,eumelanin_blend,hemoglobin,oiliness,oxygenation,epidermis_thickness_mm,dermis_scattering_scale,epidermis_blood,bilirubin_g_per_l,mie_scale,rayleigh_scale,rms,l,a,b\n");
+    csv.push_str("name,group_code,site,n_records,melanin,eumelanin_blend,hemoglobin,oiliness,oxygenation,epidermis_thickness_mm,dermis_scattering_scale,epidermis_blood,bilirubin_g_per_l,mie_scale,rayleigh_scale,rms,l,a,b,at_bounds\n");
     for (r, f) in rows.iter().zip(&fits) {
         let s = f.skin;
         let x = s.physiology();
         let lab = ColourModel::new(10.0, opts.fit.method, s)?.lab(&s)?;
+        let bounds: Vec<String> = f
+            .at_bounds()
+            .iter()
+            .map(|(p, b)| format!("{p}={b}"))
+            .collect();
+        let bounds = bounds.join(" ");
+        // Both as the instrument sees them (SCI), the median spectrum's and the fit's.
+        let de = lab_of(&r.lambda, &r.median)?.delta_e_2000(lab_of(&r.lambda, &f.model)?);
         let name = format!("{}-{}", r.code.to_lowercase(), r.site.replace('_', "-"));
         let _ = writeln!(
             csv,
-            "{name},{},{},{},{:.5},{:.4},{:.5},{:.4},{:.4},{:.4},{:.4},{:.5},{:.5},{:.4},{:.4},{:.5},{:.2},{:.2},{:.2}",
+            "{name},{},{},{},{:.5},{:.4},{:.5},{:.4},{:.4},{:.4},{:.4},{:.5},{:.5},{:.4},{:.4},{:.5},{:.2},{:.2},{:.2},{}",
             r.code,
             r.site,
             r.n,
@@ -96,18 +105,20 @@ pub fn run_presets(noise: f64, path: &Path) -> anyhow::Result<()> {
             f.rms,
             lab.l,
             lab.a,
-            lab.b
+            lab.b,
+            bounds
         );
         let free: Vec<&str> = f.parameters.iter().skip(4).map(|p| p.name()).collect();
         println!(
-            "{name:<18} RMS {:.4} (seed {:.4})  L*a*b* ({:.1}, {:.1}, {:.1})  ITA° {:.1}  added: {}",
+            "{name:<18} RMS {:.4} (seed {:.4})  ΔE2000 to the median {de:.2}  L*a*b* ({:.1}, {:.1}, {:.1})  ITA° {:.1}  added: {}  on a bound: {}",
             f.rms,
             f.seed_rms,
             lab.l,
             lab.a,
             lab.b,
             lab.ita_deg(),
-            free.join(", ")
+            free.join(", "),
+            if bounds.is_empty() { "none" } else { &bounds }
         );
     }
     render::atomic::write_bytes(path, csv.as_bytes())

@@ -147,7 +147,22 @@ pub fn fit_measured(
         ModelChoice::Seed => {}
         ModelChoice::Full => {
             params.extend(Parameter::CANDIDATES);
-            (skin, rms) = problem.refine(skin, &params)?;
+            // Several starts: every candidate at the base skin's value (where the seed fit left
+            // the spectrum), at mid-range, and at a quarter and three quarters of its range. With
+            // seven parameters that trade against each other (blood near the surface against
+            // C_h, ρ_s against the scattering scales), one local descent can stop in a valley.
+            let mut best = problem.refine(skin, &params)?;
+            for t in FULL_STARTS {
+                let start = Parameter::CANDIDATES.iter().try_fold(best.0, |s, p| {
+                    let [lo, hi] = p.range();
+                    p.set(s, lo + t * (hi - lo))
+                })?;
+                let trial = problem.refine(start, &params)?;
+                if trial.1 < best.1 {
+                    best = trial;
+                }
+            }
+            (skin, rms) = best;
         }
         ModelChoice::Auto => {
             let mut chosen = 0;
@@ -210,6 +225,37 @@ pub fn fit_measured(
         full_evaluations: problem.full_evals,
         search_evaluations: problem.search_evals,
     })
+}
+
+/// Where the extra starts of a `full` fit put every candidate, as a fraction of its range (the
+/// seed's C_m, β_m, C_h and ρ_s start from the best fit so far).
+const FULL_STARTS: [f64; 3] = [0.5, 0.25, 0.75];
+
+/// A fitted value closer than this fraction of its range to a bound counts as on the bound.
+pub const AT_BOUND_FRACTION: f64 = 1e-3;
+
+impl MeasuredFit {
+    /// The free parameters whose fitted value sits on a bound of its fit range (within
+    /// [`AT_BOUND_FRACTION`] of the range), with the bound: the optimiser wanted to go further,
+    /// so the model lacks something there or trades that parameter against another.
+    #[must_use]
+    pub fn at_bounds(&self) -> Vec<(Parameter, f64)> {
+        self.parameters
+            .iter()
+            .filter_map(|&p| {
+                let [lo, hi] = p.range();
+                let v = p.get(&self.skin);
+                let tol = AT_BOUND_FRACTION * (hi - lo);
+                if v <= lo + tol {
+                    Some((p, lo))
+                } else if v >= hi - tol {
+                    Some((p, hi))
+                } else {
+                    None
+                }
+            })
+            .collect()
+    }
 }
 
 /// ln C(m, j).

@@ -34,6 +34,11 @@ pub(crate) fn report(
             })
         })
         .collect();
+    let bounds: serde_json::Map<String, serde_json::Value> = fit
+        .at_bounds()
+        .iter()
+        .map(|(p, b)| (p.name().to_string(), (*b).into()))
+        .collect();
     if args.json {
         let out = serde_json::json!({
             "target": { "spectrum": path.display().to_string(), "points": measured.len() },
@@ -49,6 +54,7 @@ pub(crate) fn report(
                 "lambda_nm": measured.lambda_nm(), "reflectance": fit.model,
             },
             "residual": { "rms_reflectance": fit.rms, "seed_rms_reflectance": fit.seed_rms },
+            "at_bounds": bounds,
             "criterion": fit.criterion,
             "selection": steps,
             "within_tolerance": fit.rms <= opts.max_rms,
@@ -100,6 +106,18 @@ fn print_text(
         free.len(),
         free.join(", ")
     );
+    let bounds: Vec<String> = fit
+        .at_bounds()
+        .iter()
+        .map(|(p, b)| format!("{p} at {b}"))
+        .collect();
+    if !bounds.is_empty() {
+        println!(
+            "{:<9}on a bound of its fit range (the data wanted it further): {}",
+            "bounds",
+            bounds.join(", ")
+        );
+    }
     for s in &fit.steps {
         println!(
             "{:<9}{} {}: RMS {:.5} → {:.5}, Δcriterion {:+.1} at σ = {}",

@@ -142,3 +142,35 @@ fn bad_noise_is_rejected() {
     let e = fit_measured(&m, &options(ModelChoice::Auto, 0.0)).unwrap_err();
     assert_eq!(e.to_string(), "fit option noise = 0 outside (0, 1)");
 }
+
+/// `full` on a seed-model spectrum: the extra starts only ever replace the first descent by a
+/// better one, so the RMS is at most the seed model's (the full model contains it); and
+/// `at_bounds` names exactly the free parameters within 0.1 % of their range of a bound.
+#[test]
+fn full_is_no_worse_than_seed_and_bounds_are_flagged() {
+    let skin = SkinParams::new(0.05, 0.7, 0.02, 0.3).unwrap();
+    let m = synthetic_sci(&skin, 0.003, 11);
+    let mut fit = fit_measured(&m, &options(ModelChoice::Full, 0.003)).unwrap();
+    assert_eq!(fit.parameters.len(), 4 + Parameter::CANDIDATES.len());
+    assert!(fit.rms <= fit.seed_rms, "{} > {}", fit.rms, fit.seed_rms);
+    let bilirubin = Parameter::Extended(Extension::Bilirubin);
+    let [lo, hi] = bilirubin.range();
+    fit.skin = Parameter::Oiliness.set(fit.skin, 0.0).unwrap();
+    fit.skin = bilirubin.set(fit.skin, 0.5 * (lo + hi)).unwrap();
+    fit.skin = Parameter::EpidermisThickness.set(fit.skin, 0.3).unwrap();
+    let flagged = fit.at_bounds();
+    assert!(flagged.contains(&(Parameter::Oiliness, 0.0)), "{flagged:?}");
+    assert!(
+        flagged.contains(&(Parameter::EpidermisThickness, 0.3)),
+        "{flagged:?}"
+    );
+    assert!(flagged.iter().all(|(p, _)| *p != bilirubin), "{flagged:?}");
+    fit.skin = Parameter::Oiliness
+        .set(fit.skin, 2.0 * AT_BOUND_FRACTION)
+        .unwrap();
+    assert!(
+        fit.at_bounds()
+            .iter()
+            .all(|(p, _)| *p != Parameter::Oiliness)
+    );
+}
