@@ -41,6 +41,23 @@ enum Command {
     Measured(MeasuredArgs),
     /// Fit the ISSA group/site medians (SCI, model auto) and write the measured-preset table.
     Presets(PresetArgs),
+    /// Error against cost (build CPU-s, evaluation ms) for every knob of the exact profile's shape
+    /// table, against Monte Carlo references; CSV and PNG into --out.
+    TableKnobs(TableKnobArgs),
+}
+
+#[derive(Args, Debug)]
+struct TableKnobArgs {
+    /// Photons per Monte Carlo reference (nine: light, medium, dark at 450, 550, 650 nm), [1e4, 1e9].
+    #[arg(long, value_name = "N", default_value_t = 1_000_000, value_parser = Checked(parse_reference_photons))]
+    photons: u64,
+    /// Output folder.
+    #[arg(long, value_name = "DIR", default_value = "out/table_knobs")]
+    out: PathBuf,
+}
+
+fn parse_reference_photons(s: &str) -> Result<u64, String> {
+    parse_whole(s, 10_000, 1_000_000_000, "[1e4, 1e9]")
 }
 
 #[derive(Args, Debug)]
@@ -220,6 +237,9 @@ fn main() {
         Some(Command::Noise(args)) => run_noise(args),
         Some(Command::Measured(args)) => run_measured(args),
         Some(Command::Presets(args)) => validation::presets::run_presets(args.noise, &args.out),
+        Some(Command::TableKnobs(args)) => {
+            validation::compare::table_knobs::run_table_knobs(args.photons, &args.out)
+        }
         None => validation::compare::run_comparison(cli.quick, &cli.out),
     };
     if let Err(e) = result {

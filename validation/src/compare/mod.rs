@@ -8,6 +8,9 @@
 //! 4. [`knobs`]: time against error for every knob of `multipole` and the MC photon count;
 //! 5. [`exact`]: `Method::Exact` beside `Method::Multipole` against MC, totals over C_m and profiles.
 //!
+//! [`table_knobs`] (`skin-validate table-knobs`, run alone: it builds a dozen shape tables) charts
+//! error against cost for every knob of the exact profile's shape table.
+//!
 //! The observable compared is the diffuse reflectance per incident photon at normal incidence,
 //! specular excluded: the MC's R_d against (1 − F_r(0)) R_d of diffusion
 //! (`multipole::skin::diffuse_reflectance`).
@@ -17,6 +20,7 @@ pub mod knobs;
 pub mod profiles;
 pub mod spectra;
 pub mod stability;
+pub mod table_knobs;
 
 use crate::montecarlo::{self, LayeredMedium, McOptions, McResult};
 use anyhow::Context;
