@@ -205,3 +205,23 @@ pub fn bounds_summary(label: &str, fits: &[RecordFit]) -> String {
         parts.join(", ")
     )
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A perfect white reflector is the D65 white point (L* 100, a* = b* = 0) to rounding; a
+    /// grey of 18% has L* = 116 · 0.18^(1/3) − 16 = 49.5; uneven wavelengths are refused.
+    #[test]
+    fn lab_of_white_grey_and_uneven_grids() {
+        let nm: Vec<f64> = (0..31).map(|i| 400.0 + 10.0 * f64::from(i)).collect();
+        let white = lab_of(&nm, &[1.0; 31]).unwrap();
+        assert!((white.l - 100.0).abs() < 1e-9 && white.a.abs() < 1e-9 && white.b.abs() < 1e-9);
+        let grey = lab_of(&nm, &[0.18; 31]).unwrap();
+        let want = 116.0 * 0.18_f64.cbrt() - 16.0;
+        assert!((grey.l - want).abs() < 1e-9, "{grey:?}");
+        let mut uneven = nm.clone();
+        uneven[3] += 1.0;
+        assert!(lab_of(&uneven, &[0.5; 31]).is_err());
+    }
+}
