@@ -1,6 +1,8 @@
 //! Bad scene files fail with a message naming the file, the key (or path) and what was expected,
 //! and `skin render` writes no image.
 
+mod common;
+
 use clap::Parser;
 use render::cli::render::{RenderArgs, run};
 use std::path::PathBuf;
@@ -161,5 +163,64 @@ fn unknown_material_and_bad_light_are_named() {
         "{GOOD}\n[[lights]]\ntype = \"sphere\"\ncenter_mm = [0, 0, 200]\nradius_mm = -1\nintensity = 1\n"
     );
     let e = render_text("light", &text).unwrap_err();
-    assert_mentions(&e, &["lights[0].radius_mm", "> 0"]);
+    assert_mentions(&e, &["lights[0].radius_mm", "(0, 1e9] mm"]);
+}
+
+/// Light sizes, positions and intensities beyond what f32 transport can carry are typed errors
+/// naming the key and its range (they used to pass and turn every selection weight into inf or
+/// NaN, which silently switched light sampling off).
+#[test]
+fn huge_light_parameters_are_named_with_their_range() {
+    let quad = "type = \"quad\"\ncenter_mm = [0, 0, 200]\nlook_at_mm = [0, 0, 0]\nintensity = 1";
+    let sphere = "type = \"sphere\"\ncenter_mm = [0, 0, 200]\nintensity = 1";
+    let cases = [
+        (
+            format!("{quad}\nsize_mm = [1e20, 1e20]"),
+            "lights[0].size_mm",
+            "(0, 1e9] mm",
+        ),
+        (
+            format!("{sphere}\nradius_mm = 3e19"),
+            "lights[0].radius_mm",
+            "(0, 1e9] mm",
+        ),
+        (
+            format!("{sphere}\nradius_mm = 10").replace("intensity = 1", "intensity = 3e38"),
+            "lights[0].intensity",
+            "[0, 1e30]",
+        ),
+        (
+            format!("{sphere}\nradius_mm = 10").replace("[0, 0, 200]", "[3e38, 0, 0]"),
+            "lights[0].center_mm",
+            "1e9 mm",
+        ),
+    ];
+    for (i, (light, key, range)) in cases.iter().enumerate() {
+        let text = format!("{GOOD}\n[[lights]]\n{light}\n");
+        let e = render_text(&format!("huge{i}"), &text).unwrap_err();
+        assert_mentions(&e, &[key, range, "scene.toml"]);
+    }
+    let text = format!("{GOOD}\n[environment]\nintensity = 3e38\n");
+    let e = render_text("huge-env", &text).unwrap_err();
+    assert_mentions(&e, &["environment.intensity", "[0, 1e30]"]);
+}
+
+/// A distant light's direction whose squared length overflows f32 is still a direction: the
+/// scene loads with a unit `to_light` and the sphere it shines on is lit.
+#[test]
+fn distant_direction_3e38_normalises_and_lights_the_scene() {
+    let text = format!(
+        "{GOOD}\n[[lights]]\ntype = \"distant\"\ndirection = [3e38, 3e38, 3e38]\nintensity = 1\n"
+    )
+    .replace(
+        "type = \"skin\"\npreset = \"light\"",
+        "type = \"diffuse\"\nalbedo = 0.5",
+    );
+    let scene = common::scene(&text);
+    let render::light::Light::Distant(d) = &scene.lights[0] else {
+        panic!("{:?}", scene.lights[0]);
+    };
+    assert!((d.to_light - glam::Vec3::splat(1.0 / 3f32.sqrt())).length() < 1e-6);
+    let y = common::mean_xyz(&common::run(&scene, 8, 8, 4, 1))[1];
+    assert!(y.is_finite() && y > 0.0, "{y}");
 }
