@@ -2,7 +2,9 @@
 //! to a uniquely named temporary file in the target's own folder (`tempfile`, so two writers of the
 //! same target never share a temporary and the final rename stays on one file system), which is
 //! persisted over the target only once complete; on failure it is removed. A target that exists and
-//! is not a regular file (directory, symlink, FIFO, device) is never replaced.
+//! is not a regular file (directory, symlink, FIFO, device) is never replaced. Files that belong
+//! together (a render's EXR and PNG) are staged first and committed as a group ([`stage`],
+//! [`commit`]): all are replaced, or on an error none is.
 
 use std::fs;
 use std::io::{self, Write};
@@ -51,21 +53,27 @@ fn check_target(path: &Path) -> Result<(), AtomicWriteError> {
     })
 }
 
-/// Write `path` through `fill`, which receives the path of a fresh temporary file (in the same
-/// folder) to write; on success it is renamed over `path`, on failure it is removed. Parent
-/// folders are created.
-pub fn write_via_temp<E>(path: &Path, fill: impl FnOnce(&Path) -> Result<(), E>) -> Result<(), E>
-where
-    E: From<AtomicWriteError>,
-{
-    let io_err = |source| AtomicWriteError::Io {
+/// A complete temporary file waiting to be persisted over its target (see [`commit`]); dropped
+/// uncommitted, it is removed.
+#[derive(Debug)]
+pub struct Staged {
+    target: PathBuf,
+    tmp: tempfile::NamedTempFile,
+}
+
+/// The I/O error of an atomic write of `path`.
+fn io_error(path: &Path) -> impl Fn(io::Error) -> AtomicWriteError + '_ {
+    move |source| AtomicWriteError::Io {
         path: path.to_path_buf(),
         source,
-    };
-    check_target(path)?;
+    }
+}
+
+/// A fresh, uniquely named temporary file beside `path` (`name.XXXXXX.tmp`), creating the folder.
+fn temp_beside(path: &Path) -> Result<tempfile::NamedTempFile, AtomicWriteError> {
     let dir = match path.parent().filter(|d| !d.as_os_str().is_empty()) {
         Some(dir) => {
-            fs::create_dir_all(dir).map_err(io_err)?;
+            fs::create_dir_all(dir).map_err(io_error(path))?;
             dir
         }
         None => Path::new("."),
@@ -75,28 +83,94 @@ where
         .map(|n| n.to_os_string())
         .unwrap_or_default();
     prefix.push(".");
-    let tmp = tempfile::Builder::new()
+    tempfile::Builder::new()
         .prefix(&prefix)
         .suffix(".tmp")
         .tempfile_in(dir)
-        .map_err(io_err)?;
+        .map_err(io_error(path))
+}
+
+/// Write the future contents of `path` through `fill`, which receives the path of a fresh
+/// temporary file in the same folder; nothing at `path` changes until [`commit`]. On failure the
+/// temporary file is removed.
+pub fn stage<E>(path: &Path, fill: impl FnOnce(&Path) -> Result<(), E>) -> Result<Staged, E>
+where
+    E: From<AtomicWriteError>,
+{
+    check_target(path)?;
+    let tmp = temp_beside(path)?;
     // On an error `tmp` is dropped here, which deletes the temporary file.
     fill(tmp.path())?;
-    check_target(path)?;
-    tmp.persist(path).map_err(|e| io_err(e.error))?;
-    Ok(())
+    Ok(Staged {
+        target: path.to_path_buf(),
+        tmp,
+    })
+}
+
+/// Persist staged files over their targets as one group: either every target gets its new
+/// contents, or (on an error) every target keeps what it had — the old file, or no file — and no
+/// temporary file remains. The targets are moved aside first (to unique names beside them) and
+/// moved back if a later rename fails. A crash inside this function can still leave the group
+/// mixed; an error cannot.
+pub fn commit(files: Vec<Staged>) -> Result<(), AtomicWriteError> {
+    // Old contents moved aside, per target: restored on failure, deleted (by drop) on success.
+    let mut aside: Vec<Option<tempfile::TempPath>> = Vec::with_capacity(files.len());
+    let mut done: Vec<&Path> = Vec::with_capacity(files.len());
+    let result = (|| {
+        for f in &files {
+            check_target(&f.target)?;
+        }
+        for f in &files {
+            aside.push(if f.target.exists() {
+                let old = temp_beside(&f.target)?.into_temp_path();
+                fs::rename(&f.target, &old).map_err(io_error(&f.target))?;
+                Some(old)
+            } else {
+                None
+            });
+        }
+        for f in &files {
+            fs::rename(f.tmp.path(), &f.target).map_err(io_error(&f.target))?;
+            done.push(&f.target);
+        }
+        Ok(())
+    })();
+    if result.is_err() {
+        // Best effort: the error being reported matters more than one from the roll-back.
+        for target in &done {
+            let _ = fs::remove_file(target);
+        }
+        for (f, old) in files.iter().zip(&aside) {
+            if let Some(old) = old {
+                let _ = fs::rename(old, &f.target);
+            }
+        }
+    }
+    // Dropping `files` removes any temporary not renamed; dropping `aside` the old contents.
+    result
+}
+
+/// Write `path` through `fill` (see [`stage`]) and persist it at once.
+pub fn write_via_temp<E>(path: &Path, fill: impl FnOnce(&Path) -> Result<(), E>) -> Result<(), E>
+where
+    E: From<AtomicWriteError>,
+{
+    let staged = stage(path, fill)?;
+    Ok(commit(vec![staged])?)
 }
 
 /// Write `bytes` to `path` atomically (unique temporary name, then rename).
 pub fn write_bytes(path: &Path, bytes: &[u8]) -> Result<(), AtomicWriteError> {
-    write_via_temp(path, |tmp| {
-        let io_err = |source| AtomicWriteError::Io {
-            path: path.to_path_buf(),
-            source,
-        };
-        let mut f = fs::File::create(tmp).map_err(io_err)?;
-        f.write_all(bytes).map_err(io_err)?;
-        f.sync_all().map_err(io_err)
+    commit(vec![stage_bytes(path, bytes)?])
+}
+
+/// Stage `bytes` as the future contents of `path` (see [`stage`]).
+pub fn stage_bytes(path: &Path, bytes: &[u8]) -> Result<Staged, AtomicWriteError> {
+    stage(path, |tmp| {
+        let io_err = io_error(path);
+        let mut f = fs::File::create(tmp).map_err(&io_err)?;
+        f.write_all(bytes).map_err(&io_err)?;
+        f.sync_all().map_err(&io_err)
     })
 }
 
@@ -144,6 +218,78 @@ mod tests {
         write_bytes(&target, b"whole").unwrap();
         assert_eq!(fs::read(&target).unwrap(), b"whole");
         assert!(leftovers(&dir, &["a.txt"]).is_empty());
+        fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// A group whose last rename fails leaves every target as it was (the old bytes, or no file)
+    /// and no temporary or moved-aside file behind; a group that succeeds replaces all of them.
+    #[test]
+    fn pair_is_committed_together_or_not_at_all() {
+        let dir = temp_dir("pair");
+        let (exr, png) = (dir.join("render.exr"), dir.join("render.png"));
+        let pair = |a: &[u8], b: &[u8]| {
+            let staged = vec![stage_bytes(&exr, a).unwrap(), stage_bytes(&png, b).unwrap()];
+            // Take the second temporary away: its rename fails after the first one succeeded.
+            fs::remove_file(staged[1].tmp.path()).unwrap();
+            commit(staged)
+        };
+        // No previous pair: neither file may appear.
+        assert!(matches!(
+            pair(b"new exr", b"new png"),
+            Err(AtomicWriteError::Io { .. })
+        ));
+        assert!(!exr.exists() && !png.exists());
+        assert!(
+            leftovers(&dir, &[]).is_empty(),
+            "{:?}",
+            leftovers(&dir, &[])
+        );
+        // A previous pair: both keep their bytes.
+        commit(vec![
+            stage_bytes(&exr, b"old exr").unwrap(),
+            stage_bytes(&png, b"old png").unwrap(),
+        ])
+        .unwrap();
+        assert!(pair(b"new exr", b"new png").is_err());
+        assert_eq!(fs::read(&exr).unwrap(), b"old exr");
+        assert_eq!(fs::read(&png).unwrap(), b"old png");
+        let keep = ["render.exr", "render.png"];
+        assert!(
+            leftovers(&dir, &keep).is_empty(),
+            "{:?}",
+            leftovers(&dir, &keep)
+        );
+        // A target that became a directory after staging: refused before anything moves.
+        let staged = vec![
+            stage_bytes(&exr, b"new exr").unwrap(),
+            stage_bytes(&png, b"new png").unwrap(),
+        ];
+        fs::remove_file(&png).unwrap();
+        fs::create_dir(&png).unwrap();
+        assert!(matches!(
+            commit(staged),
+            Err(AtomicWriteError::NotARegularFile { .. })
+        ));
+        assert_eq!(fs::read(&exr).unwrap(), b"old exr");
+        assert!(png.is_dir());
+        assert!(
+            leftovers(&dir, &keep).is_empty(),
+            "{:?}",
+            leftovers(&dir, &keep)
+        );
+        fs::remove_dir(&png).unwrap();
+        commit(vec![
+            stage_bytes(&exr, b"new exr").unwrap(),
+            stage_bytes(&png, b"new png").unwrap(),
+        ])
+        .unwrap();
+        assert_eq!(fs::read(&exr).unwrap(), b"new exr");
+        assert_eq!(fs::read(&png).unwrap(), b"new png");
+        assert!(
+            leftovers(&dir, &keep).is_empty(),
+            "{:?}",
+            leftovers(&dir, &keep)
+        );
         fs::remove_dir_all(&dir).unwrap();
     }
 

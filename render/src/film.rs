@@ -167,6 +167,16 @@ impl Film {
 
     /// Write the tone-mapped sRGB PNG.
     pub fn write_png(&self, path: &Path, exposure_stops: f32) -> Result<(), RenderError> {
+        Ok(atomic::commit(vec![self.stage_png(path, exposure_stops)?])?)
+    }
+
+    /// The tone-mapped sRGB PNG, staged beside `path` for [`atomic::commit`] (so it can be
+    /// committed together with the EXR).
+    pub fn stage_png(
+        &self,
+        path: &Path,
+        exposure_stops: f32,
+    ) -> Result<atomic::Staged, RenderError> {
         use image::ImageEncoder;
         let mut bytes = Vec::new();
         image::codecs::png::PngEncoder::new(&mut bytes)
@@ -180,7 +190,7 @@ impl Film {
                 path: path.to_path_buf(),
                 message: e.to_string(),
             })?;
-        Ok(atomic::write_bytes(path, &bytes)?)
+        Ok(atomic::stage_bytes(path, &bytes)?)
     }
 }
 
