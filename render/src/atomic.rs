@@ -6,10 +6,68 @@
 //! together (a render's EXR and PNG) are staged first and committed as a group ([`stage`],
 //! [`commit`]): all are replaced, or on an error none is.
 
+use std::collections::HashSet;
 use std::fs;
 use std::io::{self, Write};
 use std::path::{Path, PathBuf};
+use std::sync::{Mutex, MutexGuard, PoisonError};
 use thiserror::Error;
+
+/// Temporary files of writes under way, so an interrupt can remove them (a signal ends the
+/// process without running destructors). Commits hold the lock while they rename, so an interrupt
+/// never lands in the middle of one.
+static LIVE: Mutex<Option<HashSet<PathBuf>>> = Mutex::new(None);
+
+fn live() -> MutexGuard<'static, Option<HashSet<PathBuf>>> {
+    LIVE.lock().unwrap_or_else(PoisonError::into_inner)
+}
+
+/// Removes every temporary file still registered and returns how many it removed (what the
+/// interrupt handler does before exiting).
+pub fn remove_live_temporaries() -> usize {
+    remove_registered(&mut live())
+}
+
+fn remove_registered(live: &mut Option<HashSet<PathBuf>>) -> usize {
+    live.take()
+        .unwrap_or_default()
+        .iter()
+        .filter(|p| fs::remove_file(p).is_ok())
+        .count()
+}
+
+/// Install the handler for SIGINT, SIGTERM and SIGHUP (once per process; later calls do nothing):
+/// it waits for a commit under way to finish, removes the temporary files of writes under way,
+/// and exits with status 130. The binaries call it first thing.
+pub fn remove_temporaries_on_interrupt() {
+    let _ = ctrlc::set_handler(|| {
+        let mut guard = live();
+        let n = remove_registered(&mut guard);
+        eprintln!("interrupted: removed {n} temporary file(s); nothing half-written is left");
+        std::process::exit(130);
+    });
+}
+
+/// A registered temporary path, unregistered on drop.
+#[derive(Debug)]
+struct Registered(PathBuf);
+
+impl Registered {
+    fn new(path: &Path) -> Self {
+        live()
+            .get_or_insert_with(HashSet::new)
+            .insert(path.to_path_buf());
+        Self(path.to_path_buf())
+    }
+}
+
+impl Drop for Registered {
+    fn drop(&mut self) {
+        if let Some(set) = live().as_mut() {
+            set.remove(&self.0);
+        }
+    }
+}
 
 /// Why an atomic write did not happen.
 #[derive(Debug, Error)]
@@ -58,7 +116,9 @@ fn check_target(path: &Path) -> Result<(), AtomicWriteError> {
 #[derive(Debug)]
 pub struct Staged {
     target: PathBuf,
+    // Dropped in this order: the file is removed before it leaves the interrupt registry.
     tmp: tempfile::NamedTempFile,
+    _registered: Registered,
 }
 
 /// The I/O error of an atomic write of `path`.
@@ -99,12 +159,14 @@ where
 {
     check_target(path)?;
     let tmp = temp_beside(path)?;
-    // On an error `tmp` is dropped here, which deletes the temporary file.
-    fill(tmp.path())?;
-    Ok(Staged {
+    let staged = Staged {
         target: path.to_path_buf(),
+        _registered: Registered::new(tmp.path()),
         tmp,
-    })
+    };
+    // On an error `staged` is dropped here, which deletes the temporary file.
+    fill(staged.tmp.path())?;
+    Ok(staged)
 }
 
 /// Persist staged files over their targets as one group: either every target gets its new
@@ -116,6 +178,8 @@ pub fn commit(files: Vec<Staged>) -> Result<(), AtomicWriteError> {
     // Old contents moved aside, per target: restored on failure, deleted (by drop) on success.
     let mut aside: Vec<Option<tempfile::TempPath>> = Vec::with_capacity(files.len());
     let mut done: Vec<&Path> = Vec::with_capacity(files.len());
+    // An interrupt waits for this group to be whole (new or old) before it exits.
+    let interrupt = live();
     let result = (|| {
         for f in &files {
             check_target(&f.target)?;
@@ -146,7 +210,11 @@ pub fn commit(files: Vec<Staged>) -> Result<(), AtomicWriteError> {
             }
         }
     }
-    // Dropping `files` removes any temporary not renamed; dropping `aside` the old contents.
+    // The old contents go while the interrupt still waits; then `files` is dropped, which
+    // removes any temporary not renamed (and takes the lock itself).
+    drop(aside);
+    drop(interrupt);
+    drop(files);
     result
 }
 
@@ -290,6 +358,30 @@ mod tests {
             "{:?}",
             leftovers(&dir, &keep)
         );
+        fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// A staged file is registered for the interrupt handler while it exists, and the handler's
+    /// removal deletes it; committed or dropped, it leaves the registry. (Checked on a copy of the
+    /// registry: the real one also holds other tests' writes under way.)
+    #[test]
+    fn interrupt_removes_registered_temporaries() {
+        let dir = temp_dir("interrupt");
+        let target = dir.join("render.exr");
+        let staged = stage_bytes(&target, b"half").unwrap();
+        let tmp = staged.tmp.path().to_path_buf();
+        let registered = |p: &Path| live().as_ref().is_some_and(|set| set.contains(p));
+        assert!(tmp.exists() && registered(&tmp));
+        let mut copy = Some(HashSet::from([tmp.clone()]));
+        assert_eq!(remove_registered(&mut copy), 1);
+        assert!(!tmp.exists() && copy.is_none());
+        drop(staged);
+        assert!(!registered(&tmp));
+        let staged = stage_bytes(&target, b"whole").unwrap();
+        let tmp = staged.tmp.path().to_path_buf();
+        commit(vec![staged]).unwrap();
+        assert!(!registered(&tmp));
+        assert!(leftovers(&dir, &["render.exr"]).is_empty());
         fs::remove_dir_all(&dir).unwrap();
     }
 

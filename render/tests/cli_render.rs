@@ -210,3 +210,46 @@ fn out_in_proc_fails_before_the_scene_loads() {
         "the scene was loaded: {stderr}"
     );
 }
+
+/// SIGINT during a render ends `skin render` through its interrupt handler (exit 130, the
+/// "interrupted" line) and leaves no file in `--out`: no temporary, no half pair. (The handler's
+/// removal of temporaries under way is tested in `render::atomic`.)
+#[cfg(unix)]
+#[test]
+fn sigint_during_a_render_leaves_nothing_behind() {
+    use std::io::{BufRead, BufReader};
+    use std::process::Stdio;
+    let s = Scratch::new();
+    let (scene, out) = (s.scene(), s.out().display().to_string());
+    let mut child = Command::new(env!("CARGO_BIN_EXE_skin"))
+        .args(["render", "--quiet", "--scene", &scene, "--out", &out])
+        .args(["--width", "64", "--height", "64", "--spp", "1000000"])
+        .args(["--time-limit", "0", "--threads", "1"])
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("run skin");
+    let mut stderr = BufReader::new(child.stderr.take().expect("stderr"));
+    let mut text = String::new();
+    // The scene has loaded and the (long) render has started once this line is out.
+    while !text.contains("loaded in") {
+        assert!(
+            stderr.read_line(&mut text).expect("read stderr") > 0,
+            "{text}"
+        );
+    }
+    let kill = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .expect("kill");
+    assert!(kill.success());
+    let status = child.wait().expect("wait");
+    let mut rest = String::new();
+    std::io::Read::read_to_string(&mut stderr, &mut rest).expect("read stderr");
+    assert_eq!(status.code(), Some(130), "{text}{rest}");
+    assert!(rest.contains("interrupted"), "{rest}");
+    let left: Vec<_> = std::fs::read_dir(s.out())
+        .expect("--out was created before the render")
+        .map(|e| e.expect("entry").file_name())
+        .collect();
+    assert!(left.is_empty(), "{left:?}");
+}
