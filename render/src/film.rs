@@ -27,6 +27,8 @@ pub struct Film {
     spp: u32,
     /// Samples dropped per pixel, for the pixels that dropped any (normally none).
     dropped: BTreeMap<usize, u32>,
+    /// Samples dropped before they reached this film (by an adaptive accumulator).
+    dropped_upstream: u64,
     /// Estimated variance of each pixel's mean luminance Y (zero when not estimated).
     variance_y: Vec<f64>,
 }
@@ -41,6 +43,7 @@ impl Film {
             sum_xyz: vec![[0.0; 3]; width * height],
             spp: 0,
             dropped: BTreeMap::new(),
+            dropped_upstream: 0,
             variance_y: vec![0.0; width * height],
         }
     }
@@ -65,7 +68,15 @@ impl Film {
             spp,
             variance_y,
             dropped: BTreeMap::new(),
+            dropped_upstream: 0,
         }
+    }
+
+    /// The film, reporting `n` more non-finite samples dropped before its means were formed.
+    #[must_use]
+    pub fn with_dropped(mut self, n: u64) -> Self {
+        self.dropped_upstream += n;
+        self
     }
 
     /// Estimated variance of pixel (x, y)'s mean luminance Y (the `variance` pass).
@@ -89,7 +100,7 @@ impl Film {
     /// Non-finite samples dropped so far, over all pixels.
     #[must_use]
     pub fn dropped_samples(&self) -> u64 {
-        self.dropped.values().map(|&n| u64::from(n)).sum()
+        self.dropped_upstream + self.dropped.values().map(|&n| u64::from(n)).sum::<u64>()
     }
 
     /// Add one sample per pixel for the whole image: `pass[i]` is pixel i's XYZ estimate.

@@ -33,8 +33,13 @@ struct Scratch {
 
 impl Scratch {
     fn new() -> Self {
+        Self::with_scene(SLAB)
+    }
+
+    /// A scratch folder whose `slab.toml` holds `text` instead of the slab.
+    fn with_scene(text: &str) -> Self {
         let dir = tempfile::tempdir().expect("temp dir");
-        std::fs::write(dir.path().join("slab.toml"), SLAB).expect("write scene");
+        std::fs::write(dir.path().join("slab.toml"), text).expect("write scene");
         Self { dir }
     }
 
@@ -252,4 +257,43 @@ fn sigint_during_a_render_leaves_nothing_behind() {
         .map(|e| e.expect("entry").file_name())
         .collect();
     assert!(left.is_empty(), "{left:?}");
+}
+
+/// A point light of the largest intensity 10 nm above a wall, seen up close: the samples near its
+/// foot (irradiance 1e30 / d²) overflow f32. `skin render` drops and counts them, prints the
+/// report line, and writes an image whose every pixel is finite.
+#[test]
+fn overflowing_samples_are_dropped_and_reported_in_the_summary() {
+    let s = Scratch::with_scene(
+        r#"
+[camera]
+position_mm = [0, 0, 1]
+look_at_mm = [0, 0, 0]
+fov_deg = 0.01
+[materials.wall]
+type = "diffuse"
+albedo = 0.8
+[[meshes]]
+shape = "quad"
+material = "wall"
+scale = 10
+[[lights]]
+type = "point"
+position_mm = [0, 0, 1e-5]
+intensity = 1e30
+"#,
+    );
+    let out = s.render(&[]);
+    assert_outputs(&s, &out);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    let line = stderr
+        .lines()
+        .find(|l| l.starts_with("dropped "))
+        .unwrap_or_else(|| panic!("no dropped-samples report: {stderr}"));
+    let n: u64 = line
+        .split_whitespace()
+        .nth(1)
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("{line}"));
+    assert!(n > 0 && line.contains("non-finite samples"), "{line}");
 }
