@@ -2,29 +2,21 @@
 //! written), and tiny end-to-end renders with `--method multipole` and `--no-subsurface` whose
 //! outputs are a valid EXR and PNG of the requested size.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 /// A flat slab of skin under a distant light, seen head-on: small enough to load in well under a
 /// second with the multipole method.
-const SLAB: &str = r#"
-[camera]
-position_mm = [0, 0, 500]
-look_at_mm = [0, 0, 0]
-fov_deg = 2
-[materials.skin]
-type = "skin"
-preset = "light"
-[[meshes]]
-shape = "quad"
-material = "skin"
-scale = 1000
-[[lights]]
-type = "distant"
-direction = [0, 0, 1]
-spectrum = "d65"
-intensity = 1
-"#;
+fn slab() -> String {
+    common::SceneText::camera([0.0, 0.0, 500.0], 2.0)
+        .skin("skin", "preset = \"light\"")
+        .mesh("quad", "skin", 1000.0)
+        .distant([0.0, 0.0, 1.0], 1.0)
+        .text()
+        .to_string()
+}
 
 /// A scratch folder holding the slab scene; `out` inside it does not exist yet.
 struct Scratch {
@@ -33,7 +25,7 @@ struct Scratch {
 
 impl Scratch {
     fn new() -> Self {
-        Self::with_scene(SLAB)
+        Self::with_scene(&slab())
     }
 
     /// A scratch folder whose `slab.toml` holds `text` instead of the slab.

@@ -168,14 +168,7 @@ pub fn run(args: &SpectrumArgs) -> anyhow::Result<()> {
     let hex = srgb.to_hex();
     eprintln!("srgb {hex}");
     let lab = skin_optics::lab::Lab::from_xyz(xyz);
-    eprintln!(
-        "lab L*={:.2} a*={:.2} b*={:.2} ITA°={:.1} ({})",
-        lab.l,
-        lab.a,
-        lab.b,
-        lab.ita_deg(),
-        lab.ita_category()
-    );
+    eprintln!("{}", lab_line(&lab));
     if grid.start_nm() > 400.0 || grid.nm(grid.len() - 1) < 700.0 {
         eprintln!(
             "note: the grid does not cover 400-700 nm; the colour holds the end reflectances beyond it"
@@ -312,4 +305,17 @@ mod tests {
         assert_eq!(format_nm(400.300_000_000_000_07), "400.3");
         assert_eq!(format_nm(412.25), "412.25");
     }
+}
+
+/// The `lab L*=… a*=… b*=… ITA°=… (category)` line `skin spectrum` prints after the spectrum.
+#[must_use]
+pub fn lab_line(lab: &skin_optics::lab::Lab) -> String {
+    format!(
+        "lab L*={:.2} a*={:.2} b*={:.2} ITA°={:.1} ({})",
+        lab.l,
+        lab.a,
+        lab.b,
+        lab.ita_deg(),
+        lab.ita_category()
+    )
 }
