@@ -362,6 +362,11 @@ mod tests {
         let two = Stack::new(vec![half, half])
             .unwrap()
             .response(0.0, Poles::Exact);
+        eprintln!(
+            "halves/whole − 1: R {}, T {}",
+            two.r_down / whole.total_reflectance(Poles::Exact) - 1.0,
+            two.t_down / whole.total_transmittance(Poles::Exact) - 1.0
+        );
         assert_relative_eq!(
             two.r_down,
             whole.total_reflectance(Poles::Exact),

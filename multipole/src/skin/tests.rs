@@ -253,6 +253,7 @@ mod direction_tests {
             .over(&st.layers()[1].response(0.0, Poles::Exact))
             .r_down;
         let excess = symmetric / directional - 1.0;
+        eprintln!("symmetric/directional − 1 = {excess}");
         assert!(
             (0.10..0.25).contains(&excess),
             "symmetric/directional − 1 = {excess}"
