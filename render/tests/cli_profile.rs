@@ -72,28 +72,13 @@ fn explicit_r_max_and_preset() {
 #[test]
 fn bad_values_name_the_flag_and_range() {
     for (args, flag, range) in [
-        (vec!["--lambda", "100"], "--lambda", "[250, 1000]"),
-        (
-            vec!["--lambda", "500", "--samples", "1"],
-            "--samples",
-            "[2, 1000000]",
-        ),
-        (
-            vec!["--lambda", "500", "--r-max", "-3"],
-            "--r-max",
-            "[0.002, 10000]",
-        ),
-        (
-            vec!["--lambda", "500", "--melanin", "1.5"],
-            "--melanin",
-            "[0, 1]",
-        ),
-        (
-            vec!["--lambda", "500", "--method", "mcml"],
-            "--method",
-            "multipole",
-        ),
+        ("--lambda 100", "--lambda", "[250, 1000]"),
+        ("--lambda 500 --samples 1", "--samples", "[2, 1000000]"),
+        ("--lambda 500 --r-max -3", "--r-max", "[0.002, 10000]"),
+        ("--lambda 500 --melanin 1.5", "--melanin", "[0, 1]"),
+        ("--lambda 500 --method mcml", "--method", "multipole"),
     ] {
+        let args: Vec<&str> = args.split_whitespace().collect();
         let out = skin(&args);
         assert_eq!(out.status.code(), Some(2), "{args:?}");
         let err = String::from_utf8_lossy(&out.stderr);

@@ -42,51 +42,55 @@ impl Loader<'_> {
         }
     }
 
+    /// `v` if `ok(v)`, else an error naming `key`, what was `expected` and the value.
+    fn checked<T: Copy>(
+        &self,
+        key: &str,
+        v: T,
+        ok: bool,
+        expected: &str,
+        shown: f32,
+    ) -> Result<T, RenderError> {
+        if ok {
+            Ok(v)
+        } else {
+            Err(self.err(
+                key,
+                format!("expected {expected}, got {}", Num(f64::from(shown))),
+            ))
+        }
+    }
+
     /// A light's position: finite and within ±[`MAX_COORD_MM`], like the geometry, so distances
     /// and their squares stay finite in f32.
     fn point(&self, key: &str, v: [f32; 3]) -> Result<Vec3, RenderError> {
         let p = self.vec3(key, v)?;
-        if within_scene(p) {
-            Ok(p)
-        } else {
-            Err(self.err(
-                key,
-                format!(
-                    "expected a point within ±{MAX_COORD_MM:e} mm, got {}",
-                    Num(f64::from(p.abs().max_element()))
-                ),
-            ))
-        }
+        let range = format!("a point within ±{MAX_COORD_MM:e} mm");
+        self.checked(key, p, within_scene(p), &range, p.abs().max_element())
     }
 
     /// A light's size in (0, [`MAX_COORD_MM`]] mm: its area and solid angle stay finite in f32.
     fn length(&self, key: &str, v: f32) -> Result<f32, RenderError> {
-        if v.is_finite() && v > 0.0 && v <= MAX_COORD_MM {
-            Ok(v)
-        } else {
-            Err(self.err(
-                key,
-                format!(
-                    "expected a length in (0, {MAX_COORD_MM:e}] mm, got {}",
-                    Num(f64::from(v))
-                ),
-            ))
-        }
+        let ok = v.is_finite() && v > 0.0 && v <= MAX_COORD_MM;
+        self.checked(
+            key,
+            v,
+            ok,
+            &format!("a length in (0, {MAX_COORD_MM:e}] mm"),
+            v,
+        )
     }
 
     /// A light's intensity in [0, [`MAX_INTENSITY`]].
     fn intensity(&self, key: &str, v: f32) -> Result<f32, RenderError> {
-        if v.is_finite() && (0.0..=MAX_INTENSITY).contains(&v) {
-            Ok(v)
-        } else {
-            Err(self.err(
-                key,
-                format!(
-                    "expected an intensity in [0, {MAX_INTENSITY:e}], got {}",
-                    Num(f64::from(v))
-                ),
-            ))
-        }
+        let ok = v.is_finite() && (0.0..=MAX_INTENSITY).contains(&v);
+        self.checked(
+            key,
+            v,
+            ok,
+            &format!("an intensity in [0, {MAX_INTENSITY:e}]"),
+            v,
+        )
     }
 
     fn positive(&self, key: &str, v: f32) -> Result<f32, RenderError> {
