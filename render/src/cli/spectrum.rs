@@ -253,6 +253,19 @@ fn plot(
     .with_context(|| format!("--plot {}", path.display()))
 }
 
+/// The `lab L*=… a*=… b*=… ITA°=… (category)` line `skin spectrum` prints after the spectrum.
+#[must_use]
+pub fn lab_line(lab: &skin_optics::lab::Lab) -> String {
+    format!(
+        "lab L*={:.2} a*={:.2} b*={:.2} ITA°={:.1} ({})",
+        lab.l,
+        lab.a,
+        lab.b,
+        lab.ita_deg(),
+        lab.ita_category()
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -305,17 +318,4 @@ mod tests {
         assert_eq!(format_nm(400.300_000_000_000_07), "400.3");
         assert_eq!(format_nm(412.25), "412.25");
     }
-}
-
-/// The `lab L*=… a*=… b*=… ITA°=… (category)` line `skin spectrum` prints after the spectrum.
-#[must_use]
-pub fn lab_line(lab: &skin_optics::lab::Lab) -> String {
-    format!(
-        "lab L*={:.2} a*={:.2} b*={:.2} ITA°={:.1} ({})",
-        lab.l,
-        lab.a,
-        lab.b,
-        lab.ita_deg(),
-        lab.ita_category()
-    )
 }
