@@ -5,10 +5,12 @@
 //! max_energy_density_error, total_relative_error, r99_relative_error. One knob varies at a time,
 //! the others stay at their defaults.
 
+#[path = "shared/write.rs"]
+mod shared;
+
 use multipole::skin::{Method, profile, profile_error};
 use multipole::{Poles, ProfileOptions};
 use skin_optics::{Preset, SkinParams, Wavelength};
-use std::io::Write;
 use std::time::Instant;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -16,6 +18,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .nth(1)
         .unwrap_or_else(|| "out/multipole_knobs.csv".into());
     let d = ProfileOptions::default();
+    // The same kind of sweep as `skin-validate`'s knob study (validation/src/compare/knobs.rs), on
+    // purpose wider and timed: that study charts error against time for the documented ranges,
+    // this example finds where each knob stops paying. An example cannot call the validation crate.
     let mut settings: Vec<(&str, String, ProfileOptions)> = Vec::new();
     for n in [0usize, 1, 2, 5, 10, 20, 50] {
         settings.push((
@@ -102,14 +107,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
     }
     eprintln!();
-    // Write to a temporary name and rename, so a crash leaves no half file.
-    let path = std::path::Path::new(&out);
-    if let Some(dir) = path.parent() {
-        std::fs::create_dir_all(dir)?;
-    }
-    let tmp = path.with_extension("csv.tmp");
-    std::fs::File::create(&tmp)?.write_all(csv.as_bytes())?;
-    std::fs::rename(&tmp, path)?;
-    eprintln!("wrote {}", path.display());
+    shared::write_atomically(std::path::Path::new(&out), csv.as_bytes())?;
     Ok(())
 }

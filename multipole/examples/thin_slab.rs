@@ -5,10 +5,12 @@
 //! `cargo run --release -p multipole --example thin_slab [OUT.csv]` (default `out/multipole_thin_slab.csv`).
 //! Slab: σa = 0.1, σs' = 2 mm⁻¹ (ℓ = 0.476 mm), η_top = 1.4, η_bottom = 1; also σa = 0 (energy check).
 
+#[path = "shared/write.rs"]
+mod shared;
+
 use multipole::boundary::a_coefficient;
 use multipole::medium::pole_transform;
 use multipole::{Medium, Poles, Slab};
-use std::io::Write;
 
 /// The untreated 11-pair multipole totals (R, T) at q = 0.
 fn raw(m: &Medium, d: f64) -> (f64, f64) {
@@ -55,14 +57,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             ));
         }
     }
-    let path = std::path::Path::new(&out);
-    if let Some(dir) = path.parent() {
-        std::fs::create_dir_all(dir)?;
-    }
-    // Temporary name then rename: no half-written file.
-    let tmp = path.with_extension("csv.tmp");
-    std::fs::File::create(&tmp)?.write_all(csv.as_bytes())?;
-    std::fs::rename(&tmp, path)?;
-    eprintln!("wrote {}", path.display());
+    shared::write_atomically(std::path::Path::new(&out), csv.as_bytes())?;
     Ok(())
 }

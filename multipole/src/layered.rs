@@ -31,6 +31,8 @@ pub struct Layer {
 }
 
 impl Layer {
+    // The arguments repeat the fields one for one: this is the single constructor every public
+    // one funnels into, where the ranges are checked.
     fn checked(
         sigma_a: f64,
         sigma_s: f64,

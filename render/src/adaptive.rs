@@ -23,6 +23,8 @@ pub struct Accumulator {
     sum_xyz: Vec<[f64; 3]>,
     sum_y2: Vec<f64>,
     count: Vec<u32>,
+    /// Non-finite samples dropped (not in `count` or the sums).
+    dropped: u64,
 }
 
 impl Accumulator {
@@ -36,15 +38,16 @@ impl Accumulator {
             sum_xyz: vec![[0.0; 3]; n],
             sum_y2: vec![0.0; n],
             count: vec![0; n],
+            dropped: 0,
         }
     }
 
     /// Add one XYZ sample to pixel `i` (row-major).
     pub fn add(&mut self, i: usize, xyz: [f32; 3]) {
-        // A non-finite sample counts as a zero-valued one, as the film treats it, so no NaN or
-        // infinity reaches the image or the stopping rule.
+        // A non-finite sample is dropped and counted, as the film does, so no NaN or infinity
+        // reaches the image or the stopping rule; the pixel averages the samples it kept.
         if !xyz.iter().all(|c| c.is_finite()) {
-            self.count[i] += 1;
+            self.dropped += 1;
             return;
         }
         for (sum, v) in self.sum_xyz[i].iter_mut().zip(xyz) {
@@ -54,7 +57,13 @@ impl Accumulator {
         self.count[i] += 1;
     }
 
-    /// Samples taken at pixel `i`.
+    /// Non-finite samples dropped so far, over all pixels.
+    #[must_use]
+    pub fn dropped(&self) -> u64 {
+        self.dropped
+    }
+
+    /// Samples kept at pixel `i`.
     #[must_use]
     pub fn count(&self, i: usize) -> u32 {
         self.count[i]
@@ -167,7 +176,7 @@ impl Accumulator {
             .map(|v| if v.is_finite() { v } else { 0.0 })
             .collect();
         let spp = self.count.iter().copied().max().unwrap_or(0);
-        Film::from_means(self.width, self.height, mean, var, spp)
+        Film::from_means(self.width, self.height, mean, var, spp).with_dropped(self.dropped)
     }
 }
 
@@ -187,6 +196,22 @@ mod tests {
         assert!((v - 4.0 / 3.0 / 4.0).abs() < 1e-12, "{v}");
         // Relative error √(1/3)/2 ≈ 0.289.
         assert!((acc.noise_estimate() - (1.0f64 / 3.0).sqrt() / 2.0).abs() < 1e-12);
+    }
+
+    /// A non-finite sample is left out of the pixel's mean and variance and counted, and the
+    /// film reports it.
+    #[test]
+    fn non_finite_samples_are_dropped_and_counted() {
+        let mut acc = Accumulator::new(1, 1);
+        for y in [1.0, f32::NAN, 3.0, f32::INFINITY] {
+            acc.add(0, [0.0, y, 0.0]);
+        }
+        acc.add(0, [f32::NEG_INFINITY, 1.0, 0.0]);
+        assert_eq!((acc.count(0), acc.dropped()), (2, 3));
+        assert_eq!(acc.mean_luminance(), vec![2.0]);
+        let film = acc.to_film();
+        assert_eq!(film.dropped_samples(), 3);
+        assert_eq!(film.xyz(0, 0)[1], 2.0);
     }
 
     /// A constant pixel has zero error and stops at `min_spp`, not before.

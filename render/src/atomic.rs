@@ -2,12 +2,72 @@
 //! to a uniquely named temporary file in the target's own folder (`tempfile`, so two writers of the
 //! same target never share a temporary and the final rename stays on one file system), which is
 //! persisted over the target only once complete; on failure it is removed. A target that exists and
-//! is not a regular file (directory, symlink, FIFO, device) is never replaced.
+//! is not a regular file (directory, symlink, FIFO, device) is never replaced. Files that belong
+//! together (a render's EXR and PNG) are staged first and committed as a group ([`stage`],
+//! [`commit`]): all are replaced, or on an error none is.
 
+use std::collections::HashSet;
 use std::fs;
 use std::io::{self, Write};
 use std::path::{Path, PathBuf};
+use std::sync::{Mutex, MutexGuard, PoisonError};
 use thiserror::Error;
+
+/// Temporary files of writes under way, so an interrupt can remove them (a signal ends the
+/// process without running destructors). Commits hold the lock while they rename, so an interrupt
+/// never lands in the middle of one.
+static LIVE: Mutex<Option<HashSet<PathBuf>>> = Mutex::new(None);
+
+fn live() -> MutexGuard<'static, Option<HashSet<PathBuf>>> {
+    LIVE.lock().unwrap_or_else(PoisonError::into_inner)
+}
+
+/// Removes every temporary file still registered and returns how many it removed (what the
+/// interrupt handler does before exiting).
+pub fn remove_live_temporaries() -> usize {
+    remove_registered(&mut live())
+}
+
+fn remove_registered(live: &mut Option<HashSet<PathBuf>>) -> usize {
+    live.take()
+        .unwrap_or_default()
+        .iter()
+        .filter(|p| fs::remove_file(p).is_ok())
+        .count()
+}
+
+/// Install the handler for SIGINT, SIGTERM and SIGHUP (once per process; later calls do nothing):
+/// it waits for a commit under way to finish, removes the temporary files of writes under way,
+/// and exits with status 130. The binaries call it first thing.
+pub fn remove_temporaries_on_interrupt() {
+    let _ = ctrlc::set_handler(|| {
+        let mut guard = live();
+        let n = remove_registered(&mut guard);
+        eprintln!("interrupted: removed {n} temporary file(s); nothing half-written is left");
+        std::process::exit(130);
+    });
+}
+
+/// A registered temporary path, unregistered on drop.
+#[derive(Debug)]
+struct Registered(PathBuf);
+
+impl Registered {
+    fn new(path: &Path) -> Self {
+        live()
+            .get_or_insert_with(HashSet::new)
+            .insert(path.to_path_buf());
+        Self(path.to_path_buf())
+    }
+}
+
+impl Drop for Registered {
+    fn drop(&mut self) {
+        if let Some(set) = live().as_mut() {
+            set.remove(&self.0);
+        }
+    }
+}
 
 /// Why an atomic write did not happen.
 #[derive(Debug, Error)]
@@ -51,21 +111,29 @@ fn check_target(path: &Path) -> Result<(), AtomicWriteError> {
     })
 }
 
-/// Write `path` through `fill`, which receives the path of a fresh temporary file (in the same
-/// folder) to write; on success it is renamed over `path`, on failure it is removed. Parent
-/// folders are created.
-pub fn write_via_temp<E>(path: &Path, fill: impl FnOnce(&Path) -> Result<(), E>) -> Result<(), E>
-where
-    E: From<AtomicWriteError>,
-{
-    let io_err = |source| AtomicWriteError::Io {
+/// A complete temporary file waiting to be persisted over its target (see [`commit`]); dropped
+/// uncommitted, it is removed.
+#[derive(Debug)]
+pub struct Staged {
+    target: PathBuf,
+    // Dropped in this order: the file is removed before it leaves the interrupt registry.
+    tmp: tempfile::NamedTempFile,
+    _registered: Registered,
+}
+
+/// The I/O error of an atomic write of `path`.
+fn io_error(path: &Path) -> impl Fn(io::Error) -> AtomicWriteError + '_ {
+    move |source| AtomicWriteError::Io {
         path: path.to_path_buf(),
         source,
-    };
-    check_target(path)?;
+    }
+}
+
+/// A fresh, uniquely named temporary file beside `path` (`name.XXXXXX.tmp`), creating the folder.
+fn temp_beside(path: &Path) -> Result<tempfile::NamedTempFile, AtomicWriteError> {
     let dir = match path.parent().filter(|d| !d.as_os_str().is_empty()) {
         Some(dir) => {
-            fs::create_dir_all(dir).map_err(io_err)?;
+            fs::create_dir_all(dir).map_err(io_error(path))?;
             dir
         }
         None => Path::new("."),
@@ -75,28 +143,102 @@ where
         .map(|n| n.to_os_string())
         .unwrap_or_default();
     prefix.push(".");
-    let tmp = tempfile::Builder::new()
+    tempfile::Builder::new()
         .prefix(&prefix)
         .suffix(".tmp")
         .tempfile_in(dir)
-        .map_err(io_err)?;
-    // On an error `tmp` is dropped here, which deletes the temporary file.
-    fill(tmp.path())?;
+        .map_err(io_error(path))
+}
+
+/// Write the future contents of `path` through `fill`, which receives the path of a fresh
+/// temporary file in the same folder; nothing at `path` changes until [`commit`]. On failure the
+/// temporary file is removed.
+pub fn stage<E>(path: &Path, fill: impl FnOnce(&Path) -> Result<(), E>) -> Result<Staged, E>
+where
+    E: From<AtomicWriteError>,
+{
     check_target(path)?;
-    tmp.persist(path).map_err(|e| io_err(e.error))?;
-    Ok(())
+    let tmp = temp_beside(path)?;
+    let staged = Staged {
+        target: path.to_path_buf(),
+        _registered: Registered::new(tmp.path()),
+        tmp,
+    };
+    // On an error `staged` is dropped here, which deletes the temporary file.
+    fill(staged.tmp.path())?;
+    Ok(staged)
+}
+
+/// Persist staged files over their targets as one group: either every target gets its new
+/// contents, or (on an error) every target keeps what it had — the old file, or no file — and no
+/// temporary file remains. The targets are moved aside first (to unique names beside them) and
+/// moved back if a later rename fails. A crash inside this function can still leave the group
+/// mixed; an error cannot.
+pub fn commit(files: Vec<Staged>) -> Result<(), AtomicWriteError> {
+    // Old contents moved aside, per target: restored on failure, deleted (by drop) on success.
+    let mut aside: Vec<Option<tempfile::TempPath>> = Vec::with_capacity(files.len());
+    let mut done: Vec<&Path> = Vec::with_capacity(files.len());
+    // An interrupt waits for this group to be whole (new or old) before it exits.
+    let interrupt = live();
+    let result = (|| {
+        for f in &files {
+            check_target(&f.target)?;
+        }
+        for f in &files {
+            aside.push(if f.target.exists() {
+                let old = temp_beside(&f.target)?.into_temp_path();
+                fs::rename(&f.target, &old).map_err(io_error(&f.target))?;
+                Some(old)
+            } else {
+                None
+            });
+        }
+        for f in &files {
+            fs::rename(f.tmp.path(), &f.target).map_err(io_error(&f.target))?;
+            done.push(&f.target);
+        }
+        Ok(())
+    })();
+    if result.is_err() {
+        // Best effort: the error being reported matters more than one from the roll-back.
+        for target in &done {
+            let _ = fs::remove_file(target);
+        }
+        for (f, old) in files.iter().zip(&aside) {
+            if let Some(old) = old {
+                let _ = fs::rename(old, &f.target);
+            }
+        }
+    }
+    // The old contents go while the interrupt still waits; then `files` is dropped, which
+    // removes any temporary not renamed (and takes the lock itself).
+    drop(aside);
+    drop(interrupt);
+    drop(files);
+    result
+}
+
+/// Write `path` through `fill` (see [`stage`]) and persist it at once.
+pub fn write_via_temp<E>(path: &Path, fill: impl FnOnce(&Path) -> Result<(), E>) -> Result<(), E>
+where
+    E: From<AtomicWriteError>,
+{
+    let staged = stage(path, fill)?;
+    Ok(commit(vec![staged])?)
 }
 
 /// Write `bytes` to `path` atomically (unique temporary name, then rename).
 pub fn write_bytes(path: &Path, bytes: &[u8]) -> Result<(), AtomicWriteError> {
-    write_via_temp(path, |tmp| {
-        let io_err = |source| AtomicWriteError::Io {
-            path: path.to_path_buf(),
-            source,
-        };
-        let mut f = fs::File::create(tmp).map_err(io_err)?;
-        f.write_all(bytes).map_err(io_err)?;
-        f.sync_all().map_err(io_err)
+    commit(vec![stage_bytes(path, bytes)?])
+}
+
+/// Stage `bytes` as the future contents of `path` (see [`stage`]).
+pub fn stage_bytes(path: &Path, bytes: &[u8]) -> Result<Staged, AtomicWriteError> {
+    stage(path, |tmp| {
+        let io_err = io_error(path);
+        let mut f = fs::File::create(tmp).map_err(&io_err)?;
+        f.write_all(bytes).map_err(&io_err)?;
+        f.sync_all().map_err(&io_err)
     })
 }
 
@@ -144,6 +286,102 @@ mod tests {
         write_bytes(&target, b"whole").unwrap();
         assert_eq!(fs::read(&target).unwrap(), b"whole");
         assert!(leftovers(&dir, &["a.txt"]).is_empty());
+        fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// A group whose last rename fails leaves every target as it was (the old bytes, or no file)
+    /// and no temporary or moved-aside file behind; a group that succeeds replaces all of them.
+    #[test]
+    fn pair_is_committed_together_or_not_at_all() {
+        let dir = temp_dir("pair");
+        let (exr, png) = (dir.join("render.exr"), dir.join("render.png"));
+        let pair = |a: &[u8], b: &[u8]| {
+            let staged = vec![stage_bytes(&exr, a).unwrap(), stage_bytes(&png, b).unwrap()];
+            // Take the second temporary away: its rename fails after the first one succeeded.
+            fs::remove_file(staged[1].tmp.path()).unwrap();
+            commit(staged)
+        };
+        // No previous pair: neither file may appear.
+        assert!(matches!(
+            pair(b"new exr", b"new png"),
+            Err(AtomicWriteError::Io { .. })
+        ));
+        assert!(!exr.exists() && !png.exists());
+        assert!(
+            leftovers(&dir, &[]).is_empty(),
+            "{:?}",
+            leftovers(&dir, &[])
+        );
+        // A previous pair: both keep their bytes.
+        commit(vec![
+            stage_bytes(&exr, b"old exr").unwrap(),
+            stage_bytes(&png, b"old png").unwrap(),
+        ])
+        .unwrap();
+        assert!(pair(b"new exr", b"new png").is_err());
+        assert_eq!(fs::read(&exr).unwrap(), b"old exr");
+        assert_eq!(fs::read(&png).unwrap(), b"old png");
+        let keep = ["render.exr", "render.png"];
+        assert!(
+            leftovers(&dir, &keep).is_empty(),
+            "{:?}",
+            leftovers(&dir, &keep)
+        );
+        // A target that became a directory after staging: refused before anything moves.
+        let staged = vec![
+            stage_bytes(&exr, b"new exr").unwrap(),
+            stage_bytes(&png, b"new png").unwrap(),
+        ];
+        fs::remove_file(&png).unwrap();
+        fs::create_dir(&png).unwrap();
+        assert!(matches!(
+            commit(staged),
+            Err(AtomicWriteError::NotARegularFile { .. })
+        ));
+        assert_eq!(fs::read(&exr).unwrap(), b"old exr");
+        assert!(png.is_dir());
+        assert!(
+            leftovers(&dir, &keep).is_empty(),
+            "{:?}",
+            leftovers(&dir, &keep)
+        );
+        fs::remove_dir(&png).unwrap();
+        commit(vec![
+            stage_bytes(&exr, b"new exr").unwrap(),
+            stage_bytes(&png, b"new png").unwrap(),
+        ])
+        .unwrap();
+        assert_eq!(fs::read(&exr).unwrap(), b"new exr");
+        assert_eq!(fs::read(&png).unwrap(), b"new png");
+        assert!(
+            leftovers(&dir, &keep).is_empty(),
+            "{:?}",
+            leftovers(&dir, &keep)
+        );
+        fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// A staged file is registered for the interrupt handler while it exists, and the handler's
+    /// removal deletes it; committed or dropped, it leaves the registry. (Checked on a copy of the
+    /// registry: the real one also holds other tests' writes under way.)
+    #[test]
+    fn interrupt_removes_registered_temporaries() {
+        let dir = temp_dir("interrupt");
+        let target = dir.join("render.exr");
+        let staged = stage_bytes(&target, b"half").unwrap();
+        let tmp = staged.tmp.path().to_path_buf();
+        let registered = |p: &Path| live().as_ref().is_some_and(|set| set.contains(p));
+        assert!(tmp.exists() && registered(&tmp));
+        let mut copy = Some(HashSet::from([tmp.clone()]));
+        assert_eq!(remove_registered(&mut copy), 1);
+        assert!(!tmp.exists() && copy.is_none());
+        drop(staged);
+        assert!(!registered(&tmp));
+        let staged = stage_bytes(&target, b"whole").unwrap();
+        let tmp = staged.tmp.path().to_path_buf();
+        commit(vec![staged]).unwrap();
+        assert!(!registered(&tmp));
+        assert!(leftovers(&dir, &["render.exr"]).is_empty());
         fs::remove_dir_all(&dir).unwrap();
     }
 

@@ -27,6 +27,8 @@ pub struct Film {
     spp: u32,
     /// Samples dropped per pixel, for the pixels that dropped any (normally none).
     dropped: BTreeMap<usize, u32>,
+    /// Samples dropped before they reached this film (by an adaptive accumulator).
+    dropped_upstream: u64,
     /// Estimated variance of each pixel's mean luminance Y (zero when not estimated).
     variance_y: Vec<f64>,
 }
@@ -41,6 +43,7 @@ impl Film {
             sum_xyz: vec![[0.0; 3]; width * height],
             spp: 0,
             dropped: BTreeMap::new(),
+            dropped_upstream: 0,
             variance_y: vec![0.0; width * height],
         }
     }
@@ -65,7 +68,15 @@ impl Film {
             spp,
             variance_y,
             dropped: BTreeMap::new(),
+            dropped_upstream: 0,
         }
+    }
+
+    /// The film, reporting `n` more non-finite samples dropped before its means were formed.
+    #[must_use]
+    pub fn with_dropped(mut self, n: u64) -> Self {
+        self.dropped_upstream += n;
+        self
     }
 
     /// Estimated variance of pixel (x, y)'s mean luminance Y (the `variance` pass).
@@ -89,7 +100,7 @@ impl Film {
     /// Non-finite samples dropped so far, over all pixels.
     #[must_use]
     pub fn dropped_samples(&self) -> u64 {
-        self.dropped.values().map(|&n| u64::from(n)).sum()
+        self.dropped_upstream + self.dropped.values().map(|&n| u64::from(n)).sum::<u64>()
     }
 
     /// Add one sample per pixel for the whole image: `pass[i]` is pixel i's XYZ estimate.
@@ -167,6 +178,16 @@ impl Film {
 
     /// Write the tone-mapped sRGB PNG.
     pub fn write_png(&self, path: &Path, exposure_stops: f32) -> Result<(), RenderError> {
+        Ok(atomic::commit(vec![self.stage_png(path, exposure_stops)?])?)
+    }
+
+    /// The tone-mapped sRGB PNG, staged beside `path` for [`atomic::commit`] (so it can be
+    /// committed together with the EXR).
+    pub fn stage_png(
+        &self,
+        path: &Path,
+        exposure_stops: f32,
+    ) -> Result<atomic::Staged, RenderError> {
         use image::ImageEncoder;
         let mut bytes = Vec::new();
         image::codecs::png::PngEncoder::new(&mut bytes)
@@ -180,7 +201,7 @@ impl Film {
                 path: path.to_path_buf(),
                 message: e.to_string(),
             })?;
-        Ok(atomic::write_bytes(path, &bytes)?)
+        Ok(atomic::stage_bytes(path, &bytes)?)
     }
 }
 

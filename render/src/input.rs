@@ -20,6 +20,9 @@ pub struct InputKind {
 
 const MIB: u64 = 1 << 20;
 
+// One constant per kind of input, alike by design: each is a row of the table of what may be read
+// (what, extensions, size cap), kept as named constants so the loaders and the errors cite them.
+
 /// A scene description (TOML), at most 4 MiB.
 pub const SCENE: InputKind = InputKind {
     what: "scene",

@@ -106,6 +106,12 @@ impl Passes {
     /// Write `film` (linear sRGB `R`, `G`, `B`), its `variance.Y` and these passes as one
     /// 32-bit float OpenEXR.
     pub fn write_exr(&self, film: &Film, path: &Path) -> Result<(), RenderError> {
+        Ok(atomic::commit(vec![self.stage_exr(film, path)?])?)
+    }
+
+    /// The EXR of [`Passes::write_exr`], staged beside `path` for [`atomic::commit`] (so it can
+    /// be committed together with the PNG).
+    pub fn stage_exr(&self, film: &Film, path: &Path) -> Result<atomic::Staged, RenderError> {
         use exr::prelude::*;
         let (w, h) = (self.width, self.height);
         let out_err = |message: String| RenderError::Output {
@@ -138,7 +144,7 @@ impl Passes {
             AnyChannels::sort(channels.into()),
         );
         let image = Image::from_layer(layer);
-        atomic::write_via_temp(path, |tmp| {
+        atomic::stage(path, |tmp| {
             image
                 .write()
                 .to_file(tmp)

@@ -243,15 +243,8 @@ fn render_passes(scene: &Scene, s: &RenderSettings) -> Result<(Film, RenderStats
                         let lens = Vec2::new(rng.random(), rng.random());
                         let (o, d) = scene.camera.generate_ray(film_pos, aspect, lens);
                         let l = radiance(scene, &s.path, o, d, &wl, &mut rng, &mut tile_rays);
-                        // A non-finite sample would poison the pixel: drop it (counted as black).
-                        out.push((
-                            i,
-                            if l.is_finite() {
-                                wl.to_xyz(&l)
-                            } else {
-                                [0.0; 3]
-                            },
-                        ));
+                        // A non-finite sample is dropped and counted by the accumulator.
+                        out.push((i, wl.to_xyz(&l)));
                     }
                 }
                 rays.fetch_add(tile_rays, Ordering::Relaxed);

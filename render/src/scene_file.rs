@@ -311,7 +311,9 @@ fn one() -> f32 {
     1.0
 }
 
-/// `[[lights]]`; every light has `spectrum` (default d65), `temperature_k` (blackbody) and `intensity`.
+/// `[[lights]]`; every light has `spectrum` (default d65), `temperature_k` (blackbody) and `intensity`
+/// in [0, 1e30] (`light::MAX_INTENSITY`; the environment's too). Positions lie within ±1e9 mm and
+/// sizes (`radius_mm`, `size_mm`) in (0, 1e9] mm, as the geometry's coordinates.
 #[derive(Debug, Deserialize)]
 #[serde(tag = "type", rename_all = "lowercase", deny_unknown_fields)]
 pub enum LightDesc {

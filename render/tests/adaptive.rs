@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::scene;
+use common::SceneText;
 use render::film::Film;
 use render::noise::{luminance, relative_noise};
 use render::renderer::{RenderOptions, RenderStats, render};
@@ -11,35 +11,17 @@ use render::scene::Scene;
 
 /// A grey plane lit by a small sphere light and a dim environment: every pixel is noisy (light
 /// sampling and the bounce), none has a known closed form, so fixed sampling is the reference.
-const LIT_PLANE: &str = r#"
-    [camera]
-    position_mm = [0, 0, 500]
-    look_at_mm = [0, 0, 0]
-    fov_deg = 30
-    [environment]
-    spectrum = "d65"
-    intensity = 0.05
-    [materials.grey]
-    type = "diffuse"
-    albedo = 0.5
-    [materials.white]
-    type = "diffuse"
-    albedo = 0.9
-    [[meshes]]
-    shape = "quad"
-    material = "grey"
-    scale = 1000
-    [[meshes]]
-    shape = "sphere"
-    material = "white"
-    scale = 60
-    translate_mm = [0, 0, 60]
-    [[lights]]
-    type = "sphere"
-    center_mm = [150, 150, 200]
-    radius_mm = 20
-    intensity = 40
-"#;
+fn lit_plane() -> Scene {
+    SceneText::camera([0.0, 0.0, 500.0], 30.0)
+        .environment("d65", 0.05)
+        .diffuse("grey", 0.5)
+        .diffuse("white", 0.9)
+        .mesh("quad", "grey", 1000.0)
+        .mesh("sphere", "white", 60.0)
+        .with("translate_mm = [0, 0, 60]")
+        .sphere_light([150.0, 150.0, 200.0], 20.0, 40.0)
+        .load()
+}
 
 fn run(s: &Scene, spp: u32, noise: Option<f64>, seed: u64, threads: usize) -> (Film, RenderStats) {
     let o = RenderOptions {
@@ -78,7 +60,7 @@ fn mean_and_stderr(film: &Film) -> (f64, f64) {
 /// errors (a false failure has probability 6·10⁻⁵), while the adaptive render took fewer samples.
 #[test]
 fn adaptive_mean_equals_fixed_mean() {
-    let s = scene(LIT_PLANE);
+    let s = lit_plane();
     let (fixed, _) = run(&s, 256, None, 1, 2);
     let (adaptive, stats) = run(&s, 256, Some(0.05), 2, 2);
     let (mf, ef) = mean_and_stderr(&fixed);
@@ -95,7 +77,7 @@ fn adaptive_mean_equals_fixed_mean() {
 /// (576 lit pixels: the metric itself fluctuates by about 1/√(2·576) ≈ 3%).
 #[test]
 fn noise_estimate_matches_two_seed_measurement() {
-    let s = scene(LIT_PLANE);
+    let s = lit_plane();
     let (a, sa) = run(&s, 32, None, 1, 2);
     let (b, sb) = run(&s, 32, None, 2, 2);
     let measured = relative_noise(&luminances(&a), &luminances(&b))
@@ -111,7 +93,7 @@ fn noise_estimate_matches_two_seed_measurement() {
 /// With a noise target, the same seed gives the same image on one and on two threads.
 #[test]
 fn adaptive_render_is_thread_count_independent() {
-    let s = scene(LIT_PLANE);
+    let s = lit_plane();
     let (a, _) = run(&s, 64, Some(0.05), 3, 1);
     let (b, _) = run(&s, 64, Some(0.05), 3, 2);
     assert_eq!(a, b);

@@ -1,6 +1,8 @@
 //! Bad scene files fail with a message naming the file, the key (or path) and what was expected,
 //! and `skin render` writes no image.
 
+mod common;
+
 use clap::Parser;
 use render::cli::render::{RenderArgs, run};
 use std::path::PathBuf;
@@ -11,22 +13,15 @@ struct Cli {
     args: RenderArgs,
 }
 
-const GOOD: &str = r#"
-[camera]
-position_mm = [0, 0, 300]
-look_at_mm = [0, 0, 0]
-fov_deg = 30
-
-[materials.skin]
-type = "skin"
-preset = "light"
-
-[[meshes]]
-shape = "sphere"
-material = "skin"
-scale = 50
-translate_mm = [0, 0, 0]
-"#;
+/// A scene that loads and renders: a skin sphere seen from 300 mm.
+fn good() -> String {
+    common::SceneText::camera([0.0, 0.0, 300.0], 30.0)
+        .skin("skin", "preset = \"light\"")
+        .mesh("sphere", "skin", 50.0)
+        .with("translate_mm = [0, 0, 0]")
+        .text()
+        .to_string()
+}
 
 fn dir(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("skin-bad-scene-{}-{name}", std::process::id()));
@@ -77,19 +72,19 @@ fn assert_mentions(err: &str, parts: &[&str]) {
 
 #[test]
 fn the_good_scene_renders() {
-    render_text("good", GOOD).unwrap();
+    render_text("good", &good()).unwrap();
 }
 
 #[test]
 fn unknown_key_is_named() {
-    let text = GOOD.replace("fov_deg = 30", "fov_deg = 30\nzoom = 2");
+    let text = good().replace("fov_deg = 30", "fov_deg = 30\nzoom = 2");
     let e = render_text("unknown", &text).unwrap_err();
     assert_mentions(&e, &["scene.toml", "zoom", "unknown field"]);
 }
 
 #[test]
 fn missing_mesh_names_its_path() {
-    let text = GOOD.replace("shape = \"sphere\"", "file = \"no_such_head.glb\"");
+    let text = good().replace("shape = \"sphere\"", "file = \"no_such_head.glb\"");
     let e = render_text("missing", &text).unwrap_err();
     assert_mentions(&e, &["mesh", "no_such_head.glb"]);
     assert_mentions(&e, &["cannot be read"]);
@@ -97,7 +92,7 @@ fn missing_mesh_names_its_path() {
 
 #[test]
 fn invalid_skin_parameter_is_named() {
-    let text = GOOD.replace("preset = \"light\"", "preset = \"light\"\nmelanin = 1.5");
+    let text = good().replace("preset = \"light\"", "preset = \"light\"\nmelanin = 1.5");
     let e = render_text("skin", &text).unwrap_err();
     assert_mentions(
         &e,
@@ -107,12 +102,12 @@ fn invalid_skin_parameter_is_named() {
 
 #[test]
 fn non_finite_transform_is_named() {
-    let text = GOOD.replace("translate_mm = [0, 0, 0]", "translate_mm = [nan, 0, 0]");
+    let text = good().replace("translate_mm = [0, 0, 0]", "translate_mm = [nan, 0, 0]");
     let e = render_text("nan", &text).unwrap_err();
     // Refused while parsing, on one line with its position.
     assert_mentions(&e, &["scene.toml", "line 15, column 16", "finite"]);
     assert!(!e.contains('\n'), "{e}");
-    let text = GOOD.replace("scale = 50", "scale = inf");
+    let text = good().replace("scale = 50", "scale = inf");
     let e = render_text("inf", &text).unwrap_err();
     assert_mentions(&e, &["line 14, column 9", "finite"]);
 }
@@ -124,7 +119,7 @@ fn geometry_placed_beyond_2e19_mm_is_named() {
         ("translate", "scale = 50\ntranslate_mm = [3e38, 0, 0]"),
         ("units", "scale = 50\nunits_mm = 2e19"),
     ] {
-        let text = GOOD
+        let text = good()
             .replace("translate_mm = [0, 0, 0]", "")
             .replace("scale = 50", placement);
         let e = render_text(case, &text).unwrap_err();
@@ -134,13 +129,14 @@ fn geometry_placed_beyond_2e19_mm_is_named() {
 
 #[test]
 fn dev_zero_as_scene_mesh_texture_or_environment_is_refused_before_reading() {
+    let good = good();
     let cli = Cli::parse_from(["render", "--scene", "/dev/zero", "--quiet"]);
     let e = format!("{:#}", run(&cli.args).unwrap_err());
     assert_mentions(&e, &["/dev/zero", ".toml"]);
-    let mesh = GOOD.replace("shape = \"sphere\"", "file = \"/dev/zero\"");
+    let mesh = good.replace("shape = \"sphere\"", "file = \"/dev/zero\"");
     let e = render_text("zero-mesh", &mesh).unwrap_err();
     assert_mentions(&e, &["/dev/zero", ".glb or .obj"]);
-    let env = format!("{GOOD}\n[environment]\nexr = \"/dev/zero\"\nintensity = 1\n");
+    let env = format!("{good}\n[environment]\nexr = \"/dev/zero\"\nintensity = 1\n");
     let e = render_text("zero-env", &env).unwrap_err();
     assert_mentions(&e, &["/dev/zero", ".exr"]);
 }
@@ -154,12 +150,74 @@ fn toml_errors_take_one_line() {
 
 #[test]
 fn unknown_material_and_bad_light_are_named() {
-    let text = GOOD.replace("material = \"skin\"", "material = \"bone\"");
+    let good = good();
+    let text = good.replace("material = \"skin\"", "material = \"bone\"");
     let e = render_text("material", &text).unwrap_err();
     assert_mentions(&e, &["meshes[0].material", "bone"]);
     let text = format!(
-        "{GOOD}\n[[lights]]\ntype = \"sphere\"\ncenter_mm = [0, 0, 200]\nradius_mm = -1\nintensity = 1\n"
+        "{good}\n[[lights]]\ntype = \"sphere\"\ncenter_mm = [0, 0, 200]\nradius_mm = -1\nintensity = 1\n"
     );
     let e = render_text("light", &text).unwrap_err();
-    assert_mentions(&e, &["lights[0].radius_mm", "> 0"]);
+    assert_mentions(&e, &["lights[0].radius_mm", "(0, 1e9] mm"]);
+}
+
+/// Light sizes, positions and intensities beyond what f32 transport can carry are typed errors
+/// naming the key and its range (they used to pass and turn every selection weight into inf or
+/// NaN, which silently switched light sampling off).
+#[test]
+fn huge_light_parameters_are_named_with_their_range() {
+    let good = good();
+    let quad = "type = \"quad\"\ncenter_mm = [0, 0, 200]\nlook_at_mm = [0, 0, 0]\nintensity = 1";
+    let sphere = "type = \"sphere\"\ncenter_mm = [0, 0, 200]\nintensity = 1";
+    let cases = [
+        (
+            format!("{quad}\nsize_mm = [1e20, 1e20]"),
+            "lights[0].size_mm",
+            "(0, 1e9] mm",
+        ),
+        (
+            format!("{sphere}\nradius_mm = 3e19"),
+            "lights[0].radius_mm",
+            "(0, 1e9] mm",
+        ),
+        (
+            format!("{sphere}\nradius_mm = 10").replace("intensity = 1", "intensity = 3e38"),
+            "lights[0].intensity",
+            "[0, 1e30]",
+        ),
+        (
+            format!("{sphere}\nradius_mm = 10").replace("[0, 0, 200]", "[3e38, 0, 0]"),
+            "lights[0].center_mm",
+            "1e9 mm",
+        ),
+    ];
+    for (i, (light, key, range)) in cases.iter().enumerate() {
+        let text = format!("{good}\n[[lights]]\n{light}\n");
+        let e = render_text(&format!("huge{i}"), &text).unwrap_err();
+        assert_mentions(&e, &[key, range, "scene.toml"]);
+    }
+    let text = format!("{good}\n[environment]\nintensity = 3e38\n");
+    let e = render_text("huge-env", &text).unwrap_err();
+    assert_mentions(&e, &["environment.intensity", "[0, 1e30]"]);
+}
+
+/// A distant light's direction whose squared length overflows f32 is still a direction: the
+/// scene loads with a unit `to_light` and the sphere it shines on is lit.
+#[test]
+fn distant_direction_3e38_normalises_and_lights_the_scene() {
+    let good = good();
+    let text = format!(
+        "{good}\n[[lights]]\ntype = \"distant\"\ndirection = [3e38, 3e38, 3e38]\nintensity = 1\n"
+    )
+    .replace(
+        "type = \"skin\"\npreset = \"light\"",
+        "type = \"diffuse\"\nalbedo = 0.5",
+    );
+    let scene = common::scene(&text);
+    let render::light::Light::Distant(d) = &scene.lights[0] else {
+        panic!("{:?}", scene.lights[0]);
+    };
+    assert!((d.to_light - glam::Vec3::splat(1.0 / 3f32.sqrt())).length() < 1e-6);
+    let y = common::mean_xyz(&common::run(&scene, 8, 8, 4, 1))[1];
+    assert!(y.is_finite() && y > 0.0, "{y}");
 }

@@ -269,15 +269,7 @@ fn skin_spectrum_reports_lab_and_ita_on_stderr() {
             skin_optics::Preset::Medium,
         ))
         .unwrap();
-    let want = format!(
-        "lab L*={:.2} a*={:.2} b*={:.2} ITA°={:.1} ({})",
-        lab.l,
-        lab.a,
-        lab.b,
-        lab.ita_deg(),
-        lab.ita_category()
-    );
-    assert_eq!(line, want);
+    assert_eq!(line, render::cli::spectrum::lab_line(&lab));
 }
 
 #[test]

@@ -10,25 +10,21 @@ fn skin(args: &[&str]) -> std::process::Output {
         .expect("run skin")
 }
 
-#[test]
-fn prints_csv_with_the_requested_samples() {
-    let out = skin(&[
-        "--melanin",
-        "0.002",
-        "--eumelanin",
-        "0.5",
-        "--hemoglobin",
-        "0.01",
-        "--lambda",
-        "550",
-        "--samples",
-        "64",
-    ]);
+/// `skin profile` with the whitespace-separated `args`, which must succeed.
+fn skin_ok(args: &str) -> std::process::Output {
+    let out = skin(&args.split_whitespace().collect::<Vec<_>>());
     assert!(
         out.status.success(),
-        "{}",
+        "{args}: {}",
         String::from_utf8_lossy(&out.stderr)
     );
+    out
+}
+
+#[test]
+fn prints_csv_with_the_requested_samples() {
+    let out =
+        skin_ok("--melanin 0.002 --eumelanin 0.5 --hemoglobin 0.01 --lambda 550 --samples 64");
     let text = String::from_utf8(out.stdout).unwrap();
     let mut lines = text.lines();
     assert_eq!(lines.next(), Some("r_mm,reflectance_per_mm2"));
@@ -66,21 +62,7 @@ fn prints_csv_with_the_requested_samples() {
 
 #[test]
 fn explicit_r_max_and_preset() {
-    let out = skin(&[
-        "--preset",
-        "dark",
-        "--lambda",
-        "650",
-        "--r-max",
-        "2",
-        "--samples",
-        "10",
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let out = skin_ok("--preset dark --lambda 650 --r-max 2 --samples 10");
     let text = String::from_utf8(out.stdout).unwrap();
     let last = text.lines().last().unwrap();
     let r: f64 = last.split_once(',').unwrap().0.parse().unwrap();
@@ -90,28 +72,13 @@ fn explicit_r_max_and_preset() {
 #[test]
 fn bad_values_name_the_flag_and_range() {
     for (args, flag, range) in [
-        (vec!["--lambda", "100"], "--lambda", "[250, 1000]"),
-        (
-            vec!["--lambda", "500", "--samples", "1"],
-            "--samples",
-            "[2, 1000000]",
-        ),
-        (
-            vec!["--lambda", "500", "--r-max", "-3"],
-            "--r-max",
-            "[0.002, 10000]",
-        ),
-        (
-            vec!["--lambda", "500", "--melanin", "1.5"],
-            "--melanin",
-            "[0, 1]",
-        ),
-        (
-            vec!["--lambda", "500", "--method", "mcml"],
-            "--method",
-            "multipole",
-        ),
+        ("--lambda 100", "--lambda", "[250, 1000]"),
+        ("--lambda 500 --samples 1", "--samples", "[2, 1000000]"),
+        ("--lambda 500 --r-max -3", "--r-max", "[0.002, 10000]"),
+        ("--lambda 500 --melanin 1.5", "--melanin", "[0, 1]"),
+        ("--lambda 500 --method mcml", "--method", "multipole"),
     ] {
+        let args: Vec<&str> = args.split_whitespace().collect();
         let out = skin(&args);
         assert_eq!(out.status.code(), Some(2), "{args:?}");
         let err = String::from_utf8_lossy(&out.stderr);
@@ -124,19 +91,10 @@ fn plot_writes_a_png() {
     let dir = std::env::temp_dir().join(format!("skin-profile-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let png = dir.join("profile.png");
-    let out = skin(&[
-        "--lambda",
-        "550",
-        "--samples",
-        "32",
-        "--plot",
-        png.to_str().unwrap(),
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    skin_ok(&format!(
+        "--lambda 550 --samples 32 --plot {}",
+        png.display()
+    ));
     let bytes = std::fs::read(&png).unwrap();
     assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n");
     std::fs::remove_dir_all(&dir).ok();
@@ -145,25 +103,9 @@ fn plot_writes_a_png() {
 #[test]
 fn spectral_set_has_a_lambda_column_for_both_methods() {
     for method in ["exact", "multipole"] {
-        let out = skin(&[
-            "--preset",
-            "light",
-            "--from",
-            "400",
-            "--to",
-            "700",
-            "--step",
-            "50",
-            "--samples",
-            "16",
-            "--method",
-            method,
-        ]);
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        let out = skin_ok(&format!(
+            "--preset light --from 400 --to 700 --step 50 --samples 16 --method {method}"
+        ));
         let text = String::from_utf8(out.stdout).unwrap();
         let mut lines = text.lines();
         assert_eq!(lines.next(), Some("lambda_nm,r_mm,reflectance_per_mm2"));

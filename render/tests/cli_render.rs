@@ -2,29 +2,21 @@
 //! written), and tiny end-to-end renders with `--method multipole` and `--no-subsurface` whose
 //! outputs are a valid EXR and PNG of the requested size.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 /// A flat slab of skin under a distant light, seen head-on: small enough to load in well under a
 /// second with the multipole method.
-const SLAB: &str = r#"
-[camera]
-position_mm = [0, 0, 500]
-look_at_mm = [0, 0, 0]
-fov_deg = 2
-[materials.skin]
-type = "skin"
-preset = "light"
-[[meshes]]
-shape = "quad"
-material = "skin"
-scale = 1000
-[[lights]]
-type = "distant"
-direction = [0, 0, 1]
-spectrum = "d65"
-intensity = 1
-"#;
+fn slab() -> String {
+    common::SceneText::camera([0.0, 0.0, 500.0], 2.0)
+        .skin("skin", "preset = \"light\"")
+        .mesh("quad", "skin", 1000.0)
+        .distant([0.0, 0.0, 1.0], 1.0)
+        .text()
+        .to_string()
+}
 
 /// A scratch folder holding the slab scene; `out` inside it does not exist yet.
 struct Scratch {
@@ -33,8 +25,13 @@ struct Scratch {
 
 impl Scratch {
     fn new() -> Self {
+        Self::with_scene(&slab())
+    }
+
+    /// A scratch folder whose `slab.toml` holds `text` instead of the slab.
+    fn with_scene(text: &str) -> Self {
         let dir = tempfile::tempdir().expect("temp dir");
-        std::fs::write(dir.path().join("slab.toml"), SLAB).expect("write scene");
+        std::fs::write(dir.path().join("slab.toml"), text).expect("write scene");
         Self { dir }
     }
 
@@ -209,4 +206,86 @@ fn out_in_proc_fails_before_the_scene_loads() {
         !stderr.contains("loaded in"),
         "the scene was loaded: {stderr}"
     );
+}
+
+/// SIGINT during a render ends `skin render` through its interrupt handler (exit 130, the
+/// "interrupted" line) and leaves no file in `--out`: no temporary, no half pair. (The handler's
+/// removal of temporaries under way is tested in `render::atomic`.)
+#[cfg(unix)]
+#[test]
+fn sigint_during_a_render_leaves_nothing_behind() {
+    use std::io::{BufRead, BufReader};
+    use std::process::Stdio;
+    let s = Scratch::new();
+    let (scene, out) = (s.scene(), s.out().display().to_string());
+    let mut child = Command::new(env!("CARGO_BIN_EXE_skin"))
+        .args(["render", "--quiet", "--scene", &scene, "--out", &out])
+        .args(["--width", "64", "--height", "64", "--spp", "1000000"])
+        .args(["--time-limit", "0", "--threads", "1"])
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("run skin");
+    let mut stderr = BufReader::new(child.stderr.take().expect("stderr"));
+    let mut text = String::new();
+    // The scene has loaded and the (long) render has started once this line is out.
+    while !text.contains("loaded in") {
+        assert!(
+            stderr.read_line(&mut text).expect("read stderr") > 0,
+            "{text}"
+        );
+    }
+    let kill = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .expect("kill");
+    assert!(kill.success());
+    let status = child.wait().expect("wait");
+    let mut rest = String::new();
+    std::io::Read::read_to_string(&mut stderr, &mut rest).expect("read stderr");
+    assert_eq!(status.code(), Some(130), "{text}{rest}");
+    assert!(rest.contains("interrupted"), "{rest}");
+    let left: Vec<_> = std::fs::read_dir(s.out())
+        .expect("--out was created before the render")
+        .map(|e| e.expect("entry").file_name())
+        .collect();
+    assert!(left.is_empty(), "{left:?}");
+}
+
+/// A point light of the largest intensity 10 nm above a wall, seen up close: the samples near its
+/// foot (irradiance 1e30 / d²) overflow f32. `skin render` drops and counts them, prints the
+/// report line, and writes an image whose every pixel is finite.
+#[test]
+fn overflowing_samples_are_dropped_and_reported_in_the_summary() {
+    let s = Scratch::with_scene(
+        r#"
+[camera]
+position_mm = [0, 0, 1]
+look_at_mm = [0, 0, 0]
+fov_deg = 0.01
+[materials.wall]
+type = "diffuse"
+albedo = 0.8
+[[meshes]]
+shape = "quad"
+material = "wall"
+scale = 10
+[[lights]]
+type = "point"
+position_mm = [0, 0, 1e-5]
+intensity = 1e30
+"#,
+    );
+    let out = s.render(&[]);
+    assert_outputs(&s, &out);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    let line = stderr
+        .lines()
+        .find(|l| l.starts_with("dropped "))
+        .unwrap_or_else(|| panic!("no dropped-samples report: {stderr}"));
+    let n: u64 = line
+        .split_whitespace()
+        .nth(1)
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("{line}"));
+    assert!(n > 0 && line.contains("non-finite samples"), "{line}");
 }

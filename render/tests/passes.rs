@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::scene;
+use common::{SceneText, plane};
 use glam::{Vec2, Vec3};
 use render::passes::{NO_DEPTH, Passes};
 
@@ -12,21 +12,7 @@ use render::passes::{NO_DEPTH, Passes};
 /// the centre, mask 0.
 #[test]
 fn diffuse_plane_albedo_normal_depth() {
-    let s = scene(
-        r#"
-        [camera]
-        position_mm = [0, 0, 500]
-        look_at_mm = [0, 0, 0]
-        fov_deg = 10
-        [materials.grey]
-        type = "diffuse"
-        albedo = 0.5
-        [[meshes]]
-        shape = "quad"
-        material = "grey"
-        scale = 1000
-        "#,
-    );
+    let s = plane("grey").diffuse("grey", 0.5).load();
     let p = Passes::first_hit(&s, 9, 9);
     for i in 0..81 {
         for c in 0..3 {
@@ -44,21 +30,10 @@ fn diffuse_plane_albedo_normal_depth() {
 /// depth is NO_DEPTH and the mask 0.
 #[test]
 fn sphere_normals_and_mask() {
-    let s = scene(
-        r#"
-        [camera]
-        position_mm = [0, 0, 500]
-        look_at_mm = [0, 0, 0]
-        fov_deg = 40
-        [materials.skin]
-        type = "skin"
-        preset = "medium"
-        [[meshes]]
-        shape = "sphere"
-        material = "skin"
-        scale = 100
-        "#,
-    );
+    let s = SceneText::camera([0.0, 0.0, 500.0], 40.0)
+        .skin("skin", "preset = \"medium\"")
+        .mesh("sphere", "skin", 100.0)
+        .load();
     let (w, h) = (15, 15);
     let p = Passes::first_hit(&s, w, h);
     let c = (h / 2) * w + w / 2;

@@ -6,7 +6,7 @@
 use render::bssrdf::{Directional, EnergySplit};
 mod common;
 
-use common::{mean_xyz, run, scene, xyz_of};
+use common::{SceneText, mean_xyz, run, xyz_of};
 use glam::Vec3;
 use skin_optics::color::d65;
 use skin_optics::{Preset, SkinParams, Wavelength};
@@ -17,27 +17,11 @@ const SEED: u64 = 7;
 /// A 2 m wide slab of skin of `preset` at z = 0 under a distant D65 light of irradiance 1 (luminance)
 /// from the unit direction `to_light`, seen from `camera` (mm) with a 2° field of view.
 fn slab(preset: &str, to_light: Vec3, camera: Vec3) -> render::scene::Scene {
-    scene(&format!(
-        r#"
-        [camera]
-        position_mm = [{}, {}, {}]
-        look_at_mm = [0, 0, 0]
-        fov_deg = 2
-        [materials.skin]
-        type = "skin"
-        preset = "{preset}"
-        [[meshes]]
-        shape = "quad"
-        material = "skin"
-        scale = 1000
-        [[lights]]
-        type = "distant"
-        direction = [{}, {}, {}]
-        spectrum = "d65"
-        intensity = 1
-        "#,
-        camera.x, camera.y, camera.z, to_light.x, to_light.y, to_light.z
-    ))
+    SceneText::camera(camera.to_array(), 2.0)
+        .skin("skin", &format!("preset = \"{preset}\""))
+        .mesh("quad", "skin", 1000.0)
+        .distant(to_light.to_array(), 1.0)
+        .load()
 }
 
 /// The closed-form XYZ of that slab seen from `wo` and lit from `wi` (unit vectors, z the normal):
@@ -117,27 +101,14 @@ fn flat_slab_at_oblique_incidence_and_view_matches_the_closed_form() {
 #[test]
 fn skin_sphere_in_a_white_furnace_never_exceeds_the_environment() {
     for radius in [100.0, 2.0] {
-        let s = scene(&format!(
-            r#"
-            [camera]
-            position_mm = [0, 0, {}]
-            look_at_mm = [0, 0, 0]
-            fov_deg = 10
-            [environment]
-            spectrum = "constant"
-            intensity = 1
-            [materials.skin]
-            type = "skin"
-            preset = "light"
-            hemoglobin = 0.0
-            melanin = 0.0
-            [[meshes]]
-            shape = "sphere"
-            material = "skin"
-            scale = {radius}
-            "#,
-            radius * 8.0
-        ));
+        let s = SceneText::camera([0.0, 0.0, radius * 8.0], 10.0)
+            .environment("constant", 1.0)
+            .skin(
+                "skin",
+                "preset = \"light\"\nhemoglobin = 0.0\nmelanin = 0.0",
+            )
+            .mesh("sphere", "skin", radius)
+            .load();
         let film = run(&s, 24, 24, 32, SEED);
         let y = xyz_of(|_| 1.0)[1];
         let env = xyz_of(|_| 1.0 / y);
@@ -151,10 +122,13 @@ fn skin_sphere_in_a_white_furnace_never_exceeds_the_environment() {
         if radius > 50.0 {
             // Far larger than the profiles' reach, each point of the sphere reflects the uniform
             // environment like a flat slab: ρ_dr(θ_o) + T(θ_o) R_tot = R_tot + ρ_dr (1 − R_tot) ≥ R_tot.
-            // Measured: the render falls 1.0% (Y) to 1.7% (Z) below R_tot alone, i.e. about 3% short
-            // of the flat-slab value: the curved surface loses energy the flat slab does not (probe
-            // rays that miss it, most in the red where the profiles reach furthest). The floor is
-            // R_tot − 3%, so that known deficit passes and any larger loss fails.
+            // Measured: the render falls 1.1% (Y) to 1.9% (Z) below R_tot alone, about 3% short of
+            // the flat-slab value, and by the same amount at radius 100, 400 and 1600 mm
+            // (docs/tests.md): not curvature or probe rays missing the surface, which would shrink
+            // as the radius grows past the profiles' reach. The loss is still unexplained (the
+            // closed-form slab checks cover 0° and 45°/30° only; the furnace also integrates
+            // grazing angles). The floor is R_tot − 3%, so that known deficit passes and any
+            // larger loss fails.
             let light = SkinParams::preset(Preset::Light);
             let bloodless =
                 SkinParams::new(0.0, light.eumelanin_blend(), 0.0, light.oiliness()).unwrap();
@@ -191,30 +165,15 @@ fn skin_sphere_in_a_white_furnace_never_exceeds_the_environment() {
 #[test]
 fn edge_parameters_render_finite_non_negative_images() {
     for (melanin, hemoglobin) in [(0.5, 0.05), (0.1, 0.1), (0.0, 0.05), (0.0, 0.0), (0.5, 0.1)] {
-        let s = scene(&format!(
-            r#"
-            [camera]
-            position_mm = [0, 0, 300]
-            look_at_mm = [0, 0, 0]
-            fov_deg = 30
-            [environment]
-            spectrum = "d65"
-            intensity = 0.3
-            [materials.skin]
-            type = "skin"
-            melanin = {melanin}
-            hemoglobin = {hemoglobin}
-            [[meshes]]
-            shape = "sphere"
-            material = "skin"
-            scale = 50
-            [[lights]]
-            type = "sphere"
-            center_mm = [150, 150, 150]
-            radius_mm = 20
-            intensity = 30
-            "#
-        ));
+        let s = SceneText::camera([0.0, 0.0, 300.0], 30.0)
+            .environment("d65", 0.3)
+            .skin(
+                "skin",
+                &format!("melanin = {melanin}\nhemoglobin = {hemoglobin}"),
+            )
+            .mesh("sphere", "skin", 50.0)
+            .sphere_light([150.0; 3], 20.0, 30.0)
+            .load();
         let film = run(&s, 16, 16, 4, SEED);
         let (w, h) = film.size();
         let mut total = 0.0;

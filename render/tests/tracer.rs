@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{assert_close, mean_xyz, run, scene, xyz_of};
+use common::{SceneText, assert_close, mean_xyz, plane, run, white_furnace, xyz_of};
 use render::renderer::{RenderOptions, TILE, render};
 use render::scene::{Scene, SceneOptions};
 
@@ -15,24 +15,7 @@ const SEED: u64 = 42;
 /// environment: every path's energy is conserved and the MIS weights sum to one.
 #[test]
 fn white_furnace_sphere_matches_environment() {
-    let s = scene(
-        r#"
-        [camera]
-        position_mm = [0, 0, 300]
-        look_at_mm = [0, 0, 0]
-        fov_deg = 20
-        [environment]
-        spectrum = "constant"
-        intensity = 1
-        [materials.white]
-        type = "diffuse"
-        albedo = 1
-        [[meshes]]
-        shape = "sphere"
-        material = "white"
-        scale = 100
-        "#,
-    );
+    let s = white_furnace().load();
     let film = run(&s, 32, 32, 16, SEED);
     // Equal-energy radiance with Y = 1.
     let y = xyz_of(|_| 1.0)[1];
@@ -44,26 +27,10 @@ fn white_furnace_sphere_matches_environment() {
 /// a E cosθ / π in every direction.
 #[test]
 fn lambertian_plane_under_distant_light() {
-    let s = scene(
-        r#"
-        [camera]
-        position_mm = [0, 0, 500]
-        look_at_mm = [0, 0, 0]
-        fov_deg = 10
-        [materials.grey]
-        type = "diffuse"
-        albedo = 0.5
-        [[meshes]]
-        shape = "quad"
-        material = "grey"
-        scale = 1000
-        [[lights]]
-        type = "distant"
-        direction = [0.8660254, 0, 0.5]
-        spectrum = "d65"
-        intensity = 2
-        "#,
-    );
+    let s = plane("grey")
+        .diffuse("grey", 0.5)
+        .distant([0.866_025_4, 0.0, 0.5], 2.0)
+        .load();
     let film = run(&s, 32, 32, 8, SEED);
     let d65_y = xyz_of(skin_optics::color::d65)[1];
     let radiance = 0.5 * 2.0 * 0.5 / std::f64::consts::PI;
@@ -75,24 +42,10 @@ fn lambertian_plane_under_distant_light() {
 /// (1, 1, 1), and the PNG maps it through exposure and the tone curve.
 #[test]
 fn d65_white_plane_is_srgb_white() {
-    let s = scene(
-        r#"
-        [camera]
-        position_mm = [0, 0, 500]
-        look_at_mm = [0, 0, 0]
-        fov_deg = 10
-        [environment]
-        spectrum = "d65"
-        intensity = 1
-        [materials.white]
-        type = "diffuse"
-        albedo = 1
-        [[meshes]]
-        shape = "quad"
-        material = "white"
-        scale = 1000
-        "#,
-    );
+    let s = plane("white")
+        .environment("d65", 1.0)
+        .diffuse("white", 1.0)
+        .load();
     let film = run(&s, 32, 32, 8, SEED);
     let (w, h) = film.size();
     let mut rgb = [0.0f64; 3];
@@ -118,29 +71,12 @@ fn d65_white_plane_is_srgb_white() {
 /// sample has its own seeded stream and the film adds passes in pixel order.
 #[test]
 fn image_does_not_depend_on_thread_count() {
-    let s = scene(
-        r#"
-        [camera]
-        position_mm = [0, 0, 300]
-        look_at_mm = [0, 0, 0]
-        fov_deg = 40
-        [environment]
-        spectrum = "d65"
-        intensity = 0.2
-        [materials.skin]
-        type = "skin"
-        preset = "medium"
-        [[meshes]]
-        shape = "sphere"
-        material = "skin"
-        scale = 60
-        [[lights]]
-        type = "sphere"
-        center_mm = [200, 200, 200]
-        radius_mm = 30
-        intensity = 20
-        "#,
-    );
+    let s = SceneText::camera([0.0, 0.0, 300.0], 40.0)
+        .environment("d65", 0.2)
+        .skin("skin", "preset = \"medium\"")
+        .mesh("sphere", "skin", 60.0)
+        .sphere_light([200.0; 3], 30.0, 20.0)
+        .load();
     let mut settings = RenderOptions {
         width: 72,
         height: 40,
@@ -163,24 +99,7 @@ fn image_does_not_depend_on_thread_count() {
 /// the closed-form tests above check, never a partly added pass.
 #[test]
 fn time_limit_stops_after_whole_passes() {
-    let s = scene(
-        r#"
-        [camera]
-        position_mm = [0, 0, 300]
-        look_at_mm = [0, 0, 0]
-        fov_deg = 20
-        [environment]
-        spectrum = "constant"
-        intensity = 1
-        [materials.white]
-        type = "diffuse"
-        albedo = 1
-        [[meshes]]
-        shape = "sphere"
-        material = "white"
-        scale = 100
-        "#,
-    );
+    let s = white_furnace().load();
     let limited = RenderOptions {
         width: 16,
         height: 16,

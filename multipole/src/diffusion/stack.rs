@@ -354,24 +354,21 @@ mod tests {
 
     #[test]
     fn splitting_a_slab_in_two_is_close_to_the_whole() {
-        // Two halves of one slab stacked ≈ the whole slab (diffusion is only approximately additive,
-        // so a loose 10% check: it catches a wrong direction or a missing inter-reflection term).
+        // Two halves of one slab stacked ≈ the whole slab. Diffusion is only approximately
+        // additive (each half's multipole images assume its own boundaries), and the halves
+        // differ from the whole by R −0.96%, T +7.16% (measured). Both sides are deterministic
+        // sums, so those differences are pinned to 0.1 percentage point: a wrong direction, a
+        // missing inter-reflection term or a changed boundary moves them by far more.
         let m = Medium::new(0.05, 3.0).unwrap();
         let whole = Slab::new(m, 2.0, 1.0, 1.0).unwrap();
         let half = DiffusionLayer::Slab(Slab::new(m, 1.0, 1.0, 1.0).unwrap());
         let two = Stack::new(vec![half, half])
             .unwrap()
             .response(0.0, Poles::Exact);
-        assert_relative_eq!(
-            two.r_down,
-            whole.total_reflectance(Poles::Exact),
-            max_relative = 0.10
-        );
-        assert_relative_eq!(
-            two.t_down,
-            whole.total_transmittance(Poles::Exact),
-            max_relative = 0.10
-        );
+        let dr = two.r_down / whole.total_reflectance(Poles::Exact) - 1.0;
+        let dt = two.t_down / whole.total_transmittance(Poles::Exact) - 1.0;
+        assert!((dr - -0.00959).abs() < 1e-3, "halves/whole − 1: R {dr}");
+        assert!((dt - 0.07163).abs() < 1e-3, "halves/whole − 1: T {dt}");
     }
 
     #[test]

@@ -205,6 +205,8 @@ impl ShapeTable {
         }
     }
 
+    // g and n read like `Layer`'s accessors on purpose: a shape table is tabulated for one such
+    // layer's anisotropy and index, and callers compare the two.
     /// HG anisotropy of the run.
     #[must_use]
     pub fn g(&self) -> f64 {

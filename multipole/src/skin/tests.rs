@@ -239,7 +239,9 @@ mod direction_tests {
     #[test]
     fn directional_stacking_differs_from_the_symmetric_shortcut() {
         // docs/physics.md §6: using ↓ for both directions overestimates light skin's red reflectance by
-        // about 16% at 650 nm. Pin the size (10–25%) and the sign.
+        // 17.6% at 650 nm (0.17580, measured). Both sides are deterministic diffusion sums with
+        // exact poles, so the only spread is floating-point (≪ 1e-6); the 1e-3 bound fails any
+        // change of either stacking rule that moves the excess by more than 0.6% of itself.
         let skin = SkinParams::preset(Preset::Light);
         let st = stack(&skin, Wavelength::new(650.0).unwrap()).unwrap();
         let directional = st.total_reflectance(Poles::Exact);
@@ -254,7 +256,7 @@ mod direction_tests {
             .r_down;
         let excess = symmetric / directional - 1.0;
         assert!(
-            (0.10..0.25).contains(&excess),
+            (excess - 0.17580).abs() < 1e-3,
             "symmetric/directional − 1 = {excess}"
         );
     }

@@ -31,6 +31,7 @@ enum Command {
 }
 
 fn main() -> ExitCode {
+    render::atomic::remove_temporaries_on_interrupt();
     let cli = Cli::parse();
     let result = match &cli.command {
         Command::Spectrum(a) => cli::spectrum::run(a),

@@ -43,6 +43,15 @@ pub fn parse_number(s: &str, range: &str) -> Result<f64, String> {
         .map_err(|_| format!("'{}' is not a number (valid range {range})", Text(s)))
 }
 
+/// Parse a number in [`lo`, `hi`]; `range` is how the help spells the interval.
+pub fn parse_in(s: &str, lo: f64, hi: f64, range: &str) -> Result<f64, String> {
+    let v = parse_number(s, range)?;
+    if !(lo..=hi).contains(&v) {
+        return Err(format!("{} outside {range}", Num(v)));
+    }
+    Ok(v)
+}
+
 /// Parse a whole number in [`lo`, `hi`]; `range` is how the help spells the interval.
 pub fn parse_whole(s: &str, lo: u64, hi: u64, range: &str) -> Result<u64, String> {
     let v = parse_number(s, range)?;

@@ -3,13 +3,12 @@
 //! (`--from`/`--to`/`--step`: `lambda_nm,r_mm,reflectance_per_mm2`, from
 //! `multipole::SpectralProfiles`); optionally a log–log chart of the profiles at 450, 550 and 650 nm.
 
-use crate::cli::args::{Checked, SkinArgs};
+use crate::cli::args::{Checked, SkinArgs, parse_in, parse_whole};
 use crate::plot::{LineChart, Panel, Series, palette_color, save_png};
 use anyhow::Context;
 use clap::Args;
 use multipole::skin::{DEFAULT_SHAPE_ESCAPES, ExactShape, Method, ShapeTableOptions, profile};
 use multipole::{Profile, ProfileOptions, SpectralProfiles};
-use skin_optics::echo::{Num, Text};
 use skin_optics::{Wavelength, WavelengthGrid};
 use std::io::{BufWriter, Write};
 use std::path::PathBuf;
@@ -65,55 +64,24 @@ pub struct ProfileArgs {
     pub plot: Option<PathBuf>,
 }
 
-fn parse_number(s: &str, range: &str) -> Result<f64, String> {
-    s.trim()
-        .parse::<f64>()
-        .map_err(|_| format!("'{}' is not a number (valid range {range})", Text(s)))
-}
-
 fn parse_lambda(s: &str) -> Result<f64, String> {
-    let v = parse_number(s, "[250, 1000] nm")?;
-    if !(250.0..=1000.0).contains(&v) {
-        return Err(format!("{} outside [250, 1000] nm", Num(v)));
-    }
-    Ok(v)
+    parse_in(s, 250.0, 1000.0, "[250, 1000] nm")
 }
 
 fn parse_step(s: &str) -> Result<f64, String> {
-    let v = parse_number(s, "[0.01, 750] nm")?;
-    if !(0.01..=750.0).contains(&v) {
-        return Err(format!("{v} outside [0.01, 750] nm"));
-    }
-    Ok(v)
+    parse_in(s, 0.01, 750.0, "[0.01, 750] nm")
 }
 
 fn parse_r_max(s: &str) -> Result<f64, String> {
-    let v = parse_number(s, "[0.002, 10000] mm")?;
-    if !(0.002..=1e4).contains(&v) {
-        return Err(format!("{} outside [0.002, 10000] mm", Num(v)));
-    }
-    Ok(v)
+    parse_in(s, 0.002, 1e4, "[0.002, 10000] mm")
 }
 
 fn parse_samples(s: &str) -> Result<usize, String> {
-    let v: usize = s.trim().parse().map_err(|_| {
-        format!(
-            "'{}' is not a whole number (valid range [2, 1000000])",
-            Text(s)
-        )
-    })?;
-    if !(2..=1_000_000).contains(&v) {
-        return Err(format!("{v} outside [2, 1000000]"));
-    }
-    Ok(v)
+    parse_whole(s, 2, 1_000_000, "[2, 1000000]").map(|v| v as usize)
 }
 
 fn parse_escapes(s: &str) -> Result<u64, String> {
-    let v = parse_number(s, "[100, 1e9]")?;
-    if !(100.0..=1e9).contains(&v) || v.fract() != 0.0 {
-        return Err(format!("{} outside [100, 1e9] (whole number)", Num(v)));
-    }
-    Ok(v as u64)
+    parse_whole(s, 100, 1_000_000_000, "[100, 1e9]")
 }
 
 fn parse_method(s: &str) -> Result<Method, String> {

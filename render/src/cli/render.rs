@@ -133,8 +133,11 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     let exr = args.out.join("render.exr");
     let png = args.out.join("render.png");
     let passes = crate::passes::Passes::first_hit(&scene, settings.width, settings.height);
-    passes.write_exr(&film, &exr)?;
-    film.write_png(&png, scene.exposure_stops + args.exposure)?;
+    // Both or neither: a failure of either leaves the previous pair (or nothing) in place.
+    crate::atomic::commit(vec![
+        passes.stage_exr(&film, &exr)?,
+        film.stage_png(&png, scene.exposure_stops + args.exposure)?,
+    ])?;
     println!(
         "rendered {}×{} at {:.1} spp (mean; at most {}) in {:.1} s ({} threads): {:.2} M rays/s, {:.3} s per sample per pixel",
         settings.width,

@@ -168,14 +168,7 @@ pub fn run(args: &SpectrumArgs) -> anyhow::Result<()> {
     let hex = srgb.to_hex();
     eprintln!("srgb {hex}");
     let lab = skin_optics::lab::Lab::from_xyz(xyz);
-    eprintln!(
-        "lab L*={:.2} a*={:.2} b*={:.2} ITA°={:.1} ({})",
-        lab.l,
-        lab.a,
-        lab.b,
-        lab.ita_deg(),
-        lab.ita_category()
-    );
+    eprintln!("{}", lab_line(&lab));
     if grid.start_nm() > 400.0 || grid.nm(grid.len() - 1) < 700.0 {
         eprintln!(
             "note: the grid does not cover 400-700 nm; the colour holds the end reflectances beyond it"
@@ -258,6 +251,19 @@ fn plot(
         1100,
     )
     .with_context(|| format!("--plot {}", path.display()))
+}
+
+/// The `lab L*=… a*=… b*=… ITA°=… (category)` line `skin spectrum` prints after the spectrum.
+#[must_use]
+pub fn lab_line(lab: &skin_optics::lab::Lab) -> String {
+    format!(
+        "lab L*={:.2} a*={:.2} b*={:.2} ITA°={:.1} ({})",
+        lab.l,
+        lab.a,
+        lab.b,
+        lab.ita_deg(),
+        lab.ita_category()
+    )
 }
 
 #[cfg(test)]

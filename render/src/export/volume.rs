@@ -21,15 +21,15 @@ pub const VOLUME_SEED: u64 = 0x0BE1_7A11;
 /// Batches of those runs.
 const BATCHES: u32 = 16;
 
-/// Total reflectance per unit flux entering a semi-infinite layer (σa, σs in mm⁻¹, HG g, index η
-/// under air), by adding-doubling at its default quadrature.
-pub fn semi_infinite_total(
+/// One semi-infinite layer (σa, σs in mm⁻¹, HG g, index η) under air, on air (the exit side is
+/// never reached).
+fn semi_infinite_medium(
     sigma_a_per_mm: f64,
     sigma_s_per_mm: f64,
     g: f64,
     eta: f64,
-) -> Result<f64, ExportError> {
-    let medium = LayeredMedium::new(
+) -> Result<LayeredMedium, ExportError> {
+    Ok(LayeredMedium::new(
         vec![Layer::semi_infinite(
             sigma_a_per_mm,
             sigma_s_per_mm,
@@ -38,7 +38,18 @@ pub fn semi_infinite_total(
         )?],
         1.0,
         1.0,
-    )?;
+    )?)
+}
+
+/// Total reflectance per unit flux entering a semi-infinite layer (σa, σs in mm⁻¹, HG g, index η
+/// under air), by adding-doubling at its default quadrature.
+pub fn semi_infinite_total(
+    sigma_a_per_mm: f64,
+    sigma_s_per_mm: f64,
+    g: f64,
+    eta: f64,
+) -> Result<f64, ExportError> {
+    let medium = semi_infinite_medium(sigma_a_per_mm, sigma_s_per_mm, g, eta)?;
     let t = solve(&medium, &AddingDoublingOptions::default()).map_err(MultipoleError::from)?;
     Ok(t.diffuse_reflectance / (1.0 - t.specular_reflectance))
 }
@@ -85,16 +96,7 @@ pub fn semi_infinite_profile(
         (500.0 * transport_mfp).min(1000.0),
         96,
     )?;
-    let stack = LayeredMedium::new(
-        vec![Layer::semi_infinite(
-            sigma_a_per_mm,
-            sigma_s_per_mm,
-            g,
-            eta,
-        )?],
-        1.0,
-        1.0,
-    )?;
+    let stack = semi_infinite_medium(sigma_a_per_mm, sigma_s_per_mm, g, eta)?;
     let result = run(
         &stack,
         &McOptions::new(photons, BATCHES, VOLUME_SEED)?.with_grid(grid),

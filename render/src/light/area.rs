@@ -1,11 +1,10 @@
 //! Area lights, which rays can hit and BSDF sampling can find (MIS with light sampling): the
 //! sphere and the one-sided parallelogram (quad).
 
-use super::{LightSample, facing};
+use super::{LightSample, facing, selection};
 use crate::sampling::{uniform_cone, uniform_cone_pdf};
 use crate::spectrum::{SampledWavelengths, SpectrumTable};
 use glam::{Vec2, Vec3};
-use std::f32::consts::PI;
 
 /// Smallest 1 − cos θ_max sampled as a cone (a smaller visible cap is too far to matter).
 const CONE_EPS: f32 = 1e-4;
@@ -52,11 +51,11 @@ impl SphereLight {
     /// Selection proxy at `p` with normal `n`: L · solid angle, times the widened cosine.
     #[must_use]
     pub fn selection_weight(&self, p: Vec3, n: Vec3) -> f32 {
-        let to = self.center_mm - p;
-        let r2 = self.radius_mm * self.radius_mm;
-        let d2 = to.length_squared().max(r2);
-        let d = d2.sqrt();
-        self.radiance.mean() * PI * r2 / d2 * facing(n, to, d, self.radius_mm / d)
+        let to = (self.center_mm - p).as_dvec3();
+        let r = f64::from(self.radius_mm);
+        let d = to.length().max(r);
+        let l = f64::from(self.radiance.mean());
+        selection(l * std::f64::consts::PI * (r / d).powi(2) * facing(n, to, d, r / d))
     }
 
     /// Nearest positive hit of the ray (`o`, unit `d`) with the sphere.
@@ -125,20 +124,22 @@ impl QuadLight {
     /// widened cosine; 0 behind the emitting side.
     #[must_use]
     pub fn selection_weight(&self, p: Vec3, n: Vec3) -> f32 {
-        let (eu, ev) = (self.edge_u_mm, self.edge_v_mm);
+        let (eu, ev) = (self.edge_u_mm.as_dvec3(), self.edge_v_mm.as_dvec3());
+        let corner = self.corner_mm.as_dvec3();
         let nl = eu.cross(ev);
         let area = nl.length();
         let nl = nl / area;
-        if (p - self.corner_mm).dot(nl) <= 0.0 {
+        let p = p.as_dvec3();
+        if (p - corner).dot(nl) <= 0.0 {
             return 0.0;
         }
-        let c = self.corner_mm + (eu + ev) * 0.5;
-        let to = c - p;
+        let to = corner + (eu + ev) * 0.5 - p;
         let d2 = to.length_squared().max(area);
         let d = d2.sqrt();
         let cos_l = (-to.dot(nl) / d).max(0.05);
         let half_diagonal = 0.5 * (eu + ev).length();
-        self.radiance.mean() * area * cos_l / d2 * facing(n, to, d, half_diagonal / d)
+        let l = f64::from(self.radiance.mean());
+        selection(l * area * cos_l / d2 * facing(n, to, d, half_diagonal / d))
     }
 
     /// Distance at which the ray (`o`, unit `d`) hits the emitting side, if it does.

@@ -1,7 +1,7 @@
 //! Delta lights, which BSDF sampling can never hit (no MIS): the point light, the spot light and
 //! the distant light.
 
-use super::{LightSample, facing};
+use super::{LightSample, facing, selection};
 use crate::spectrum::{SampledWavelengths, SpectrumTable};
 use glam::Vec3;
 
@@ -80,9 +80,9 @@ impl SpotLight {
 
 /// intensity / d² · cos towards a point light at `position_mm`.
 fn inverse_square_weight(position_mm: Vec3, intensity: &SpectrumTable, p: Vec3, n: Vec3) -> f32 {
-    let to = position_mm - p;
+    let to = (position_mm - p).as_dvec3();
     let d2 = to.length_squared().max(1e-6);
-    intensity.mean() / d2 * facing(n, to, d2.sqrt(), 0.0)
+    selection(f64::from(intensity.mean()) / d2 * facing(n, to, d2.sqrt(), 0.0))
 }
 
 /// Light from a single direction (the sun), irradiance on a surface facing it.
@@ -110,6 +110,6 @@ impl DistantLight {
     /// Selection proxy with normal `n`: E times the cosine.
     #[must_use]
     pub fn selection_weight(&self, n: Vec3) -> f32 {
-        self.irradiance.mean() * facing(n, self.to_light, 1.0, 0.0)
+        selection(f64::from(self.irradiance.mean()) * facing(n, self.to_light.as_dvec3(), 1.0, 0.0))
     }
 }

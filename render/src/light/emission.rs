@@ -6,6 +6,12 @@ use crate::spectrum::{SpectrumTable, luminance_of};
 /// Second radiation constant c₂ = hc/k, m·K (CODATA 2018).
 const PLANCK_C2_M_K: f64 = 1.438_776_877e-2;
 
+/// Largest luminance a light or the environment may be given (relative units, Y = 1 is "white
+/// 1"). Far above any scene (the built-in ones use ≤ 1e5), and low enough that every emission
+/// table stays finite in f32 (the most lopsided shape allowed, a 500 K blackbody normalised to
+/// Y = 1, peaks at 6.1e3 at 780 nm) with four decades left for the path weights that multiply it.
+pub const MAX_INTENSITY: f32 = 1e30;
+
 /// Shape of an emission spectrum, before normalisation to unit luminance.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum EmissionShape {
@@ -64,6 +70,28 @@ mod tests {
                     }
             });
             assert!((y - 2.5).abs() < 0.01, "{shape:?}: {y}");
+        }
+    }
+
+    /// Every shape at the largest intensity allowed tabulates finite values, the reddest
+    /// blackbody with four decades of f32 to spare.
+    #[test]
+    fn largest_intensity_gives_finite_tables() {
+        for shape in [
+            EmissionShape::D65,
+            EmissionShape::Constant,
+            EmissionShape::Blackbody { kelvin: 500.0 },
+            EmissionShape::Blackbody { kelvin: 100_000.0 },
+        ] {
+            let t = shape.table(MAX_INTENSITY);
+            let max = (380..=780)
+                .step_by(5)
+                .map(|nm| t.at_nm(nm as f32))
+                .fold(0.0f32, f32::max);
+            assert!(
+                max.is_finite() && max < 1e-4 * f32::MAX,
+                "{shape:?}: {max:e}"
+            );
         }
     }
 

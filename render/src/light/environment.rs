@@ -1,7 +1,7 @@
 //! Light from infinitely far away: a constant radiance or a lat-long (equirectangular) EXR map,
 //! sampled by the cosine around the shading normal.
 
-use super::LightSample;
+use super::{LightSample, selection};
 use crate::sampling::cosine_hemisphere;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths, SpectrumTable, linear_srgb_at_nm};
 use crate::texture::Texture;
@@ -41,12 +41,13 @@ impl Environment {
     /// Rough irradiance from the environment (luminance units), for choosing what to sample.
     #[must_use]
     pub fn selection_weight(&self) -> f32 {
-        match self {
-            Environment::Constant(t) => PI * t.mean(),
+        let irradiance = match self {
+            Environment::Constant(t) => f64::from(t.mean()),
             Environment::LatLong { map, scale } => {
-                PI * scale * crate::texture::luminance(map.mean())
+                f64::from(*scale) * f64::from(crate::texture::luminance(map.mean()))
             }
-        }
+        };
+        selection(std::f64::consts::PI * irradiance)
     }
 
     /// Sample a direction around the shading normal `n` with density cos θ / π (the environment

@@ -14,11 +14,11 @@ mod environment;
 
 pub use area::{QuadLight, SphereLight};
 pub use delta::{DistantLight, PointLight, SpotLight};
-pub use emission::EmissionShape;
+pub use emission::{EmissionShape, MAX_INTENSITY};
 pub use environment::Environment;
 
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
-use glam::{Vec2, Vec3};
+use glam::{DVec3, Vec2, Vec3};
 
 /// A light sample seen from a shading point.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -52,8 +52,25 @@ pub enum Light {
 
 /// cos towards a light in direction `to` (length `d`) of angular radius with sine `spread`, seen
 /// with normal `n`, clamped to [0, 1].
-fn facing(n: Vec3, to: Vec3, d: f32, spread: f32) -> f32 {
-    (n.dot(to) / d + spread.min(1.0)).clamp(0.0, 1.0)
+fn facing(n: Vec3, to: DVec3, d: f64, spread: f64) -> f64 {
+    (n.as_dvec3().dot(to) / d + spread.min(1.0)).clamp(0.0, 1.0)
+}
+
+/// Range a positive selection weight is clamped to. The proxies are computed in f64 (a light of
+/// intensity 1e30 at 1 µm, or an area light filling the sky, overflows f32), then clamped so that
+/// the sum over up to 1e20 lights stays finite and the smallest share, 1e-36, is still a normal
+/// f32: no light that can contribute gets probability 0 or disables light sampling. Clamping
+/// only flattens the proxy; any positive proxy keeps the estimator unbiased.
+const SELECTION_WEIGHT_RANGE: (f64, f64) = (1e-18, 1e18);
+
+/// A proxy computed in f64 as the f32 selection weight: 0 stays 0 (the light cannot contribute),
+/// anything positive is clamped into [`SELECTION_WEIGHT_RANGE`].
+fn selection(w: f64) -> f32 {
+    if w > 0.0 {
+        w.clamp(SELECTION_WEIGHT_RANGE.0, SELECTION_WEIGHT_RANGE.1) as f32
+    } else {
+        0.0
+    }
 }
 
 impl Light {
@@ -115,5 +132,63 @@ impl Light {
             Light::Quad(l) => l.pdf(wi, t),
             Light::Point(_) | Light::Spot(_) | Light::Distant(_) => 0.0,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::MAX_COORD_MM;
+    use crate::spectrum::SpectrumTable;
+
+    /// The largest values a scene may give (lengths [`MAX_COORD_MM`], intensity [`MAX_INTENSITY`],
+    /// a point light 1 nm away) give finite positive weights, whose sum stays finite: light
+    /// sampling is never switched off by one extreme light. In f32 these proxies were inf or NaN.
+    #[test]
+    fn extreme_but_valid_lights_keep_finite_selection_weights() {
+        let hot = SpectrumTable::constant(MAX_INTENSITY);
+        let (p, n) = (Vec3::ZERO, Vec3::Z);
+        let lights = [
+            Light::Quad(QuadLight {
+                corner_mm: Vec3::new(-0.5, -0.5, 0.0) * MAX_COORD_MM - Vec3::Z,
+                edge_u_mm: Vec3::X * MAX_COORD_MM,
+                edge_v_mm: Vec3::Y * MAX_COORD_MM,
+                radiance: hot.clone(),
+            }),
+            Light::Sphere(SphereLight {
+                center_mm: Vec3::Z * MAX_COORD_MM,
+                radius_mm: MAX_COORD_MM,
+                radiance: hot.clone(),
+            }),
+            Light::Point(PointLight {
+                position_mm: p + Vec3::Z * 1e-6,
+                intensity: hot.clone(),
+            }),
+            Light::Distant(DistantLight {
+                to_light: Vec3::Z,
+                irradiance: hot.clone(),
+            }),
+            // And the dimmest: far, tiny and faint still gets a positive share.
+            Light::Sphere(SphereLight {
+                center_mm: Vec3::Z * MAX_COORD_MM,
+                radius_mm: 1e-6,
+                radiance: SpectrumTable::constant(1e-30),
+            }),
+        ];
+        let env = Environment::Constant(hot);
+        let mut weights: Vec<f32> = lights.iter().map(|l| l.selection_weight(p, n)).collect();
+        weights.push(env.selection_weight());
+        let total: f32 = weights.iter().sum();
+        assert!(total.is_finite() && total > 0.0, "{weights:?}");
+        assert!(
+            weights.iter().all(|w| w.is_finite() && *w > 0.0),
+            "{weights:?}"
+        );
+        assert!(weights.iter().all(|w| w / total > 0.0), "{weights:?}");
+        // A light that cannot reach p keeps weight 0: behind the one-sided quad.
+        let Light::Quad(q) = &lights[0] else {
+            unreachable!()
+        };
+        assert_eq!(q.selection_weight(Vec3::NEG_Z * 2.0, n), 0.0);
     }
 }

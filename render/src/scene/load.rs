@@ -5,10 +5,11 @@ use super::Scene;
 use crate::builtin;
 use crate::camera::Camera;
 use crate::error::RenderError;
-use crate::geometry::{Geometry, MAX_COORD_MM, within_scene};
+use crate::geometry::{Geometry, MAX_COORD_MM, unit_vector, within_scene};
 use crate::input::{self, InputKind};
 use crate::light::{
-    DistantLight, EmissionShape, Environment, Light, PointLight, QuadLight, SphereLight, SpotLight,
+    DistantLight, EmissionShape, Environment, Light, MAX_INTENSITY, PointLight, QuadLight,
+    SphereLight, SpotLight,
 };
 use crate::material::{DiffuseMaterial, Material, SkinKnobs, SkinMaterial};
 use crate::mesh::{Placement, TriangleMesh};
@@ -41,19 +42,62 @@ impl Loader<'_> {
         }
     }
 
+    /// `v` if `ok(v)`, else an error naming `key`, what was `expected` and the value.
+    fn checked<T: Copy>(
+        &self,
+        key: &str,
+        v: T,
+        ok: bool,
+        expected: &str,
+        shown: f32,
+    ) -> Result<T, RenderError> {
+        if ok {
+            Ok(v)
+        } else {
+            Err(self.err(
+                key,
+                format!("expected {expected}, got {}", Num(f64::from(shown))),
+            ))
+        }
+    }
+
+    /// A light's position: finite and within ±[`MAX_COORD_MM`], like the geometry, so distances
+    /// and their squares stay finite in f32.
+    fn point(&self, key: &str, v: [f32; 3]) -> Result<Vec3, RenderError> {
+        let p = self.vec3(key, v)?;
+        let range = format!("a point within ±{MAX_COORD_MM:e} mm");
+        self.checked(key, p, within_scene(p), &range, p.abs().max_element())
+    }
+
+    /// A light's size in (0, [`MAX_COORD_MM`]] mm: its area and solid angle stay finite in f32.
+    fn length(&self, key: &str, v: f32) -> Result<f32, RenderError> {
+        let ok = v.is_finite() && v > 0.0 && v <= MAX_COORD_MM;
+        self.checked(
+            key,
+            v,
+            ok,
+            &format!("a length in (0, {MAX_COORD_MM:e}] mm"),
+            v,
+        )
+    }
+
+    /// A light's intensity in [0, [`MAX_INTENSITY`]].
+    fn intensity(&self, key: &str, v: f32) -> Result<f32, RenderError> {
+        let ok = v.is_finite() && (0.0..=MAX_INTENSITY).contains(&v);
+        self.checked(
+            key,
+            v,
+            ok,
+            &format!("an intensity in [0, {MAX_INTENSITY:e}]"),
+            v,
+        )
+    }
+
     fn positive(&self, key: &str, v: f32) -> Result<f32, RenderError> {
         if v.is_finite() && v > 0.0 {
             Ok(v)
         } else {
             Err(self.err(key, format!("expected a finite number > 0, got {v}")))
-        }
-    }
-
-    fn non_negative(&self, key: &str, v: f32) -> Result<f32, RenderError> {
-        if v.is_finite() && v >= 0.0 {
-            Ok(v)
-        } else {
-            Err(self.err(key, format!("expected a finite number ≥ 0, got {v}")))
         }
     }
 
@@ -92,7 +136,7 @@ impl Loader<'_> {
         temperature_k: Option<f64>,
         intensity: f32,
     ) -> Result<SpectrumTable, RenderError> {
-        let intensity = self.non_negative(&format!("{key}.intensity"), intensity)?;
+        let intensity = self.intensity(&format!("{key}.intensity"), intensity)?;
         let shape = match kind.unwrap_or(SpectrumKind::D65) {
             SpectrumKind::D65 => EmissionShape::D65,
             SpectrumKind::Constant => EmissionShape::Constant,
@@ -268,7 +312,7 @@ impl Loader<'_> {
                 temperature_k,
                 intensity,
             } => Light::Point(PointLight {
-                position_mm: self.vec3(&format!("{key}.position_mm"), *position_mm)?,
+                position_mm: self.point(&format!("{key}.position_mm"), *position_mm)?,
                 intensity: self.emission(key, *spectrum, *temperature_k, *intensity)?,
             }),
             LightDesc::Spot {
@@ -280,13 +324,13 @@ impl Loader<'_> {
                 temperature_k,
                 intensity,
             } => {
-                let p = self.vec3(&format!("{key}.position_mm"), *position_mm)?;
-                let dir = self.vec3(&format!("{key}.look_at_mm"), *look_at_mm)? - p;
-                if dir.length() <= 0.0 {
+                let p = self.point(&format!("{key}.position_mm"), *position_mm)?;
+                let to = self.point(&format!("{key}.look_at_mm"), *look_at_mm)? - p;
+                let Some(dir) = unit_vector(to) else {
                     return Err(
                         self.err(format!("{key}.look_at_mm"), "must differ from position_mm")
                     );
-                }
+                };
                 if !(*inner_deg >= 0.0 && inner_deg <= outer_deg && *outer_deg < 180.0) {
                     return Err(self.err(
                         format!("{key}.outer_deg"),
@@ -297,7 +341,7 @@ impl Loader<'_> {
                 }
                 Light::Spot(SpotLight {
                     position_mm: p,
-                    direction: dir.normalize(),
+                    direction: dir,
                     cos_inner: inner_deg.to_radians().cos(),
                     cos_outer: outer_deg.to_radians().cos(),
                     intensity: self.emission(key, *spectrum, *temperature_k, *intensity)?,
@@ -309,12 +353,14 @@ impl Loader<'_> {
                 temperature_k,
                 intensity,
             } => {
+                // Any finite non-zero vector is a direction: `unit_vector` normalises even those
+                // whose squared length overflows f32.
                 let d = self.vec3(&format!("{key}.direction"), *direction)?;
-                if d.length() <= 0.0 {
+                let Some(to_light) = unit_vector(d) else {
                     return Err(self.err(format!("{key}.direction"), "expected a non-zero vector"));
-                }
+                };
                 Light::Distant(DistantLight {
-                    to_light: d.normalize(),
+                    to_light,
                     irradiance: self.emission(key, *spectrum, *temperature_k, *intensity)?,
                 })
             }
@@ -325,8 +371,8 @@ impl Loader<'_> {
                 temperature_k,
                 intensity,
             } => Light::Sphere(SphereLight {
-                center_mm: self.vec3(&format!("{key}.center_mm"), *center_mm)?,
-                radius_mm: self.positive(&format!("{key}.radius_mm"), *radius_mm)?,
+                center_mm: self.point(&format!("{key}.center_mm"), *center_mm)?,
+                radius_mm: self.length(&format!("{key}.radius_mm"), *radius_mm)?,
                 radiance: self.emission(key, *spectrum, *temperature_k, *intensity)?,
             }),
             LightDesc::Quad {
@@ -337,14 +383,13 @@ impl Loader<'_> {
                 temperature_k,
                 intensity,
             } => {
-                let c = self.vec3(&format!("{key}.center_mm"), *center_mm)?;
-                let n = self.vec3(&format!("{key}.look_at_mm"), *look_at_mm)? - c;
-                if n.length() <= 0.0 {
+                let c = self.point(&format!("{key}.center_mm"), *center_mm)?;
+                let to = self.point(&format!("{key}.look_at_mm"), *look_at_mm)? - c;
+                let Some(n) = unit_vector(to) else {
                     return Err(self.err(format!("{key}.look_at_mm"), "must differ from center_mm"));
-                }
-                let n = n.normalize();
-                let w = self.positive(&format!("{key}.size_mm"), size_mm[0])?;
-                let h = self.positive(&format!("{key}.size_mm"), size_mm[1])?;
+                };
+                let w = self.length(&format!("{key}.size_mm"), size_mm[0])?;
+                let h = self.length(&format!("{key}.size_mm"), size_mm[1])?;
                 let hint = if n.y.abs() > 0.99 { Vec3::X } else { Vec3::Y };
                 let right = hint.cross(n).normalize();
                 let up = n.cross(right);
@@ -363,7 +408,7 @@ impl Loader<'_> {
     fn environment(&self, e: &EnvironmentDesc) -> Result<Environment, RenderError> {
         match &e.exr {
             Some(file) => {
-                let scale = self.non_negative("environment.intensity", e.intensity)?;
+                let scale = self.intensity("environment.intensity", e.intensity)?;
                 let (bytes, path) = self.read(input::ENVIRONMENT, file)?;
                 Ok(Environment::LatLong {
                     map: Texture::from_exr_bytes(&bytes, &path)?,

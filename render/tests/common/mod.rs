@@ -1,4 +1,5 @@
-//! Scaffolding shared by the end-to-end render tests (tracer.rs, subsurface.rs).
+//! Scaffolding shared by the end-to-end render tests: scene texts built from their parts
+//! ([`SceneText`]), loading, rendering and the XYZ of a spectrum.
 
 // Each test binary compiles this module on its own and uses only part of it.
 #![allow(dead_code)]
@@ -7,6 +8,105 @@ use render::film::Film;
 use render::renderer::{RenderOptions, render};
 use render::scene::{Scene, SceneOptions};
 use skin_optics::color::{cie_xyz_bar, cie_y_integral};
+
+/// The TOML of a test scene, assembled part by part so that no test spells out the same camera,
+/// material, mesh or light again. The camera looks at the origin with +Y up.
+#[derive(Debug, Clone)]
+pub struct SceneText(String);
+
+impl SceneText {
+    /// A scene whose camera at `position_mm` looks at the origin with a `fov_deg` field of view.
+    pub fn camera(position_mm: [f32; 3], fov_deg: f32) -> Self {
+        let [x, y, z] = position_mm;
+        Self(format!(
+            "[camera]\nposition_mm = [{x}, {y}, {z}]\nlook_at_mm = [0, 0, 0]\nfov_deg = {fov_deg}\n"
+        ))
+    }
+
+    /// Append raw TOML (a key, a section).
+    #[must_use]
+    pub fn with(mut self, toml: &str) -> Self {
+        self.0.push_str(toml);
+        self.0.push('\n');
+        self
+    }
+
+    /// A uniform environment of `spectrum` ("constant", "d65") with luminance `intensity`.
+    #[must_use]
+    pub fn environment(self, spectrum: &str, intensity: f32) -> Self {
+        self.with(&format!(
+            "[environment]\nspectrum = \"{spectrum}\"\nintensity = {intensity}"
+        ))
+    }
+
+    /// A Lambertian material `name` of constant `albedo`.
+    #[must_use]
+    pub fn diffuse(self, name: &str, albedo: f32) -> Self {
+        self.with(&format!(
+            "[materials.{name}]\ntype = \"diffuse\"\nalbedo = {albedo}"
+        ))
+    }
+
+    /// A skin material `name` with the given extra keys (`preset = "light"`, `melanin = 0.1`, ...).
+    #[must_use]
+    pub fn skin(self, name: &str, keys: &str) -> Self {
+        self.with(&format!("[materials.{name}]\ntype = \"skin\"\n{keys}"))
+    }
+
+    /// A built-in `shape` ("sphere", "quad") of `material`, scaled by `scale` at the origin.
+    #[must_use]
+    pub fn mesh(self, shape: &str, material: &str, scale: f32) -> Self {
+        self.with(&format!(
+            "[[meshes]]\nshape = \"{shape}\"\nmaterial = \"{material}\"\nscale = {scale}"
+        ))
+    }
+
+    /// A distant D65 light from unit direction `to_light` with irradiance (luminance) `intensity`.
+    #[must_use]
+    pub fn distant(self, to_light: [f32; 3], intensity: f32) -> Self {
+        let [x, y, z] = to_light;
+        self.with(&format!(
+            "[[lights]]\ntype = \"distant\"\ndirection = [{x}, {y}, {z}]\nspectrum = \"d65\"\nintensity = {intensity}"
+        ))
+    }
+
+    /// A sphere light at `center_mm` of `radius_mm` and luminance `intensity`.
+    #[must_use]
+    pub fn sphere_light(self, center_mm: [f32; 3], radius_mm: f32, intensity: f32) -> Self {
+        let [x, y, z] = center_mm;
+        self.with(&format!(
+            "[[lights]]\ntype = \"sphere\"\ncenter_mm = [{x}, {y}, {z}]\nradius_mm = {radius_mm}\nintensity = {intensity}"
+        ))
+    }
+
+    /// The TOML text.
+    #[must_use]
+    pub fn text(&self) -> &str {
+        &self.0
+    }
+
+    /// The scene, loaded with default options.
+    #[must_use]
+    pub fn load(&self) -> Scene {
+        scene(&self.0)
+    }
+}
+
+/// The white furnace: a diffuse albedo-1 sphere of radius 100 mm inside a constant environment
+/// of luminance 1, seen from 300 mm.
+#[must_use]
+pub fn white_furnace() -> SceneText {
+    SceneText::camera([0.0, 0.0, 300.0], 20.0)
+        .environment("constant", 1.0)
+        .diffuse("white", 1.0)
+        .mesh("sphere", "white", 100.0)
+}
+
+/// A 2 m wide quad of `material` at z = 0 seen head-on from 500 mm with a 10° field of view.
+#[must_use]
+pub fn plane(material: &str) -> SceneText {
+    SceneText::camera([0.0, 0.0, 500.0], 10.0).mesh("quad", material, 1000.0)
+}
 
 /// A scene from TOML text, with default options.
 pub fn scene(text: &str) -> Scene {

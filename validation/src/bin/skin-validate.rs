@@ -230,6 +230,7 @@ struct McArgs {
 }
 
 fn main() {
+    render::atomic::remove_temporaries_on_interrupt();
     let cli = Cli::parse();
     let result = match &cli.command {
         Some(Command::Mc(args)) => run_mc(args),

@@ -258,7 +258,8 @@ pub(crate) fn trace_batch(
     trace_lanes::<LANES>(medium, grid, w0, photons, rng, tally);
 }
 
-/// [`trace_batch`] with `K` lanes.
+/// [`trace_batch`] with `K` lanes. Its signature repeats `trace_batch`'s on purpose: the wrapper
+/// fixes the lane count for callers, tests run this one at other counts.
 fn trace_lanes<const K: usize>(
     medium: &Medium,
     grid: RadialGrid,
