@@ -13,7 +13,8 @@ use std::time::{Duration, Instant};
 /// Arguments of `skin render`.
 #[derive(Args, Debug, Clone)]
 pub struct RenderArgs {
-    /// Scene file (TOML), or a built-in scene: builtin:three-heads (default), builtin:ear.
+    /// Scene file (TOML), or a built-in scene: builtin:three-heads (default), builtin:ear,
+    /// builtin:three-heads-far.
     #[arg(long, value_name = "FILE", default_value = "builtin:three-heads")]
     pub scene: String,
     /// Output folder for render.exr and render.png.
@@ -75,8 +76,9 @@ pub struct RenderArgs {
     /// How much model each skin gets: auto (each choice from the scene: profile extent, table
     /// radii, wavelengths, level of detail) or full (every knob at its reference value, the BSSRDF
     /// at every hit). Each choice can be set alone with the flags below.
-    #[arg(long, value_name = "F", default_value_t = Fidelity::default())]
-    pub fidelity: Fidelity,
+    /// (Default: the scene's `[fidelity]` key, else auto.)
+    #[arg(long, value_name = "F")]
+    pub fidelity: Option<Fidelity>,
     /// Energy left beyond each profile row, a fraction in (0, 0.1] (auto: 0.001).
     #[arg(long, value_name = "FRACTION", value_parser = Checked(parse_fraction), allow_hyphen_values = true)]
     pub energy_tolerance: Option<f64>,

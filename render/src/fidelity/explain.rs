@@ -118,7 +118,7 @@ pub struct SkinChoices {
     pub fidelity: Fidelity,
     /// The reflectance method.
     pub method: Method,
-    /// The table's wavelengths (ΔE NaN when the step was fixed, not chosen).
+    /// The table's wavelengths.
     pub wavelengths: WavelengthChoice,
     /// Energy tolerance of the row ends (`None`: the profiles' own 99.9%).
     pub energy_tolerance: Option<f64>,
@@ -148,11 +148,9 @@ pub fn explain_table(skins: &[(&str, &SkinChoices)]) -> String {
     let mut s = String::new();
     for (name, c) in skins {
         let w = &c.wavelengths;
-        let de = if w.delta_e.is_nan() {
-            "fixed step".to_string()
-        } else {
-            format!("ΔE2000 {:.2} vs 1 nm", w.delta_e)
-        };
+        let de = w.delta_e.map_or("fixed step".to_string(), |d| {
+            format!("ΔE2000 {d:.2} vs 1 nm")
+        });
         let extent = match c.energy_tolerance {
             Some(t) => format!("rows end where {:.2}% of the energy is left", 100.0 * t),
             None => "each profile's own 99.9% radius".into(),

@@ -90,8 +90,8 @@ pub enum LodSetting {
 /// The fidelity and its per-choice overrides (`None` / `ByFidelity`: chosen by `fidelity`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FidelityKnobs {
-    /// All choices at once (default auto).
-    pub fidelity: Fidelity,
+    /// All choices at once (`None`: the scene's `[fidelity]`, else auto).
+    pub fidelity: Option<Fidelity>,
     /// Energy left beyond each profile row, a fraction of its total in (0, 0.1].
     pub energy_tolerance: Option<f64>,
     /// Interpolation error target of the radius grid, in (0, 0.1].
@@ -107,7 +107,7 @@ pub struct FidelityKnobs {
 impl Default for FidelityKnobs {
     fn default() -> Self {
         Self {
-            fidelity: Fidelity::Auto,
+            fidelity: None,
             energy_tolerance: None,
             radial_error: None,
             wavelength_step_nm: None,
@@ -155,9 +155,25 @@ pub struct FidelityError {
 }
 
 impl FidelityKnobs {
+    /// These knobs with each one left unset taken from `under` (a scene's own choices).
+    #[must_use]
+    pub fn over(self, under: &FidelityKnobs) -> Self {
+        Self {
+            fidelity: self.fidelity.or(under.fidelity),
+            energy_tolerance: self.energy_tolerance.or(under.energy_tolerance),
+            radial_error: self.radial_error.or(under.radial_error),
+            wavelength_step_nm: self.wavelength_step_nm.or(under.wavelength_step_nm),
+            lod: match self.lod {
+                LodSetting::ByFidelity => under.lod,
+                set => set,
+            },
+            cache: self.cache,
+        }
+    }
+
     /// Every choice resolved from the fidelity and the overrides, each checked against its range.
     pub fn resolve(&self) -> Result<Resolved, FidelityError> {
-        let auto = self.fidelity == Fidelity::Auto;
+        let auto = self.fidelity.unwrap_or_default() == Fidelity::Auto;
         let fraction = |name, v: Option<f64>| match v {
             Some(x) if !(x > 0.0 && x <= 0.1) => Err(FidelityError {
                 name,
@@ -207,7 +223,7 @@ mod tests {
     #[test]
     fn fidelity_resolves_each_choice() {
         let full = FidelityKnobs {
-            fidelity: Fidelity::Full,
+            fidelity: Some(Fidelity::Full),
             ..FidelityKnobs::default()
         }
         .resolve()
@@ -236,5 +252,18 @@ mod tests {
         .unwrap_err();
         assert_eq!(bad.name, "fidelity.energy_tolerance");
         assert!("Full".parse::<Fidelity>().is_ok() && "half".parse::<Fidelity>().is_err());
+        // A flag wins over the scene's key; an unset flag takes it.
+        let scene = FidelityKnobs {
+            fidelity: Some(Fidelity::Full),
+            wavelength_step_nm: Some(25.0),
+            ..FidelityKnobs::default()
+        };
+        let flags = FidelityKnobs {
+            wavelength_step_nm: Some(50.0),
+            ..FidelityKnobs::default()
+        };
+        let merged = flags.over(&scene);
+        assert_eq!(merged.fidelity, Some(Fidelity::Full));
+        assert_eq!(merged.wavelength_step_nm, Some(50.0));
     }
 }

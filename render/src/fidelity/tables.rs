@@ -71,7 +71,7 @@ pub fn skin_table(
                 StepChoice::Fixed(step_nm) => WavelengthChoice {
                     step_nm,
                     nodes: ((wavelengths::TO_NM - wavelengths::FROM_NM) / step_nm) as usize + 1,
-                    delta_e: f64::NAN,
+                    delta_e: None,
                 },
                 StepChoice::Colour { max_delta_e } => wavelengths::choose_step(
                     &wavelengths::totals_1nm(params, method)?,
@@ -85,7 +85,7 @@ pub fn skin_table(
     let table = stored.table;
     let r99_mm = table.largest_radius_for_energy_mm(0.99);
     let choices = SkinChoices {
-        fidelity: knobs.fidelity,
+        fidelity: knobs.fidelity.unwrap_or_default(),
         method,
         wavelengths: stored.wavelengths,
         energy_tolerance: resolved.energy_tolerance,
@@ -122,6 +122,7 @@ fn shape_source(method: Method, opts: &TableOptions) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::fidelity::Fidelity;
     use skin_optics::Preset;
 
     /// A cache hit gives the table a rebuild gives, bit for bit, and a corrupted or truncated
@@ -130,13 +131,22 @@ mod tests {
     fn a_cache_hit_is_bit_identical_to_a_rebuild() {
         let dir = tempfile::tempdir().unwrap();
         let params = SkinParams::preset(Preset::Medium);
-        let knobs = FidelityKnobs::default();
+        for fidelity in [Fidelity::Auto, Fidelity::Full] {
+            check_cache_round_trip(dir.path(), &params, fidelity);
+        }
+    }
+
+    fn check_cache_round_trip(dir: &std::path::Path, params: &SkinParams, fidelity: Fidelity) {
+        let knobs = FidelityKnobs {
+            fidelity: Some(fidelity),
+            ..FidelityKnobs::default()
+        };
         let resolved = knobs.resolve().unwrap();
         let probe = table_options(&resolved, None, 10.0);
-        let k = key(&params, Method::Exact, &probe, &resolved);
+        let k = key(params, Method::Exact, &probe, &resolved);
         let build = || {
             let (t, c) = skin_table(
-                &params,
+                params,
                 Method::Exact,
                 None,
                 &FidelityKnobs {
@@ -150,20 +160,21 @@ mod tests {
             })
         };
         let fresh = build().unwrap();
-        let (first, o) = cache::load_or_build(Some(dir.path()), &k, build).unwrap();
+        let (first, o) = cache::load_or_build(Some(dir), &k, build).unwrap();
         assert!(matches!(o, CacheOutcome::Built(_)));
-        let (hit, o) = cache::load_or_build(Some(dir.path()), &k, build).unwrap();
+        let (hit, o) = cache::load_or_build(Some(dir), &k, build).unwrap();
         assert!(matches!(o, CacheOutcome::Hit(_)), "{o:?}");
         assert_eq!(bits(&hit.table), bits(&fresh.table));
         assert_eq!(bits(&first.table), bits(&fresh.table));
-        let path = cache::entry_path(dir.path(), &k);
+        assert_eq!(hit.wavelengths, fresh.wavelengths);
+        let path = cache::entry_path(dir, &k);
         let good = std::fs::read(&path).unwrap();
         let mut corrupt = good.clone();
         let mid = good.len() / 2;
         corrupt[mid] = if corrupt[mid] == b'1' { b'2' } else { b'1' };
         for bad in [corrupt, good[..good.len() / 3].to_vec()] {
             std::fs::write(&path, bad).unwrap();
-            let (again, o) = cache::load_or_build(Some(dir.path()), &k, build).unwrap();
+            let (again, o) = cache::load_or_build(Some(dir), &k, build).unwrap();
             assert!(matches!(o, CacheOutcome::Rebuilt(..)), "{o:?}");
             assert_eq!(bits(&again.table), bits(&fresh.table));
         }

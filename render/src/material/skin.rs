@@ -215,7 +215,7 @@ mod tests {
         // Full fidelity: the table's rows on the stand-in's own 10-nm grid.
         let full = SkinKnobs {
             fidelity: crate::fidelity::FidelityKnobs {
-                fidelity: crate::fidelity::Fidelity::Full,
+                fidelity: Some(crate::fidelity::Fidelity::Full),
                 ..Default::default()
             },
             ..SkinKnobs::default()
