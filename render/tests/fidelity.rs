@@ -105,3 +105,72 @@ fn full_fidelity_keeps_the_reference_tables() {
     assert_eq!((table.wavelengths(), table.radii_mm().len()), (41, 128));
     assert!(skin.lod.is_none());
 }
+
+/// The scene's `[fidelity]` keys set the choices (a flag would win, `FidelityKnobs::over`), and a
+/// bad key is an error naming it.
+#[test]
+fn scene_keys_set_the_fidelity_and_bad_ones_are_named() {
+    let with = |keys: &str| format!("{SLAB}\n[fidelity]\n{keys}\n");
+    let scene = Scene::from_toml(
+        &with("wavelength_step_nm = 50\nlod = \"off\""),
+        "slab.toml",
+        None,
+        &SceneOptions::default(),
+    )
+    .unwrap();
+    let Material::Skin(skin) = &scene.materials[0] else {
+        panic!("skin first")
+    };
+    assert_eq!(skin.subsurface.as_ref().unwrap().table.wavelengths(), 9);
+    assert!(skin.lod.is_none());
+    for (keys, name) in [
+        ("lod = \"sometimes\"", "fidelity.lod"),
+        ("energy_tolerance = 0.5", "fidelity.energy_tolerance"),
+        ("wavelength_step_nm = 7", "fidelity.wavelength_step_nm"),
+        ("fidelity = \"half\"", "fidelity.fidelity"),
+    ] {
+        let e = Scene::from_toml(&with(keys), "slab.toml", None, &SceneOptions::default())
+            .err()
+            .unwrap_or_else(|| panic!("{keys} loaded"))
+            .to_string();
+        assert!(e.contains(name), "{keys}: {e}");
+    }
+}
+
+/// `skin render --explain` prints one block per skin material with every choice, and
+/// `--method multipole` warns once where diffusion is off (the light preset: +4.3% at 400 nm,
+/// BENCHMARKS.md), naming the wavelengths (from the blue end).
+#[test]
+fn explain_prints_the_choices_and_multipole_warns() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("slab.toml");
+    std::fs::write(&scene, SLAB).unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_skin"))
+        .args(["render", "--scene"])
+        .arg(&scene)
+        .args(["--out"])
+        .arg(dir.path().join("out"))
+        .args([
+            "--width", "4", "--height", "4", "--spp", "1", "--quiet", "--explain", "--method",
+            "multipole", "--no-cache",
+        ])
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    for row in [
+        "skin material 'skin'",
+        "wavelengths",
+        "profile extent",
+        "table size",
+        "shapes",
+        "level of detail",
+        "transport",
+        "cache            off",
+    ] {
+        assert!(stdout.contains(row), "no '{row}' in\n{stdout}");
+    }
+    assert_eq!(stderr.matches("warning: --method multipole").count(), 1, "{stderr}");
+    assert!(stderr.contains("'skin' at 3") && stderr.contains(" nm"), "{stderr}");
+}
