@@ -7,7 +7,11 @@
 //! pixels. Time: process CPU time of the render (`cpu-time`), so it holds on a loaded machine.
 //! Writes OUT/fidelity.csv, OUT/fidelity.png (error against render time) and each render's PNG.
 //!
-//! `cargo run --release -p render --example fidelity -- [OUT] [SPP]` (default out/fidelity, 32)
+//! Each configuration has its own seed, so no two renders share their noise; the full-fidelity
+//! render with seed 2 gives the noise floor of the error.
+//!
+//! `cargo run --release -p render --example fidelity -- [OUT] [SPP_FAR] [SPP_EAR]` (default
+//! out/fidelity, 96, 16)
 
 use render::fidelity::{Fidelity, FidelityKnobs, LodBand, LodSetting};
 use render::integrator::PathSettings;
@@ -72,8 +76,11 @@ fn render_one(
     let (film, _) = render(&scene, &settings).expect("render");
     let cpu_s = cpu.elapsed().as_secs_f64();
     let name = spec.trim_start_matches("builtin:");
-    film.write_png(&out.join(format!("{name}-{label}.png")), scene.exposure_stops)
-        .expect("write png");
+    film.write_png(
+        &out.join(format!("{name}-{label}.png")),
+        scene.exposure_stops,
+    )
+    .expect("write png");
     let luminance = (0..HEIGHT)
         .flat_map(|y| (0..WIDTH).map(move |x| (x, y)))
         .map(|(x, y)| f64::from(film.xyz(x, y)[1]))
@@ -118,7 +125,11 @@ fn errors(run: &Run, reference: &Run, skin: &[bool], nx: usize, ny: usize) -> (f
 fn main() {
     let mut args = std::env::args().skip(1);
     let out = PathBuf::from(args.next().unwrap_or_else(|| "out/fidelity".into()));
-    let spp: u32 = args.next().map_or(32, |s| s.parse().expect("SPP is a number"));
+    let mut spp = |default: u32| {
+        args.next()
+            .map_or(default, |s| s.parse().expect("SPP is a number"))
+    };
+    let (spp_far, spp_ear) = (spp(96), spp(16));
     std::fs::create_dir_all(&out).expect("create OUT");
     let narrow = LodSetting::Band(LodBand {
         full_below: 0.25,
@@ -132,13 +143,23 @@ fn main() {
         "render CPU time, s",
         "relative RMS of mean skin luminance per cell",
     );
-    for (spec, nx, ny) in [("builtin:three-heads-far", 5, 3), ("builtin:ear", 1, 1)] {
+    for (spec, nx, ny, spp) in [
+        ("builtin:three-heads-far", 5, 3, spp_far),
+        ("builtin:ear", 1, 1, spp_ear),
+    ] {
         let full = knobs(Fidelity::Full, LodSetting::ByFidelity);
         let runs = [
             render_one(spec, "full", &full, 1, spp, &out),
             render_one(spec, "full-seed2", &full, 2, spp, &out),
-            render_one(spec, "auto", &SceneOptions::default(), 1, spp, &out),
-            render_one(spec, "auto-band-0.25-1", &knobs(Fidelity::Auto, narrow), 1, spp, &out),
+            render_one(spec, "auto", &SceneOptions::default(), 3, spp, &out),
+            render_one(
+                spec,
+                "auto-band-0.25-1",
+                &knobs(Fidelity::Auto, narrow),
+                4,
+                spp,
+                &out,
+            ),
         ];
         let scene = Scene::load(spec, &full).expect("built-in scenes load");
         let skin: Vec<bool> = Passes::first_hit(&scene, WIDTH, HEIGHT)

@@ -151,8 +151,17 @@ fn explain_prints_the_choices_and_multipole_warns() {
         .args(["--out"])
         .arg(dir.path().join("out"))
         .args([
-            "--width", "4", "--height", "4", "--spp", "1", "--quiet", "--explain", "--method",
-            "multipole", "--no-cache",
+            "--width",
+            "4",
+            "--height",
+            "4",
+            "--spp",
+            "1",
+            "--quiet",
+            "--explain",
+            "--method",
+            "multipole",
+            "--no-cache",
         ])
         .output()
         .unwrap();
@@ -171,6 +180,13 @@ fn explain_prints_the_choices_and_multipole_warns() {
     ] {
         assert!(stdout.contains(row), "no '{row}' in\n{stdout}");
     }
-    assert_eq!(stderr.matches("warning: --method multipole").count(), 1, "{stderr}");
-    assert!(stderr.contains("'skin' at 3") && stderr.contains(" nm"), "{stderr}");
+    assert_eq!(
+        stderr.matches("warning: --method multipole").count(),
+        1,
+        "{stderr}"
+    );
+    assert!(
+        stderr.contains("'skin' at 3") && stderr.contains(" nm"),
+        "{stderr}"
+    );
 }

@@ -124,7 +124,8 @@ impl ProfileTable {
             )
         })?;
         let profiles = SpectralProfiles::new(skin, &grid, method, &opts.profile)?;
-        let ends = crate::fidelity::extent::row_ends_mm(profiles.profiles(), opts.energy_tolerance)?;
+        let ends =
+            crate::fidelity::extent::row_ends_mm(profiles.profiles(), opts.energy_tolerance)?;
         let radii = match opts.radial_error {
             None => opts.radii,
             Some(target) => {

@@ -185,10 +185,7 @@ pub fn explain_table(skins: &[(&str, &SkinChoices)]) -> String {
             ),
             (
                 "profile extent",
-                format!(
-                    "{:.2} mm (r99 {:.2} mm); {extent}",
-                    c.r_out_mm, c.r99_mm
-                ),
+                format!("{:.2} mm (r99 {:.2} mm); {extent}", c.r_out_mm, c.r99_mm),
             ),
             (
                 "table size",

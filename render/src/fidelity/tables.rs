@@ -73,10 +73,9 @@ pub fn skin_table(
                     nodes: ((wavelengths::TO_NM - wavelengths::FROM_NM) / step_nm) as usize + 1,
                     delta_e: None,
                 },
-                StepChoice::Colour { max_delta_e } => wavelengths::choose_step(
-                    &wavelengths::totals_1nm(params, method)?,
-                    max_delta_e,
-                ),
+                StepChoice::Colour { max_delta_e } => {
+                    wavelengths::choose_step(&wavelengths::totals_1nm(params, method)?, max_delta_e)
+                }
             };
             let opts = table_options(&resolved, shape_escapes, wavelengths.step_nm);
             let table = ProfileTable::build(params, method, &opts)?;

@@ -105,7 +105,9 @@ mod tests {
                     .map(|i| f64::from(table.total((FROM_NM + i as f64) as f32)))
                     .collect();
                 // The table's rows are f32 (relative 6e-8): ΔE moves by far less than 0.01.
-                let de = lab(read, 1.0).unwrap().delta_e_2000(lab(fine, 1.0).unwrap());
+                let de = lab(read, 1.0)
+                    .unwrap()
+                    .delta_e_2000(lab(fine, 1.0).unwrap());
                 assert!(de <= 0.5 + 0.01, "{preset:?} {method}: table ΔE {de}");
             }
         }

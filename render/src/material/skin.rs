@@ -120,7 +120,8 @@ impl SkinMaterial {
         let totals = SpectrumTable::from_fn(|nm| f64::from(table.total(nm as f32)));
         let directional = Directional::new(surface.clone(), EnergySplit::default());
         let subsurface = Subsurface::new(Arc::new(table), directional);
-        let mut skin = Self::new(params, surface, totals, albedo_texture).with_subsurface(subsurface);
+        let mut skin =
+            Self::new(params, surface, totals, albedo_texture).with_subsurface(subsurface);
         skin.lod = choices.lod;
         skin.choices = Some(choices);
         Ok(skin)

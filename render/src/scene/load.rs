@@ -138,7 +138,10 @@ impl Loader<'_> {
         }
 
         let knobs = SkinKnobs {
-            fidelity: self.opts.fidelity.over(&self.fidelity(desc.fidelity.as_ref())?),
+            fidelity: self
+                .opts
+                .fidelity
+                .over(&self.fidelity(desc.fidelity.as_ref())?),
             ..*self.opts
         };
         let (materials, material_names, textures) = self.materials(&desc.materials, &knobs)?;

@@ -65,12 +65,11 @@ impl Loader<'_> {
                         |e: brdf::BrdfError| self.err(format!("{key}.roughness"), e.to_string());
                     brdf::check_roughness(m_rough).map_err(rough_err)?;
                     let tex = texture(albedo_texture)?;
-                    let skin = SkinMaterial::build(params, m_rough, tex, knobs).map_err(
-                        |e| match e {
+                    let skin =
+                        SkinMaterial::build(params, m_rough, tex, knobs).map_err(|e| match e {
                             SkinBuildError::Surface(e) => rough_err(e),
                             other => self.err(&key, other.to_string()),
-                        },
-                    )?;
+                        })?;
                     Material::Skin(skin)
                 }
                 MaterialDesc::Diffuse {
@@ -126,23 +125,24 @@ impl Loader<'_> {
     }
 
     /// The scene's `[fidelity]` keys, each checked (the defaults without the table).
-    pub(super) fn fidelity(&self, desc: Option<&FidelityDesc>) -> Result<FidelityKnobs, RenderError> {
+    pub(super) fn fidelity(
+        &self,
+        desc: Option<&FidelityDesc>,
+    ) -> Result<FidelityKnobs, RenderError> {
         let Some(d) = desc else {
             return Ok(FidelityKnobs::default());
         };
-        let fidelity = d
-            .fidelity
-            .as_deref()
-            .map(str::parse)
-            .transpose()
-            .map_err(|e: crate::fidelity::UnknownFidelity| {
-                self.err("fidelity.fidelity", e.to_string())
-            })?;
+        let fidelity = d.fidelity.as_deref().map(str::parse).transpose().map_err(
+            |e: crate::fidelity::UnknownFidelity| self.err("fidelity.fidelity", e.to_string()),
+        )?;
         let lod = match &d.lod {
             None => LodSetting::ByFidelity,
             Some(LodDesc::Word(w)) if w.eq_ignore_ascii_case("off") => LodSetting::Off,
             Some(LodDesc::Word(w)) => {
-                return Err(self.err("fidelity.lod", format!("expected \"off\" or [LO, HI], got \"{w}\"")));
+                return Err(self.err(
+                    "fidelity.lod",
+                    format!("expected \"off\" or [LO, HI], got \"{w}\""),
+                ));
             }
             Some(LodDesc::Band([lo, hi])) => LodSetting::Band(LodBand {
                 full_below: *lo,
