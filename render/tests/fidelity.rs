@@ -68,7 +68,7 @@ fn the_lod_switch_preserves_a_flat_slabs_reflected_energy() {
     let Material::Skin(skin) = &scene.materials[0] else {
         panic!("skin first")
     };
-    let lod = skin.lod.expect("auto fidelity has a level of detail");
+    let lod = skin.lod().expect("auto fidelity has a level of detail");
     let at = |x: f32| x * lod.r99_mm / 500.0;
     assert_eq!(lod.diffuse_probability(at(2.0) * 500.0), 0.5);
     let full = mean_xyz(&scene, 0.0, 256, 3);
@@ -103,7 +103,7 @@ fn full_fidelity_keeps_the_reference_tables() {
     };
     let table = &skin.subsurface.as_ref().unwrap().table;
     assert_eq!((table.wavelengths(), table.radii_mm().len()), (41, 128));
-    assert!(skin.lod.is_none());
+    assert!(skin.lod().is_none());
 }
 
 /// The scene's `[fidelity]` keys set the choices (a flag would win, `FidelityKnobs::over`), and a
@@ -122,7 +122,7 @@ fn scene_keys_set_the_fidelity_and_bad_ones_are_named() {
         panic!("skin first")
     };
     assert_eq!(skin.subsurface.as_ref().unwrap().table.wavelengths(), 9);
-    assert!(skin.lod.is_none());
+    assert!(skin.lod().is_none());
     for (keys, name) in [
         ("lod = \"sometimes\"", "fidelity.lod"),
         ("energy_tolerance = 0.5", "fidelity.energy_tolerance"),

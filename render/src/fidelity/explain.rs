@@ -231,7 +231,7 @@ pub fn report(scene: &crate::scene::Scene, explain: bool) {
         .iter()
         .zip(&scene.materials)
         .filter_map(|(name, m)| match m {
-            crate::material::Material::Skin(s) => s.choices.as_ref().map(|c| (name.as_str(), c)),
+            crate::material::Material::Skin(s) => s.choices.as_deref().map(|c| (name.as_str(), c)),
             crate::material::Material::Diffuse(_) => None,
         })
         .collect();

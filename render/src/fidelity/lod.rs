@@ -101,7 +101,9 @@ pub fn collapse<R: Rng>(material: &Material, footprint_mm: f32, rng: &mut R) -> 
     let Material::Skin(skin) = material else {
         return false;
     };
-    let Some(lod) = &skin.lod else { return false };
+    let Some(lod) = skin.lod() else {
+        return false;
+    };
     if skin.subsurface.is_none() {
         return false;
     }

@@ -81,10 +81,8 @@ pub struct SkinMaterial {
     pub mean_transmitted: f32,
     /// The BSSRDF; when present it replaces the Lambertian body term.
     pub subsurface: Option<Subsurface>,
-    /// Level of detail by pixel footprint (`None`: the BSSRDF at every hit).
-    pub lod: Option<crate::fidelity::Lod>,
     /// What the fidelity chose for this skin's tables (`None` without a BSSRDF).
-    pub choices: Option<crate::fidelity::SkinChoices>,
+    pub choices: Option<Box<crate::fidelity::SkinChoices>>,
 }
 
 impl SkinMaterial {
@@ -122,8 +120,7 @@ impl SkinMaterial {
         let subsurface = Subsurface::new(Arc::new(table), directional);
         let mut skin =
             Self::new(params, surface, totals, albedo_texture).with_subsurface(subsurface);
-        skin.lod = choices.lod;
-        skin.choices = Some(choices);
+        skin.choices = Some(Box::new(choices));
         Ok(skin)
     }
 
@@ -150,7 +147,6 @@ impl SkinMaterial {
             albedo_texture,
             mean_transmitted,
             subsurface: None,
-            lod: None,
             choices: None,
         }
     }
@@ -160,6 +156,12 @@ impl SkinMaterial {
     pub fn with_subsurface(mut self, subsurface: Subsurface) -> Self {
         self.subsurface = Some(subsurface);
         self
+    }
+
+    /// Level of detail by pixel footprint (`None`: the BSSRDF at every hit).
+    #[must_use]
+    pub fn lod(&self) -> Option<crate::fidelity::Lod> {
+        self.choices.as_ref().and_then(|c| c.lod)
     }
 
     /// The albedo texture's relative luminance m(uv) (texture luminance / its mean; 1 without one).
