@@ -113,6 +113,13 @@ impl Camera {
         (origin, (focus_point - origin).normalize())
     }
 
+    /// Angle one pixel subtends at the image centre for an image `height` pixels tall, radians:
+    /// 2 tan(fov/2) / height (the pixel footprint is this times the distance).
+    #[must_use]
+    pub fn pixel_angle_rad(&self, height: usize) -> f32 {
+        2.0 * self.tan_half_fov / height.max(1) as f32
+    }
+
     /// Camera position, mm.
     #[must_use]
     pub fn position_mm(&self) -> Vec3 {

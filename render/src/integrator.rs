@@ -31,6 +31,9 @@ pub struct PathSettings {
     pub max_depth: u32,
     /// Bounces before Russian roulette starts.
     pub rr_depth: u32,
+    /// Angle one pixel subtends, radians (`Camera::pixel_angle_rad`): times the distance a path
+    /// has travelled, the footprint of skin's level of detail (`crate::fidelity::lod`; 0: off).
+    pub pixel_angle_rad: f32,
 }
 
 impl Default for PathSettings {
@@ -38,6 +41,7 @@ impl Default for PathSettings {
         Self {
             max_depth: 16,
             rr_depth: 3,
+            pixel_angle_rad: 0.0,
         }
     }
 }
@@ -171,6 +175,7 @@ pub fn radiance<R: Rng>(
     let mut beta = SampledSpectrum::splat(1.0);
     let (mut o, mut d) = (origin, dir);
     let mut prev: Option<PrevVertex> = None;
+    let mut travelled_mm = 0.0f32;
 
     for depth in 0..settings.max_depth {
         *rays += 1;
@@ -206,7 +211,10 @@ pub fn radiance<R: Rng>(
             (si.ng, si.ns)
         };
         let material = &scene.materials[si.material as usize];
-        let bsdf = material.bsdf(ns, si.uv, wl, &scene.textures);
+        travelled_mm += si.t;
+        let footprint_mm = settings.pixel_angle_rad * travelled_mm;
+        let collapse = crate::fidelity::lod::collapse(material, footprint_mm, rng);
+        let bsdf = material.bsdf_lod(ns, si.uv, wl, &scene.textures, collapse);
 
         // Next-event estimation.
         let lit = n_lights > 0 && light_probabilities(scene, si.p, ns, &mut pick);

@@ -9,6 +9,7 @@ pub mod camera;
 pub mod cli;
 pub mod error;
 pub mod export;
+pub mod fidelity;
 pub mod film;
 pub mod geometry;
 pub mod input;

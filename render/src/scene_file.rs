@@ -165,6 +165,34 @@ pub struct SceneDesc {
     /// Lights.
     #[serde(default)]
     pub lights: Vec<LightDesc>,
+    /// The fidelity of the skin materials (each key overridden by its command-line flag).
+    pub fidelity: Option<FidelityDesc>,
+}
+
+/// `[fidelity]`: the scene's own choices (`render::fidelity`; docs/physics.md §16).
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FidelityDesc {
+    /// "auto" or "full".
+    pub fidelity: Option<String>,
+    /// Energy left beyond each profile row, a fraction in (0, 0.1].
+    pub energy_tolerance: Option<f64>,
+    /// Interpolation error target of the radius grid, in (0, 0.1].
+    pub radial_error: Option<f64>,
+    /// Wavelength step of the skin tables, nm.
+    pub wavelength_step_nm: Option<f64>,
+    /// Level of detail: "off", or the band [LO, HI] in pixel footprints per r99.
+    pub lod: Option<LodDesc>,
+}
+
+/// `fidelity.lod`: "off" or [LO, HI].
+#[derive(Debug, Deserialize)]
+#[serde(untagged)]
+pub enum LodDesc {
+    /// "off".
+    Word(String),
+    /// [LO, HI].
+    Band([f32; 2]),
 }
 
 /// `[camera]`.

@@ -21,6 +21,7 @@
 //! tail is redistributed over the table instead of being lost.
 
 use multipole::{Method, MultipoleError, Profile, ProfileOptions, SpectralProfiles, sampling};
+use serde::{Deserialize, Serialize};
 use skin_optics::{SkinParams, WavelengthGrid};
 use std::f32::consts::PI;
 
@@ -37,6 +38,8 @@ pub const RENDER_SHAPE_STEP_NM: f64 = 20.0;
 
 /// Smallest radius of the grid, mm (matches the multipole tables' first radius).
 pub const R_MIN_MM: f32 = 1e-3;
+/// Most radii a table sized from an error target may have.
+pub const MAX_RADII: usize = 512;
 
 /// Knobs of a [`ProfileTable`].
 #[derive(Debug, Clone, PartialEq)]
@@ -47,8 +50,15 @@ pub struct TableOptions {
     pub to_nm: f64,
     /// Wavelength step, nm (profiles are linearly interpolated between steps).
     pub step_nm: f64,
-    /// Radii of the common geometric grid (≥ 8).
+    /// Radii of the common geometric grid (≥ 8), or with `radial_error` the fewest radii from 16
+    /// up (doubling, at most [`MAX_RADII`]) that meet it.
     pub radii: usize,
+    /// Energy left beyond each row's end, a fraction of its total in (0, 0.1] (`None`: each
+    /// profile's own extent, 99.9% of its energy; docs/physics.md §16).
+    pub energy_tolerance: Option<f64>,
+    /// Interpolation error target of the radius grid (energy-weighted, a fraction of the total in
+    /// (0, 0.1]; `None`: exactly `radii` radii; docs/physics.md §16).
+    pub radial_error: Option<f64>,
     /// Knobs of each profile: the multipole's, and the exact method's shape (default: the universal
     /// table; a Monte Carlo shape, e.g. [`RENDER_SHAPE_ESCAPES`] escapes, is traced every
     /// [`RENDER_SHAPE_STEP_NM`]).
@@ -62,6 +72,8 @@ impl Default for TableOptions {
             to_nm: 780.0,
             step_nm: 10.0,
             radii: 128,
+            energy_tolerance: None,
+            radial_error: None,
             profile: ProfileOptions {
                 shape_step_nm: RENDER_SHAPE_STEP_NM,
                 ..ProfileOptions::default()
@@ -71,7 +83,7 @@ impl Default for TableOptions {
 }
 
 /// One tabulation wavelength.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 struct Row {
     /// p(r) = 2πr R(r) at the grid radii (mm⁻¹), scaled to integrate to `total`; only `len` used.
     p: Vec<f32>,
@@ -84,7 +96,7 @@ struct Row {
 }
 
 /// Radial profiles of one material at the tabulation wavelengths (f32, for the renderer).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ProfileTable {
     radii_mm: Vec<f32>,
     from_nm: f32,
@@ -112,11 +124,20 @@ impl ProfileTable {
             )
         })?;
         let profiles = SpectralProfiles::new(skin, &grid, method, &opts.profile)?;
-        Self::from_profiles(
+        let ends =
+            crate::fidelity::extent::row_ends_mm(profiles.profiles(), opts.energy_tolerance)?;
+        let radii = match opts.radial_error {
+            None => opts.radii,
+            Some(target) => {
+                crate::fidelity::extent::radii_for_error(profiles.profiles(), &ends, target)?
+            }
+        };
+        Self::from_profiles_to(
             opts.from_nm as f32,
             opts.step_nm as f32,
             profiles.profiles(),
-            opts.radii,
+            &ends,
+            radii,
         )
     }
 
@@ -128,12 +149,30 @@ impl ProfileTable {
         profiles: &[Profile],
         radii: usize,
     ) -> Result<Self, MultipoleError> {
-        if profiles.is_empty() || radii < 8 || step_nm.is_nan() || step_nm <= 0.0 {
+        let ends: Vec<f64> = profiles.iter().map(Profile::r_max_mm).collect();
+        Self::from_profiles_to(from_nm, step_nm, profiles, &ends, radii)
+    }
+
+    /// [`ProfileTable::from_profiles`] with each row ending at its own radius `ends_mm` (mm, one per
+    /// profile, each at most that profile's outer radius).
+    pub fn from_profiles_to(
+        from_nm: f32,
+        step_nm: f32,
+        profiles: &[Profile],
+        ends_mm: &[f64],
+        radii: usize,
+    ) -> Result<Self, MultipoleError> {
+        if profiles.is_empty()
+            || ends_mm.len() != profiles.len()
+            || !(8..=4096).contains(&radii)
+            || step_nm.is_nan()
+            || step_nm <= 0.0
+        {
             return Err(MultipoleError::Profile(
-                "need ≥ 1 profile, ≥ 8 radii and a positive wavelength step",
+                "need ≥ 1 profile with one end each, 8 to 4096 radii and a positive wavelength step",
             ));
         }
-        let r_out = profiles.iter().map(Profile::r_max_mm).fold(0.0, f64::max) as f32;
+        let r_out = ends_mm.iter().copied().fold(0.0, f64::max) as f32;
         if r_out.is_nan() || r_out <= R_MIN_MM || !r_out.is_finite() {
             return Err(MultipoleError::Profile(
                 "profile outer radius must exceed 1e-3 mm",
@@ -146,8 +185,9 @@ impl ProfileTable {
         radii_mm[radii - 1] = r_out;
         let rows = profiles
             .iter()
-            .map(|pr| {
-                let r_end = pr.r_max_mm() as f32;
+            .zip(ends_mm)
+            .map(|(pr, &end)| {
+                let r_end = end as f32;
                 // First grid radius at or beyond this profile's own outer radius.
                 let len = (radii_mm.partition_point(|&r| r < r_end) + 1).min(radii);
                 let mut p: Vec<f32> = radii_mm[..len]
@@ -223,6 +263,15 @@ impl ProfileTable {
             .iter()
             .filter(|(_, w)| *w > 0.0)
             .map(|(row, _)| self.radii_mm[row.len - 1])
+            .fold(0.0, f32::max)
+    }
+
+    /// The largest radius over the rows holding the fraction `frac` of each row's energy, mm.
+    #[must_use]
+    pub fn largest_radius_for_energy_mm(&self, frac: f32) -> f32 {
+        self.rows
+            .iter()
+            .map(|row| self.invert(row, frac.clamp(0.0, 1.0) * row.total))
             .fold(0.0, f32::max)
     }
 

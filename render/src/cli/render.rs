@@ -2,6 +2,7 @@
 //! OUT/render.exr (linear sRGB, f32, with the passes of `render::passes`) and OUT/render.png (sRGB, exposure + filmic tone curve).
 
 use crate::cli::args::{Checked, parse_number, parse_whole};
+use crate::fidelity::{Fidelity, FidelityKnobs, LodBand, LodSetting};
 use crate::renderer::{RenderOptions, SettingError, render};
 use crate::scene::{Scene, SceneOptions};
 use clap::Args;
@@ -12,7 +13,8 @@ use std::time::{Duration, Instant};
 /// Arguments of `skin render`.
 #[derive(Args, Debug, Clone)]
 pub struct RenderArgs {
-    /// Scene file (TOML), or a built-in scene: builtin:three-heads (default), builtin:ear.
+    /// Scene file (TOML), or a built-in scene: builtin:three-heads (default), builtin:ear,
+    /// builtin:three-heads-far.
     #[arg(long, value_name = "FILE", default_value = "builtin:three-heads")]
     pub scene: String,
     /// Output folder for render.exr and render.png.
@@ -71,6 +73,34 @@ pub struct RenderArgs {
     /// No progress bar.
     #[arg(long)]
     pub quiet: bool,
+    /// How much model each skin gets: auto (each choice from the scene: profile extent, table
+    /// radii, wavelengths, level of detail) or full (every knob at its reference value, the BSSRDF
+    /// at every hit). Each choice can be set alone with the flags below.
+    /// (Default: the scene's `[fidelity]` key, else auto.)
+    #[arg(long, value_name = "F")]
+    pub fidelity: Option<Fidelity>,
+    /// Energy left beyond each profile row, a fraction in (0, 0.1] (auto: 0.001).
+    #[arg(long, value_name = "FRACTION", value_parser = Checked(parse_fraction), allow_hyphen_values = true)]
+    pub energy_tolerance: Option<f64>,
+    /// Energy-weighted interpolation error target of the profile tables' radius grid, in (0, 0.1]
+    /// (auto: 0.002).
+    #[arg(long, value_name = "FRACTION", value_parser = Checked(parse_fraction), allow_hyphen_values = true)]
+    pub radial_error: Option<f64>,
+    /// Wavelength step of the skin tables, nm: one of 5, 8, 10, 16, 20, 25, 40, 50, 80, 100
+    /// (auto: the widest within ΔE2000 0.5 of a 1-nm grid; full: 10).
+    #[arg(long, value_name = "NM", value_parser = Checked(parse_step), allow_hyphen_values = true)]
+    pub wavelength_step: Option<f64>,
+    /// Level of detail by pixel footprint: off, or LO,HI (pixel footprint / the profile's 99%
+    /// radius: BSSRDF below LO, diffuse above HI, blended between; auto: 1,4).
+    #[arg(long, value_name = "off|LO,HI", value_parser = Checked(parse_lod))]
+    pub lod: Option<LodSetting>,
+    /// Neither read nor write the disk cache of skin tables.
+    #[arg(long)]
+    pub no_cache: bool,
+    /// Print what was chosen for each skin material and why (wavelengths, extent, table size,
+    /// shapes, level of detail, BSSRDF or volumetric, cache).
+    #[arg(long)]
+    pub explain: bool,
 }
 
 /// Run `skin render`.
@@ -82,7 +112,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         );
     }
     // Validated before the scene loads, so a bad flag fails fast.
-    let settings = RenderOptions {
+    let mut options = RenderOptions {
         width: args.width as usize,
         height: args.height as usize,
         spp: args.spp,
@@ -96,9 +126,19 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         },
         progress: !args.quiet,
         ..Default::default()
-    }
-    .validate()
-    .map_err(flag_error)?;
+    };
+    options.clone().validate().map_err(flag_error)?;
+    let fidelity = FidelityKnobs {
+        fidelity: args.fidelity,
+        energy_tolerance: args.energy_tolerance,
+        radial_error: args.radial_error,
+        wavelength_step_nm: args.wavelength_step,
+        lod: args.lod.unwrap_or_default(),
+        cache: !args.no_cache,
+    };
+    fidelity
+        .resolve()
+        .map_err(|e| anyhow::anyhow!("{e} (--fidelity and its overrides)"))?;
     // Checked before any work, so an unwritable --out does not waste the scene load and render.
     std::fs::create_dir_all(&args.out)
         .and_then(|()| tempfile::tempfile_in(&args.out))
@@ -112,9 +152,14 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
             method: args.method,
             no_subsurface: args.no_subsurface,
             shape_escapes: args.shape_escapes,
+            fidelity,
         },
     )?;
     let load = t0.elapsed();
+    crate::fidelity::explain::report(&scene, args.explain);
+    // The level of detail needs the pixel footprint: the camera's pixel angle at this height.
+    options.path.pixel_angle_rad = scene.camera.pixel_angle_rad(options.height);
+    let settings = options.validate().map_err(flag_error)?;
     eprintln!(
         "scene {}: {} triangles, {} lights, {} materials, loaded in {:.2} s",
         scene.name,
@@ -215,6 +260,42 @@ fn parse_small_count(s: &str) -> Result<u32, String> {
 
 fn parse_escapes(s: &str) -> Result<u64, String> {
     parse_whole(s, 100, 1_000_000_000, "[100, 1e9]")
+}
+
+fn parse_fraction(s: &str) -> Result<f64, String> {
+    let v = parse_number(s, "(0, 0.1]")?;
+    if !(v > 0.0 && v <= 0.1) {
+        return Err(format!("{} outside (0, 0.1]", Num(v)));
+    }
+    Ok(v)
+}
+
+fn parse_step(s: &str) -> Result<f64, String> {
+    let v = parse_number(s, "nm")?;
+    if !crate::fidelity::wavelengths::STEPS_NM.contains(&v) {
+        return Err(format!(
+            "{} nm is not one of 5, 8, 10, 16, 20, 25, 40, 50, 80, 100",
+            Num(v)
+        ));
+    }
+    Ok(v)
+}
+
+fn parse_lod(s: &str) -> Result<LodSetting, String> {
+    if s.trim().eq_ignore_ascii_case("off") {
+        return Ok(LodSetting::Off);
+    }
+    let parts: Vec<&str> = s.split(',').collect();
+    let [lo, hi] = parts[..] else {
+        return Err("expected off or LO,HI (two numbers)".into());
+    };
+    let band = LodBand {
+        full_below: parse_number(lo, "a number > 0")? as f32,
+        diffuse_above: parse_number(hi, "a number > LO")? as f32,
+    };
+    band.checked()
+        .map(LodSetting::Band)
+        .map_err(|e| e.range.to_string())
 }
 
 fn rayon_threads(requested: Option<usize>) -> usize {

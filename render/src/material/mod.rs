@@ -113,9 +113,23 @@ impl Material {
         wl: &SampledWavelengths,
         textures: &[Texture],
     ) -> Bsdf<'a> {
+        self.bsdf_lod(n, uv, wl, textures, false)
+    }
+
+    /// [`Material::bsdf`], with skin's subsurface term collapsed to its diffuse body when
+    /// `collapsed` (the level of detail of `crate::fidelity::lod`: same totals, no BSSRDF).
+    #[must_use]
+    pub fn bsdf_lod<'a>(
+        &'a self,
+        n: Vec3,
+        uv: Vec2,
+        wl: &SampledWavelengths,
+        textures: &[Texture],
+        collapsed: bool,
+    ) -> Bsdf<'a> {
         let frame = Frame::from_normal(n);
         let lobes = match self {
-            Material::Skin(s) if s.subsurface.is_some() => {
+            Material::Skin(s) if s.subsurface.is_some() && !collapsed => {
                 let m = s.texture_factor(uv, textures);
                 Lobes::SkinSurface {
                     surface: &s.surface,

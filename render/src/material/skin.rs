@@ -8,7 +8,7 @@
 //! the Lambertian stand-in tabulates the same model's totals (`multipole::skin::total_reflectance`)
 //! on the same 10-nm grid.
 
-use crate::bssrdf::{Directional, EnergySplit, ProfileTable, Subsurface, TableOptions};
+use crate::bssrdf::{Directional, EnergySplit, Subsurface};
 use crate::material::TextureRef;
 use crate::spectrum::SpectrumTable;
 use crate::texture::{Texture, luminance};
@@ -36,6 +36,8 @@ pub struct SkinKnobs {
     /// for the shapes of the universal table (`multipole::skin::ExactShape::Table`: no run-time
     /// photons, built once per machine and cached).
     pub shape_escapes: Option<u64>,
+    /// The fidelity of the tables and of the shading (default auto; `crate::fidelity`).
+    pub fidelity: crate::fidelity::FidelityKnobs,
 }
 
 /// Why a skin material could not be built.
@@ -79,6 +81,8 @@ pub struct SkinMaterial {
     pub mean_transmitted: f32,
     /// The BSSRDF; when present it replaces the Lambertian body term.
     pub subsurface: Option<Subsurface>,
+    /// What the fidelity chose for this skin's tables (`None` without a BSSRDF).
+    pub choices: Option<Box<crate::fidelity::SkinChoices>>,
 }
 
 impl SkinMaterial {
@@ -97,14 +101,16 @@ impl SkinMaterial {
             let totals = total_table(&params, knobs.method)?;
             return Ok(Self::new(params, surface, totals, albedo_texture));
         }
-        let mut opts = TableOptions::default();
-        if let Some(escapes) = knobs.shape_escapes {
-            opts.profile.exact_shape = multipole::skin::ExactShape::MonteCarlo { escapes };
-        }
-        let table =
-            ProfileTable::build(&params, knobs.method, &opts).map_err(SkinBuildError::Profiles)?;
+        let (table, choices) = crate::fidelity::tables::skin_table(
+            &params,
+            knobs.method,
+            knobs.shape_escapes,
+            &knobs.fidelity,
+        )
+        .map_err(SkinBuildError::Profiles)?;
+        let step_nm = choices.wavelengths.step_nm as f32;
         if let Some(bad) = (0..table.wavelengths())
-            .map(|j| f64::from(table.total(opts.from_nm as f32 + j as f32 * opts.step_nm as f32)))
+            .map(|j| f64::from(table.total(380.0 + j as f32 * step_nm)))
             .find(|r| !(r.is_finite() && (0.0..=1.0).contains(r)))
         {
             return Err(SkinBuildError::OutOfRange(bad));
@@ -112,7 +118,10 @@ impl SkinMaterial {
         let totals = SpectrumTable::from_fn(|nm| f64::from(table.total(nm as f32)));
         let directional = Directional::new(surface.clone(), EnergySplit::default());
         let subsurface = Subsurface::new(Arc::new(table), directional);
-        Ok(Self::new(params, surface, totals, albedo_texture).with_subsurface(subsurface))
+        let mut skin =
+            Self::new(params, surface, totals, albedo_texture).with_subsurface(subsurface);
+        skin.choices = Some(Box::new(choices));
+        Ok(skin)
     }
 
     /// Skin from its parameters, surface lobe and R_d(λ) table (no BSSRDF).
@@ -138,6 +147,7 @@ impl SkinMaterial {
             albedo_texture,
             mean_transmitted,
             subsurface: None,
+            choices: None,
         }
     }
 
@@ -146,6 +156,12 @@ impl SkinMaterial {
     pub fn with_subsurface(mut self, subsurface: Subsurface) -> Self {
         self.subsurface = Some(subsurface);
         self
+    }
+
+    /// Level of detail by pixel footprint (`None`: the BSSRDF at every hit).
+    #[must_use]
+    pub fn lod(&self) -> Option<crate::fidelity::Lod> {
+        self.choices.as_ref().and_then(|c| c.lod)
     }
 
     /// The albedo texture's relative luminance m(uv) (texture luminance / its mean; 1 without one).
@@ -193,13 +209,21 @@ mod tests {
     use skin_optics::Preset;
 
     /// One set of totals per skin. With a BSSRDF the totals the BSDF reads are the profile table's
-    /// (both interpolate linearly between the same 10-nm rows, so they agree at every 5-nm step to
+    /// (at full fidelity both interpolate linearly between the same 10-nm rows, so they agree at every 5-nm step to
     /// f32 rounding, 1e-6); without one they are the model's at the same 10-nm steps, and the two
     /// agree there to the 1e-5 to which the table's rows hold the model's totals.
     #[test]
     fn the_bsdf_and_the_bssrdf_read_the_same_totals() {
         let params = SkinParams::preset(Preset::Light);
-        let with = SkinMaterial::build(params, 0.3, None, &SkinKnobs::default()).unwrap();
+        // Full fidelity: the table's rows on the stand-in's own 10-nm grid.
+        let full = SkinKnobs {
+            fidelity: crate::fidelity::FidelityKnobs {
+                fidelity: Some(crate::fidelity::Fidelity::Full),
+                ..Default::default()
+            },
+            ..SkinKnobs::default()
+        };
+        let with = SkinMaterial::build(params, 0.3, None, &full).unwrap();
         let table = &with
             .subsurface
             .as_ref()

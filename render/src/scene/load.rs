@@ -181,7 +181,14 @@ impl Loader<'_> {
             return Err(self.err("film.exposure_stops", "expected a finite number"));
         }
 
-        let (materials, material_names, textures) = self.materials(&desc.materials)?;
+        let knobs = SkinKnobs {
+            fidelity: self
+                .opts
+                .fidelity
+                .over(&self.fidelity(desc.fidelity.as_ref())?),
+            ..*self.opts
+        };
+        let (materials, material_names, textures) = self.materials(&desc.materials, &knobs)?;
 
         let mut meshes = Vec::new();
         let mut cache: HashMap<String, TriangleMesh> = HashMap::new();

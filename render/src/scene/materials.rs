@@ -4,8 +4,11 @@
 
 use super::load::Loader;
 use crate::error::RenderError;
-use crate::material::{DiffuseMaterial, Material, SkinBuildError, SkinMaterial, TextureRef};
-use crate::scene_file::MaterialDesc;
+use crate::fidelity::{FidelityKnobs, LodBand, LodSetting};
+use crate::material::{
+    DiffuseMaterial, Material, SkinBuildError, SkinKnobs, SkinMaterial, TextureRef,
+};
+use crate::scene_file::{FidelityDesc, LodDesc, MaterialDesc};
 use crate::spectrum::{SpectrumTable, linear_srgb_to_spectrum};
 use crate::texture::{Texture, luminance};
 use skin_optics::measured::named_skin;
@@ -21,6 +24,7 @@ impl Loader<'_> {
     pub(super) fn materials(
         &self,
         descs: &BTreeMap<String, MaterialDesc>,
+        knobs: &SkinKnobs,
     ) -> Result<Materials, RenderError> {
         let mut textures = Vec::new();
         let mut texture_ids: HashMap<String, usize> = HashMap::new();
@@ -62,12 +66,11 @@ impl Loader<'_> {
                         |e: brdf::BrdfError| self.err(format!("{key}.roughness"), e.to_string());
                     brdf::check_roughness(m_rough).map_err(rough_err)?;
                     let tex = texture(albedo_texture)?;
-                    let skin = SkinMaterial::build(params, m_rough, tex, self.opts).map_err(
-                        |e| match e {
+                    let skin =
+                        SkinMaterial::build(params, m_rough, tex, knobs).map_err(|e| match e {
                             SkinBuildError::Surface(e) => rough_err(e),
                             other => self.err(&key, other.to_string()),
-                        },
-                    )?;
+                        })?;
                     Material::Skin(skin)
                 }
                 MaterialDesc::Diffuse {
@@ -120,6 +123,45 @@ impl Loader<'_> {
             materials.push(material);
         }
         Ok((materials, material_names, textures))
+    }
+
+    /// The scene's `[fidelity]` keys, each checked (the defaults without the table).
+    pub(super) fn fidelity(
+        &self,
+        desc: Option<&FidelityDesc>,
+    ) -> Result<FidelityKnobs, RenderError> {
+        let Some(d) = desc else {
+            return Ok(FidelityKnobs::default());
+        };
+        let fidelity = d.fidelity.as_deref().map(str::parse).transpose().map_err(
+            |e: crate::fidelity::UnknownFidelity| self.err("fidelity.fidelity", e.to_string()),
+        )?;
+        let lod = match &d.lod {
+            None => LodSetting::ByFidelity,
+            Some(LodDesc::Word(w)) if w.eq_ignore_ascii_case("off") => LodSetting::Off,
+            Some(LodDesc::Word(w)) => {
+                return Err(self.err(
+                    "fidelity.lod",
+                    format!("expected \"off\" or [LO, HI], got \"{w}\""),
+                ));
+            }
+            Some(LodDesc::Band([lo, hi])) => LodSetting::Band(LodBand {
+                full_below: *lo,
+                diffuse_above: *hi,
+            }),
+        };
+        let knobs = FidelityKnobs {
+            fidelity,
+            energy_tolerance: d.energy_tolerance,
+            radial_error: d.radial_error,
+            wavelength_step_nm: d.wavelength_step_nm,
+            lod,
+            cache: true,
+        };
+        knobs
+            .resolve()
+            .map_err(|e| self.err(e.name, format!("{} outside {}", e.value, e.range)))?;
+        Ok(knobs)
     }
 
     fn unit(&self, key: &str, v: f32) -> Result<f32, RenderError> {

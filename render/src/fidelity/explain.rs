@@ -1,0 +1,278 @@
+//! What was chosen for each skin material and why (`skin render --explain`), and the one warning
+//! for diffusion inside its known failure region (docs/physics.md §9, §16).
+
+use super::cache::CacheOutcome;
+use super::{Fidelity, Lod, WavelengthChoice};
+use multipole::skin::DIFFUSION_OK;
+use multipole::{DEFAULT_G, LayeredMedium, Method};
+use skin_optics::{SkinParams, Wavelength};
+use std::fmt::Write;
+
+/// How a skin's body is shaded.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum TransportChoice {
+    /// The separable BSSRDF everywhere; `transport_mfp_mm` is the dermis' largest transport mean
+    /// free path 1/(σa + σs') over 380–780 nm, the length the thickness criterion for the
+    /// volumetric walk is counted in.
+    Bssrdf {
+        /// Largest transport mean free path, mm.
+        transport_mfp_mm: f64,
+    },
+    /// The Lambertian stand-in (`--no-subsurface`).
+    Lambertian,
+}
+
+impl TransportChoice {
+    /// The BSSRDF with the dermis' largest transport mean free path of `params` (every 10 nm).
+    #[must_use]
+    pub fn bssrdf(params: &SkinParams) -> Self {
+        let transport_mfp_mm = (0..=40)
+            .filter_map(|i| Wavelength::new(380.0 + 10.0 * f64::from(i)).ok())
+            .filter_map(|l| LayeredMedium::skin(params, l, DEFAULT_G).ok())
+            .filter_map(|m| {
+                m.layers()
+                    .last()
+                    .map(|d| 1.0 / (d.sigma_a() + d.sigma_s_prime()))
+            })
+            .fold(0.0, f64::max);
+        Self::Bssrdf { transport_mfp_mm }
+    }
+}
+
+/// Where diffusion is wrong for one skin: wavelengths and layers.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DiffusionFailures {
+    /// Wavelengths (every 10 nm) where |multipole / exact − 1| ≥ `DIFFUSION_OK`, nm.
+    pub wavelengths_nm: Vec<f64>,
+    /// The worst relative error there.
+    pub worst: f64,
+    /// Layers whose own diffusion totals are off by ≥ `DIFFUSION_OK` at one of them.
+    pub layers: Vec<&'static str>,
+}
+
+/// Where multipole diffusion misses the exact (adding-doubling) total of `params` by 2% or more,
+/// every 10 nm over 380–780 nm, and which layers' own totals are off there
+/// (`multipole::skin::layer_scales`); `None` where it is accurate everywhere.
+#[must_use]
+pub fn diffusion_failures(params: &SkinParams) -> Option<DiffusionFailures> {
+    let mut out = DiffusionFailures {
+        wavelengths_nm: Vec::new(),
+        worst: 0.0,
+        layers: Vec::new(),
+    };
+    for i in 0..=40 {
+        let nm = 380.0 + 10.0 * f64::from(i);
+        let Ok(l) = Wavelength::new(nm) else { continue };
+        let (Ok(m), Ok(e)) = (
+            multipole::skin::total_reflectance(params, l, Method::Multipole),
+            multipole::skin::total_reflectance(params, l, Method::Exact),
+        ) else {
+            continue;
+        };
+        let err = m / e - 1.0;
+        if err.abs() < DIFFUSION_OK {
+            continue;
+        }
+        out.wavelengths_nm.push(nm);
+        if err.abs() > out.worst.abs() {
+            out.worst = err;
+        }
+        if let Ok((scales, _)) = multipole::skin::layer_scales(params, l) {
+            let off = |x: f64| (x - 1.0).abs() >= DIFFUSION_OK;
+            for (name, s) in ["epidermis", "dermis"].into_iter().zip(&scales) {
+                if [s.r_down, s.t_down, s.r_up, s.t_up].into_iter().any(off)
+                    && !out.layers.contains(&name)
+                {
+                    out.layers.push(name);
+                }
+            }
+        }
+    }
+    (!out.wavelengths_nm.is_empty()).then_some(out)
+}
+
+/// Wavelengths on a 10-nm grid as ranges: "380–450, 600 nm".
+#[must_use]
+pub fn ranges_nm(nms: &[f64]) -> String {
+    let mut parts: Vec<String> = Vec::new();
+    let mut i = 0;
+    while i < nms.len() {
+        let mut j = i;
+        while j + 1 < nms.len() && (nms[j + 1] - nms[j] - 10.0).abs() < 1e-9 {
+            j += 1;
+        }
+        parts.push(if j > i {
+            format!("{}–{}", nms[i], nms[j])
+        } else {
+            format!("{}", nms[i])
+        });
+        i = j + 1;
+    }
+    format!("{} nm", parts.join(", "))
+}
+
+/// What was chosen for one skin material.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SkinChoices {
+    /// The fidelity asked for.
+    pub fidelity: Fidelity,
+    /// The reflectance method.
+    pub method: Method,
+    /// The table's wavelengths.
+    pub wavelengths: WavelengthChoice,
+    /// Energy tolerance of the row ends (`None`: the profiles' own 99.9%).
+    pub energy_tolerance: Option<f64>,
+    /// Outer radius of the table, mm.
+    pub r_out_mm: f32,
+    /// Largest 99% energy radius over the rows, mm.
+    pub r99_mm: f32,
+    /// Radii of the table.
+    pub radii: usize,
+    /// Where the profile shapes come from.
+    pub shape: String,
+    /// The level of detail, if on.
+    pub lod: Option<Lod>,
+    /// BSSRDF or the stand-in.
+    pub transport: TransportChoice,
+    /// What the disk cache did.
+    pub cache: CacheOutcome,
+    /// Time to build or read the tables, ms.
+    pub build_ms: f64,
+    /// With `--method multipole`: where diffusion is wrong.
+    pub diffusion_failures: Option<DiffusionFailures>,
+}
+
+/// The `--explain` table: one block per skin material (`name`, its choices).
+#[must_use]
+pub fn explain_table(skins: &[(&str, &SkinChoices)]) -> String {
+    let mut s = String::new();
+    for (name, c) in skins {
+        let w = &c.wavelengths;
+        let de = w.delta_e.map_or("fixed step".to_string(), |d| {
+            format!("ΔE2000 {d:.2} vs 1 nm")
+        });
+        let extent = match c.energy_tolerance {
+            Some(t) => format!("rows end where {:.2}% of the energy is left", 100.0 * t),
+            None => "each profile's own 99.9% radius".into(),
+        };
+        let lod = match &c.lod {
+            Some(l) => {
+                let (a, b) = l.band_mm();
+                format!(
+                    "BSSRDF below a {a:.2} mm pixel footprint, diffuse above {b:.2} mm \
+                     ({}–{} × r99), blended between",
+                    l.band.full_below, l.band.diffuse_above
+                )
+            }
+            None => "off (BSSRDF at every hit)".into(),
+        };
+        let transport = match c.transport {
+            TransportChoice::Bssrdf { transport_mfp_mm } => format!(
+                "BSSRDF everywhere (no volumetric integrator in this build; thickness criterion \
+                 counted in the dermis' largest transport mean free path, {transport_mfp_mm:.3} mm)"
+            ),
+            TransportChoice::Lambertian => "Lambertian stand-in (--no-subsurface)".into(),
+        };
+        let _ = writeln!(
+            s,
+            "skin material '{name}' (fidelity {}, method {}):",
+            c.fidelity, c.method
+        );
+        let rows = [
+            (
+                "wavelengths",
+                format!("{} rows every {} nm, 380–780 nm ({de})", w.nodes, w.step_nm),
+            ),
+            (
+                "profile extent",
+                format!("{:.2} mm (r99 {:.2} mm); {extent}", c.r_out_mm, c.r99_mm),
+            ),
+            (
+                "table size",
+                format!(
+                    "{} radii × {} rows ({:.0} KiB)",
+                    c.radii,
+                    w.nodes,
+                    (c.radii * w.nodes * 8) as f64 / 1024.0
+                ),
+            ),
+            ("shapes", c.shape.clone()),
+            ("level of detail", lod),
+            ("transport", transport),
+            (
+                "cache",
+                format!("{} ({:.0} ms to get the tables)", c.cache, c.build_ms),
+            ),
+        ];
+        for (k, v) in rows {
+            let _ = writeln!(s, "  {k:<16} {v}");
+        }
+        if let Some(f) = &c.diffusion_failures {
+            let _ = writeln!(
+                s,
+                "  {:<16} diffusion off by ≥ {:.0}% at {} (worst {:+.0}%; layers: {})",
+                "warning",
+                100.0 * DIFFUSION_OK,
+                ranges_nm(&f.wavelengths_nm),
+                100.0 * f.worst,
+                f.layers.join(", ")
+            );
+        }
+    }
+    s
+}
+
+/// After a scene loads: the `--explain` table on stdout when `explain`, and (always) one warning on
+/// stderr naming the materials, wavelengths and layers where `--method multipole` is inside
+/// diffusion's failure region.
+pub fn report(scene: &crate::scene::Scene, explain: bool) {
+    let skins: Vec<(&str, &SkinChoices)> = scene
+        .material_names
+        .iter()
+        .zip(&scene.materials)
+        .filter_map(|(name, m)| match m {
+            crate::material::Material::Skin(s) => s.choices.as_deref().map(|c| (name.as_str(), c)),
+            crate::material::Material::Diffuse(_) => None,
+        })
+        .collect();
+    if explain {
+        print!("{}", explain_table(&skins));
+    }
+    let failing: Vec<String> = skins
+        .iter()
+        .filter_map(|(name, c)| {
+            c.diffusion_failures.as_ref().map(|f| {
+                format!(
+                    "'{name}' at {} ({}; worst {:+.0}%)",
+                    ranges_nm(&f.wavelengths_nm),
+                    f.layers.join(", "),
+                    100.0 * f.worst
+                )
+            })
+        })
+        .collect();
+    if !failing.is_empty() {
+        eprintln!(
+            "warning: --method multipole misses the exact total by ≥ {:.0}% for skin {}: \
+             diffusion fails there (BENCHMARKS.md, stability map); --method exact is right",
+            100.0 * DIFFUSION_OK,
+            failing.join("; ")
+        );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use skin_optics::Preset;
+
+    /// The dark preset is the stability map's failure case (diffusion +233% at 400 nm,
+    /// BENCHMARKS.md): it is flagged with its blue wavelengths; ranges print compactly.
+    #[test]
+    fn diffusion_failures_name_wavelengths_and_layers() {
+        let f = diffusion_failures(&SkinParams::preset(Preset::Dark)).expect("dark fails");
+        assert!(f.wavelengths_nm.contains(&400.0), "{f:?}");
+        assert!(f.worst > 0.5 && !f.layers.is_empty(), "{f:?}");
+        assert_eq!(ranges_nm(&[380.0, 390.0, 400.0, 600.0]), "380–400, 600 nm");
+    }
+}

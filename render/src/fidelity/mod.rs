@@ -1,0 +1,269 @@
+//! How much model each skin gets (docs/physics.md §16): the renderer chooses each knob of a skin's
+//! tables and of its shading from what the scene needs, and reports every choice with its measured
+//! error (`skin render --explain`).
+//!
+//! - [`extent`]: where a profile row ends (energy left beyond it below a tolerance) and how many
+//!   radii the table needs for an interpolation error target.
+//! - [`wavelengths`]: the widest wavelength step whose interpolated reflectance keeps the skin's
+//!   colour within a CIEDE2000 target of a 1-nm grid.
+//! - [`lod`]: subsurface scattering blended into a Fresnel-weighted diffuse surface where a pixel
+//!   covers much more than the profile's 99% radius.
+//! - [`cache`]: the tables on disk, keyed by everything they depend on, verified before use.
+//! - [`explain`]: what was chosen for each skin material and why; the diffusion warning.
+//! - [`tables`]: a skin's tables with the choices applied, through the cache.
+//!
+//! `Fidelity::Full` keeps every table knob at its fixed default (10-nm rows, 128 radii, each
+//! profile's own 99.9% extent) and shades every skin hit with the full BSSRDF: the reference the
+//! automatic choices are measured against. Each choice can be overridden alone
+//! ([`FidelityKnobs`]).
+
+pub mod cache;
+pub mod explain;
+pub mod extent;
+pub mod lod;
+pub mod tables;
+pub mod wavelengths;
+
+pub use explain::{SkinChoices, TransportChoice};
+pub use lod::{Lod, LodBand};
+pub use wavelengths::WavelengthChoice;
+
+use std::fmt;
+use std::str::FromStr;
+use thiserror::Error;
+
+/// Energy left beyond a profile row's end in `Fidelity::Auto`, a fraction of its total.
+pub const DEFAULT_ENERGY_TOLERANCE: f64 = 1e-3;
+/// Energy-weighted interpolation error target of the radius grid in `Fidelity::Auto`.
+pub const DEFAULT_RADIAL_ERROR: f64 = 2e-3;
+/// CIEDE2000 target of the wavelength choice in `Fidelity::Auto` (against a 1-nm grid).
+pub const DEFAULT_MAX_DELTA_E: f64 = 0.5;
+
+/// All automatic choices on (`Auto`, the default) or every knob at its fixed reference value
+/// (`Full`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Fidelity {
+    /// Each choice made from the scene (extent, radii, wavelengths, level of detail).
+    #[default]
+    Auto,
+    /// Every choice at its reference: full tables and the BSSRDF at every skin hit.
+    Full,
+}
+
+/// A fidelity name that is neither `auto` nor `full`.
+#[derive(Debug, Clone, Error)]
+#[error("unknown fidelity '{0}' (valid: auto, full)")]
+pub struct UnknownFidelity(pub String);
+
+impl fmt::Display for Fidelity {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Fidelity::Auto => "auto",
+            Fidelity::Full => "full",
+        })
+    }
+}
+
+impl FromStr for Fidelity {
+    type Err = UnknownFidelity;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "auto" => Ok(Fidelity::Auto),
+            "full" => Ok(Fidelity::Full),
+            _ => Err(UnknownFidelity(s.to_string())),
+        }
+    }
+}
+
+/// Level of detail asked for: by the fidelity, off, or a given band.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum LodSetting {
+    /// `Auto`: [`LodBand::default`]; `Full`: off.
+    #[default]
+    ByFidelity,
+    /// The BSSRDF at every skin hit.
+    Off,
+    /// This band.
+    Band(LodBand),
+}
+
+/// The fidelity and its per-choice overrides (`None` / `ByFidelity`: chosen by `fidelity`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FidelityKnobs {
+    /// All choices at once (`None`: the scene's `[fidelity]`, else auto).
+    pub fidelity: Option<Fidelity>,
+    /// Energy left beyond each profile row, a fraction of its total in (0, 0.1].
+    pub energy_tolerance: Option<f64>,
+    /// Interpolation error target of the radius grid, in (0, 0.1].
+    pub radial_error: Option<f64>,
+    /// Wavelength step of the tables, nm (dividing 400 nm).
+    pub wavelength_step_nm: Option<f64>,
+    /// Level of detail by pixel footprint.
+    pub lod: LodSetting,
+    /// Read and write the disk cache of skin tables (default true; `--no-cache` clears it).
+    pub cache: bool,
+}
+
+impl Default for FidelityKnobs {
+    fn default() -> Self {
+        Self {
+            fidelity: None,
+            energy_tolerance: None,
+            radial_error: None,
+            wavelength_step_nm: None,
+            lod: LodSetting::ByFidelity,
+            cache: true,
+        }
+    }
+}
+
+/// How the wavelength step is chosen.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum StepChoice {
+    /// This step, nm.
+    Fixed(f64),
+    /// The widest step within this CIEDE2000 of a 1-nm grid.
+    Colour {
+        /// ΔE2000 target.
+        max_delta_e: f64,
+    },
+}
+
+/// [`FidelityKnobs`] with every choice resolved.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Resolved {
+    /// Energy tolerance of the row ends (`None`: the profiles' own 99.9% extent).
+    pub energy_tolerance: Option<f64>,
+    /// Radius-grid error target (`None`: 128 radii).
+    pub radial_error: Option<f64>,
+    /// Wavelength step.
+    pub step: StepChoice,
+    /// The level-of-detail band, if on.
+    pub lod: Option<LodBand>,
+}
+
+/// A fidelity knob outside its range.
+#[derive(Debug, Clone, Error)]
+#[error("{name} = {value} outside {range}")]
+pub struct FidelityError {
+    /// The knob.
+    pub name: &'static str,
+    /// Its value.
+    pub value: f64,
+    /// Its valid range.
+    pub range: &'static str,
+}
+
+impl FidelityKnobs {
+    /// These knobs with each one left unset taken from `under` (a scene's own choices).
+    #[must_use]
+    pub fn over(self, under: &FidelityKnobs) -> Self {
+        Self {
+            fidelity: self.fidelity.or(under.fidelity),
+            energy_tolerance: self.energy_tolerance.or(under.energy_tolerance),
+            radial_error: self.radial_error.or(under.radial_error),
+            wavelength_step_nm: self.wavelength_step_nm.or(under.wavelength_step_nm),
+            lod: match self.lod {
+                LodSetting::ByFidelity => under.lod,
+                set => set,
+            },
+            cache: self.cache,
+        }
+    }
+
+    /// Every choice resolved from the fidelity and the overrides, each checked against its range.
+    pub fn resolve(&self) -> Result<Resolved, FidelityError> {
+        let auto = self.fidelity.unwrap_or_default() == Fidelity::Auto;
+        let fraction = |name, v: Option<f64>| match v {
+            Some(x) if !(x > 0.0 && x <= 0.1) => Err(FidelityError {
+                name,
+                value: x,
+                range: "(0, 0.1]",
+            }),
+            _ => Ok(v),
+        };
+        let energy_tolerance = fraction("fidelity.energy_tolerance", self.energy_tolerance)?
+            .or(auto.then_some(DEFAULT_ENERGY_TOLERANCE));
+        let radial_error = fraction("fidelity.radial_error", self.radial_error)?
+            .or(auto.then_some(DEFAULT_RADIAL_ERROR));
+        let step = match self.wavelength_step_nm {
+            Some(s) if wavelengths::STEPS_NM.contains(&s) => StepChoice::Fixed(s),
+            Some(s) => {
+                return Err(FidelityError {
+                    name: "fidelity.wavelength_step_nm",
+                    value: s,
+                    range: "{5, 8, 10, 16, 20, 25, 40, 50, 80, 100} nm (dividing 400 nm)",
+                });
+            }
+            None if auto => StepChoice::Colour {
+                max_delta_e: DEFAULT_MAX_DELTA_E,
+            },
+            None => StepChoice::Fixed(crate::material::SKIN_TABLE_STEP_NM),
+        };
+        let lod = match self.lod {
+            LodSetting::ByFidelity => auto.then(LodBand::default),
+            LodSetting::Off => None,
+            LodSetting::Band(b) => Some(b.checked()?),
+        };
+        Ok(Resolved {
+            energy_tolerance,
+            radial_error,
+            step,
+            lod,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `Full` is today's fixed tables without level of detail; `Auto` turns every choice on; an
+    /// override wins over either, and a bad one names its knob.
+    #[test]
+    fn fidelity_resolves_each_choice() {
+        let full = FidelityKnobs {
+            fidelity: Some(Fidelity::Full),
+            ..FidelityKnobs::default()
+        }
+        .resolve()
+        .unwrap();
+        assert_eq!(full.energy_tolerance, None);
+        assert_eq!(full.radial_error, None);
+        assert_eq!(full.step, StepChoice::Fixed(10.0));
+        assert_eq!(full.lod, None);
+        let auto = FidelityKnobs::default().resolve().unwrap();
+        assert_eq!(auto.energy_tolerance, Some(DEFAULT_ENERGY_TOLERANCE));
+        assert!(matches!(auto.step, StepChoice::Colour { .. }));
+        assert_eq!(auto.lod, Some(LodBand::default()));
+        let over = FidelityKnobs {
+            wavelength_step_nm: Some(20.0),
+            lod: LodSetting::Off,
+            ..FidelityKnobs::default()
+        }
+        .resolve()
+        .unwrap();
+        assert_eq!((over.step, over.lod), (StepChoice::Fixed(20.0), None));
+        let bad = FidelityKnobs {
+            energy_tolerance: Some(0.5),
+            ..FidelityKnobs::default()
+        }
+        .resolve()
+        .unwrap_err();
+        assert_eq!(bad.name, "fidelity.energy_tolerance");
+        assert!("Full".parse::<Fidelity>().is_ok() && "half".parse::<Fidelity>().is_err());
+        // A flag wins over the scene's key; an unset flag takes it.
+        let scene = FidelityKnobs {
+            fidelity: Some(Fidelity::Full),
+            wavelength_step_nm: Some(25.0),
+            ..FidelityKnobs::default()
+        };
+        let flags = FidelityKnobs {
+            wavelength_step_nm: Some(50.0),
+            ..FidelityKnobs::default()
+        };
+        let merged = flags.over(&scene);
+        assert_eq!(merged.fidelity, Some(Fidelity::Full));
+        assert_eq!(merged.wavelength_step_nm, Some(50.0));
+    }
+}

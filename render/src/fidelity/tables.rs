@@ -1,0 +1,193 @@
+//! A skin's BSSRDF tables with every fidelity choice applied, through the disk cache, and the
+//! record of what was chosen ([`SkinChoices`]).
+
+use super::cache::{self, CacheOutcome};
+use super::explain::{SkinChoices, TransportChoice, diffusion_failures};
+use super::wavelengths::{self, WavelengthChoice};
+use super::{FidelityKnobs, Lod, Resolved, StepChoice};
+use crate::bssrdf::{ProfileTable, TableOptions};
+use multipole::skin::ExactShape;
+use multipole::{Method, MultipoleError};
+use serde::{Deserialize, Serialize};
+use skin_optics::SkinParams;
+use std::time::Instant;
+
+/// What a cache entry holds: the table and the wavelength choice that sized it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+struct Stored {
+    table: ProfileTable,
+    wavelengths: WavelengthChoice,
+}
+
+/// The table options of `resolved` at wavelength step `step_nm`.
+fn table_options(resolved: &Resolved, shape_escapes: Option<u64>, step_nm: f64) -> TableOptions {
+    let mut opts = TableOptions {
+        step_nm,
+        energy_tolerance: resolved.energy_tolerance,
+        radial_error: resolved.radial_error,
+        ..TableOptions::default()
+    };
+    if let Some(escapes) = shape_escapes {
+        opts.profile.exact_shape = ExactShape::MonteCarlo { escapes };
+    }
+    opts
+}
+
+/// The cache key: everything the table depends on, as text.
+fn key(params: &SkinParams, method: Method, opts: &TableOptions, resolved: &Resolved) -> String {
+    format!(
+        "skin-tables v{} render {} | {params:?} | method {method} | {opts:?} | step {:?}",
+        cache::CACHE_VERSION,
+        env!("CARGO_PKG_VERSION"),
+        resolved.step
+    )
+}
+
+/// Build (or read from the cache) the profile table of `params` with `method`, the shape knob
+/// and the fidelity `knobs`, and record the choices.
+pub fn skin_table(
+    params: &SkinParams,
+    method: Method,
+    shape_escapes: Option<u64>,
+    knobs: &FidelityKnobs,
+) -> Result<(ProfileTable, SkinChoices), MultipoleError> {
+    let t0 = Instant::now();
+    let resolved = knobs.resolve().map_err(|e| MultipoleError::InvalidOption {
+        name: e.name,
+        value: e.value,
+        range: e.range,
+    })?;
+    // The key holds the options before the wavelength choice (the choice is part of the value).
+    let probe = table_options(&resolved, shape_escapes, 10.0);
+    let key = key(params, method, &probe, &resolved);
+    let dir = knobs
+        .cache
+        .then(multipole::skin::cache_dir)
+        .flatten()
+        .map(|d| d.join("tables"));
+    let (stored, outcome): (Stored, CacheOutcome) =
+        cache::load_or_build(dir.as_deref(), &key, || {
+            let wavelengths = match resolved.step {
+                StepChoice::Fixed(step_nm) => WavelengthChoice {
+                    step_nm,
+                    nodes: ((wavelengths::TO_NM - wavelengths::FROM_NM) / step_nm) as usize + 1,
+                    delta_e: None,
+                },
+                StepChoice::Colour { max_delta_e } => {
+                    wavelengths::choose_step(&wavelengths::totals_1nm(params, method)?, max_delta_e)
+                }
+            };
+            let opts = table_options(&resolved, shape_escapes, wavelengths.step_nm);
+            let table = ProfileTable::build(params, method, &opts)?;
+            Ok::<_, MultipoleError>(Stored { table, wavelengths })
+        })?;
+    let table = stored.table;
+    let r99_mm = table.largest_radius_for_energy_mm(0.99);
+    let choices = SkinChoices {
+        fidelity: knobs.fidelity.unwrap_or_default(),
+        method,
+        wavelengths: stored.wavelengths,
+        energy_tolerance: resolved.energy_tolerance,
+        r_out_mm: table.radii_mm().last().copied().unwrap_or(0.0),
+        r99_mm,
+        radii: table.radii_mm().len(),
+        shape: shape_source(method, &probe),
+        lod: resolved.lod.map(|band| Lod { r99_mm, band }),
+        transport: TransportChoice::bssrdf(params),
+        cache: outcome,
+        build_ms: 1e3 * t0.elapsed().as_secs_f64(),
+        diffusion_failures: (method == Method::Multipole)
+            .then(|| diffusion_failures(params))
+            .flatten(),
+    };
+    Ok((table, choices))
+}
+
+/// Where the profile shapes come from, in words.
+fn shape_source(method: Method, opts: &TableOptions) -> String {
+    match (method, opts.profile.exact_shape) {
+        (Method::Multipole, _) => "multipole diffusion (no photons)".into(),
+        (_, ExactShape::MonteCarlo { escapes }) => format!(
+            "Monte Carlo, {escapes} escapes every {} nm",
+            opts.profile.shape_step_nm
+        ),
+        (_, ExactShape::Table(t)) => {
+            format!("universal table ({} white photons, cached)", t.photons)
+        }
+        (_, other) => format!("{other:?}"),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fidelity::Fidelity;
+    use skin_optics::Preset;
+
+    /// A cache hit gives the table a rebuild gives, bit for bit, and a corrupted or truncated
+    /// entry is rebuilt (the same bits again), never trusted.
+    #[test]
+    fn a_cache_hit_is_bit_identical_to_a_rebuild() {
+        let dir = tempfile::tempdir().unwrap();
+        let params = SkinParams::preset(Preset::Medium);
+        for fidelity in [Fidelity::Auto, Fidelity::Full] {
+            check_cache_round_trip(dir.path(), &params, fidelity);
+        }
+    }
+
+    fn check_cache_round_trip(dir: &std::path::Path, params: &SkinParams, fidelity: Fidelity) {
+        let knobs = FidelityKnobs {
+            fidelity: Some(fidelity),
+            ..FidelityKnobs::default()
+        };
+        let resolved = knobs.resolve().unwrap();
+        let probe = table_options(&resolved, None, 10.0);
+        let k = key(params, Method::Exact, &probe, &resolved);
+        let build = || {
+            let (t, c) = skin_table(
+                params,
+                Method::Exact,
+                None,
+                &FidelityKnobs {
+                    cache: false,
+                    ..knobs
+                },
+            )?;
+            Ok::<_, MultipoleError>(Stored {
+                table: t,
+                wavelengths: c.wavelengths,
+            })
+        };
+        let fresh = build().unwrap();
+        let (first, o) = cache::load_or_build(Some(dir), &k, build).unwrap();
+        assert!(matches!(o, CacheOutcome::Built(_)));
+        let (hit, o) = cache::load_or_build(Some(dir), &k, build).unwrap();
+        assert!(matches!(o, CacheOutcome::Hit(_)), "{o:?}");
+        assert_eq!(bits(&hit.table), bits(&fresh.table));
+        assert_eq!(bits(&first.table), bits(&fresh.table));
+        assert_eq!(hit.wavelengths, fresh.wavelengths);
+        let path = cache::entry_path(dir, &k);
+        let good = std::fs::read(&path).unwrap();
+        let mut corrupt = good.clone();
+        let mid = good.len() / 2;
+        corrupt[mid] = if corrupt[mid] == b'1' { b'2' } else { b'1' };
+        for bad in [corrupt, good[..good.len() / 3].to_vec()] {
+            std::fs::write(&path, bad).unwrap();
+            let (again, o) = cache::load_or_build(Some(dir), &k, build).unwrap();
+            assert!(matches!(o, CacheOutcome::Rebuilt(..)), "{o:?}");
+            assert_eq!(bits(&again.table), bits(&fresh.table));
+        }
+    }
+
+    /// Every value the renderer reads from the table, as bits: R(r) at every grid radius and every
+    /// nm, and the totals.
+    fn bits(t: &ProfileTable) -> Vec<u32> {
+        (380..=780)
+            .flat_map(|nm| {
+                let nm = nm as f32;
+                std::iter::once(t.total(nm)).chain(t.radii_mm().iter().map(move |&r| t.eval(nm, r)))
+            })
+            .map(f32::to_bits)
+            .collect()
+    }
+}
