@@ -16,13 +16,25 @@
 use crate::bssrdf::{ProbeFrame, texture_modulation};
 use crate::geometry::offset_origin;
 use crate::material::Material;
+use crate::sampler::{PathSampler, SamplerKind};
 use crate::sampling::cosine_hemisphere;
 use crate::scene::{Hit, Scene};
-use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use crate::spectrum::{SampledSpectrum, SampledWavelengths, WavelengthSampling};
 use brdf::Frame;
-use glam::{Vec2, Vec3};
-use rand::Rng;
+use glam::Vec3;
 use std::f32::consts::FRAC_1_PI;
+
+/// Where each decision of a bounce reads its uniforms in the bounce's region of
+/// [`PathSampler`] (sets of four dimensions: light choice and position at the hit with the
+/// subsurface decision; the probe, or the BSDF sample and roulette; light at the exit point; the
+/// continuation from the exit point and roulette).
+mod dims {
+    pub const SUBSURFACE_CHOICE: u32 = 3;
+    pub const PROBE: u32 = 4;
+    pub const CONTINUATION: u32 = 4;
+    pub const EXIT_LIGHT: u32 = 8;
+    pub const EXIT_CONTINUATION: u32 = 12;
+}
 
 /// Knobs of the path tracer.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -31,6 +43,10 @@ pub struct PathSettings {
     pub max_depth: u32,
     /// Bounces before Russian roulette starts.
     pub rr_depth: u32,
+    /// Where the path's uniforms come from.
+    pub sampler: SamplerKind,
+    /// How the path's wavelengths are drawn.
+    pub wavelengths: WavelengthSampling,
 }
 
 impl Default for PathSettings {
@@ -38,6 +54,8 @@ impl Default for PathSettings {
         Self {
             max_depth: 16,
             rr_depth: 3,
+            sampler: SamplerKind::default(),
+            wavelengths: WavelengthSampling::default(),
         }
     }
 }
@@ -68,15 +86,15 @@ fn light_probabilities(scene: &Scene, p: Vec3, n: Vec3, probs: &mut Vec<f32>) ->
 
 /// Russian roulette after `settings.rr_depth` bounces: false when the path ends, else `beta`
 /// is rescaled by the survival probability.
-fn russian_roulette<R: Rng>(
+fn russian_roulette(
     beta: &mut SampledSpectrum,
     depth: u32,
     settings: &PathSettings,
-    rng: &mut R,
+    sampler: &mut PathSampler,
 ) -> bool {
     if depth + 1 >= settings.rr_depth {
         let survive = beta.max_value().min(1.0);
-        if survive <= 0.0 || rng.random::<f32>() >= survive {
+        if survive <= 0.0 || sampler.get_1d() >= survive {
             return false;
         }
         *beta = *beta / survive;
@@ -89,20 +107,20 @@ fn russian_roulette<R: Rng>(
 /// against the scattering density; `scatter(wi)` gives (f(wi) · |cos θ_i| per wavelength, its
 /// sampling density sr⁻¹).
 #[allow(clippy::too_many_arguments)] // the shading point and its random state, nothing to group
-fn direct_light<R: Rng>(
+fn direct_light(
     scene: &Scene,
     p: Vec3,
     ng: Vec3,
     ns: Vec3,
     wl: &SampledWavelengths,
     pick: &[f32],
-    rng: &mut R,
+    sampler: &mut PathSampler,
     rays: &mut u64,
     scatter: impl Fn(Vec3) -> (SampledSpectrum, f32),
 ) -> SampledSpectrum {
     let n_lights = pick.len();
     // Pick a light by its selection probability (inverse CDF over a handful of lights).
-    let u_pick: f32 = rng.random();
+    let u_pick = sampler.get_1d();
     let mut k = 0;
     let mut cdf = pick[0];
     while u_pick >= cdf && k + 1 < n_lights {
@@ -110,7 +128,7 @@ fn direct_light<R: Rng>(
         cdf += pick[k];
     }
     let pick_pdf = pick[k];
-    let u = Vec2::new(rng.random(), rng.random());
+    let u = sampler.get_2d();
     let sample = if k < scene.lights.len() {
         scene.lights[k].sample(p, u, wl)
     } else {
@@ -156,13 +174,13 @@ struct PrevVertex {
 
 /// Radiance arriving at `origin` from direction `-dir` (i.e. along the ray), at the path's
 /// wavelengths; `rays` counts the rays traced (closest hit and shadow).
-pub fn radiance<R: Rng>(
+pub fn radiance(
     scene: &Scene,
     settings: &PathSettings,
     origin: Vec3,
     dir: Vec3,
     wl: &SampledWavelengths,
-    rng: &mut R,
+    sampler: &mut PathSampler,
     rays: &mut u64,
 ) -> SampledSpectrum {
     let n_lights = scene.lights.len() + usize::from(scene.environment.is_some());
@@ -173,6 +191,7 @@ pub fn radiance<R: Rng>(
     let mut prev: Option<PrevVertex> = None;
 
     for depth in 0..settings.max_depth {
+        sampler.start_bounce(depth);
         *rays += 1;
         let hit = scene.intersect(o, d, 0.0, f32::INFINITY);
         let si = match hit {
@@ -212,7 +231,7 @@ pub fn radiance<R: Rng>(
         let lit = n_lights > 0 && light_probabilities(scene, si.p, ns, &mut pick);
         if lit {
             l += beta
-                * direct_light(scene, si.p, ng, ns, wl, &pick, rng, rays, |wi| {
+                * direct_light(scene, si.p, ng, ns, wl, &pick, sampler, rays, |wi| {
                     (bsdf.eval(wo, wi) * wi.dot(ns).abs(), bsdf.pdf(wo, wi))
                 });
         }
@@ -220,7 +239,8 @@ pub fn radiance<R: Rng>(
         // Subsurface branch (skin rendered with the BSSRDF, crate::bssrdf): light leaving here
         // entered at an exit point sampled with probe rays; continue from there.
         let q_sss = bsdf.subsurface_probability(wo);
-        if q_sss > 0.0 && rng.random::<f32>() < q_sss {
+        sampler.seek(dims::SUBSURFACE_CHOICE);
+        if q_sss > 0.0 && sampler.get_1d() < q_sss {
             let Material::Skin(skin) = material else {
                 break;
             };
@@ -230,7 +250,13 @@ pub fn radiance<R: Rng>(
                 y: bsdf.frame.y,
                 n: bsdf.frame.z,
             };
-            let u = [rng.random(), rng.random(), rng.random(), rng.random()];
+            sampler.seek(dims::PROBE);
+            let u = [
+                sampler.get_1d(),
+                sampler.get_1d(),
+                sampler.get_1d(),
+                sampler.get_1d(),
+            ];
             let flipped = ns.dot(si.ns) < 0.0;
             let Some(exit) = ss.sample_exit(
                 &scene.geometry,
@@ -262,10 +288,11 @@ pub fn radiance<R: Rng>(
             // At the exit point: next-event estimation with S_ω, then a cosine-weighted
             // continuation (weight S_ω cos / (cos / π) = T / c).
             let (eng, ens) = (exit.ng, exit.ns);
+            sampler.seek(dims::EXIT_LIGHT);
             let lit = n_lights > 0 && light_probabilities(scene, exit.p, ens, &mut pick);
             if lit {
                 l += beta
-                    * direct_light(scene, exit.p, eng, ens, wl, &pick, rng, rays, |wi| {
+                    * direct_light(scene, exit.p, eng, ens, wl, &pick, sampler, rays, |wi| {
                         let c = wi.dot(ens);
                         (
                             SampledSpectrum::splat(ss.directional.s_omega(c) * c.max(0.0)),
@@ -273,7 +300,8 @@ pub fn radiance<R: Rng>(
                         )
                     });
             }
-            let local = cosine_hemisphere(Vec2::new(rng.random(), rng.random()));
+            sampler.seek(dims::EXIT_CONTINUATION);
+            let local = cosine_hemisphere(sampler.get_2d());
             let wi = Frame::from_normal(ens).to_world(local);
             if local.z <= 0.0 || wi.dot(eng) <= 0.0 {
                 break;
@@ -291,7 +319,7 @@ pub fn radiance<R: Rng>(
                 bsdf_pdf: local.z * FRAC_1_PI,
                 pick: prev_pick,
             });
-            if !russian_roulette(&mut beta, depth, settings, rng) {
+            if !russian_roulette(&mut beta, depth, settings, sampler) {
                 break;
             }
             o = offset_origin(exit.p, eng, wi);
@@ -300,8 +328,9 @@ pub fn radiance<R: Rng>(
         }
 
         // Continue the path by sampling the BSDF.
-        let u_lobe: f32 = rng.random();
-        let u = Vec2::new(rng.random(), rng.random());
+        sampler.seek(dims::CONTINUATION);
+        let u_lobe = sampler.get_1d();
+        let u = sampler.get_2d();
         let Some(bs) = bsdf.sample(wo, u_lobe, u) else {
             break;
         };
@@ -321,7 +350,7 @@ pub fn radiance<R: Rng>(
             bsdf_pdf: bs.pdf,
             pick: prev_pick,
         });
-        if !russian_roulette(&mut beta, depth, settings, rng) {
+        if !russian_roulette(&mut beta, depth, settings, sampler) {
             break;
         }
         o = offset_origin(si.p, ng, bs.wi);
