@@ -7,4 +7,5 @@ pub mod shape_error;
 pub use multipole::montecarlo;
 pub mod measured;
 pub mod measured_report;
+pub mod noise_chart;
 pub mod presets;
