@@ -13,7 +13,7 @@
 //! next-event estimation with S_ω (MIS against the cosine-weighted continuation), and the path
 //! continues from the exit point with a cosine-weighted direction (weight T(θ_i) / c).
 
-use crate::bssrdf::{ProbeFrame, texture_modulation};
+use crate::bssrdf::{ProbeAxes, ProbeFrame, texture_modulation};
 use crate::geometry::offset_origin;
 use crate::material::Material;
 use crate::sampler::{PathSampler, SamplerKind};
@@ -26,14 +26,14 @@ use std::f32::consts::FRAC_1_PI;
 
 /// Where each decision of a bounce reads its uniforms in the bounce's region of
 /// [`PathSampler`] (sets of four dimensions: light choice and position at the hit with the
-/// subsurface decision; the probe, or the BSDF sample and roulette; light at the exit point; the
-/// continuation from the exit point and roulette).
+/// subsurface decision; the probe, or the BSDF sample and roulette; light at the exit point (two
+/// sets: up to two light samples stratified); the continuation from the exit point and roulette).
 mod dims {
     pub const SUBSURFACE_CHOICE: u32 = 3;
     pub const PROBE: u32 = 4;
     pub const CONTINUATION: u32 = 4;
     pub const EXIT_LIGHT: u32 = 8;
-    pub const EXIT_CONTINUATION: u32 = 12;
+    pub const EXIT_CONTINUATION: u32 = 16;
 }
 
 /// Knobs of the path tracer.
@@ -47,6 +47,10 @@ pub struct PathSettings {
     pub sampler: SamplerKind,
     /// How the path's wavelengths are drawn.
     pub wavelengths: WavelengthSampling,
+    /// How subsurface probe axes are chosen.
+    pub probe_axes: ProbeAxes,
+    /// Light samples (next-event estimates, averaged) at each subsurface exit point, ≥ 1.
+    pub exit_light_samples: u32,
 }
 
 impl Default for PathSettings {
@@ -56,6 +60,8 @@ impl Default for PathSettings {
             rr_depth: 3,
             sampler: SamplerKind::default(),
             wavelengths: WavelengthSampling::default(),
+            probe_axes: ProbeAxes::default(),
+            exit_light_samples: 1,
         }
     }
 }
@@ -263,6 +269,7 @@ pub fn radiance(
                 si.material,
                 si.p,
                 &frame,
+                &settings.probe_axes,
                 flipped,
                 wl,
                 u,
@@ -291,14 +298,21 @@ pub fn radiance(
             sampler.seek(dims::EXIT_LIGHT);
             let lit = n_lights > 0 && light_probabilities(scene, exit.p, ens, &mut pick);
             if lit {
-                l += beta
-                    * direct_light(scene, exit.p, eng, ens, wl, &pick, sampler, rays, |wi| {
-                        let c = wi.dot(ens);
-                        (
-                            SampledSpectrum::splat(ss.directional.s_omega(c) * c.max(0.0)),
-                            c.max(0.0) * FRAC_1_PI,
-                        )
-                    });
+                // Several light samples share one probe (splitting): their mean is the estimate.
+                let n = settings.exit_light_samples.max(1);
+                let mut direct = SampledSpectrum::zero();
+                for j in 0..n {
+                    sampler.seek(dims::EXIT_LIGHT + 4 * j.min(1));
+                    direct +=
+                        direct_light(scene, exit.p, eng, ens, wl, &pick, sampler, rays, |wi| {
+                            let c = wi.dot(ens);
+                            (
+                                SampledSpectrum::splat(ss.directional.s_omega(c) * c.max(0.0)),
+                                c.max(0.0) * FRAC_1_PI,
+                            )
+                        });
+                }
+                l += beta * direct / n as f32;
             }
             sampler.seek(dims::EXIT_CONTINUATION);
             let local = cosine_hemisphere(sampler.get_2d());

@@ -32,6 +32,8 @@ pub const MAX_SIDE: usize = 16384;
 pub const MAX_THREADS: usize = 1024;
 /// Longest path accepted, scattering events.
 pub const MAX_DEPTH: u32 = 1024;
+/// Most light samples per subsurface exit point accepted.
+pub const MAX_EXIT_LIGHT_SAMPLES: u32 = 64;
 
 /// What to render and how long, as requested; [`RenderOptions::validate`] checks it once and
 /// gives the [`RenderSettings`] that [`render`] takes.
@@ -115,6 +117,13 @@ impl RenderOptions {
             && !(1..=MAX_THREADS).contains(&t)
         {
             return Err(bad("threads", t.to_string(), "[1, 1024]"));
+        }
+        if !(1..=MAX_EXIT_LIGHT_SAMPLES).contains(&self.path.exit_light_samples) {
+            return Err(bad(
+                "path.exit_light_samples",
+                self.path.exit_light_samples.to_string(),
+                "[1, 64]",
+            ));
         }
         if !(1..=MAX_DEPTH).contains(&self.path.max_depth) {
             return Err(bad(

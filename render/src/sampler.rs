@@ -31,7 +31,7 @@ pub enum SamplerKind {
 pub const CAMERA_DIMENSIONS: u32 = 8;
 /// Dimensions reserved for each bounce (light choice and position, subsurface probe, exit
 /// light, continuation, roulette).
-pub const BOUNCE_DIMENSIONS: u32 = 16;
+pub const BOUNCE_DIMENSIONS: u32 = 20;
 
 /// Samples per Sobol sequence of `sobol_burley`.
 const SEQUENCE_LENGTH: u32 = 1 << 16;

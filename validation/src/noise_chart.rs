@@ -9,6 +9,7 @@
 //! better) and the ratio of two variants' figures squared is their speed-up at equal noise.
 
 use cpu_time::ProcessTime;
+use render::bssrdf::ProbeAxes;
 use render::integrator::PathSettings;
 use render::noise::lit_threshold;
 use render::passes::Passes;
@@ -39,6 +40,11 @@ pub fn variants() -> Vec<Variant> {
         wavelengths: WavelengthSampling::Uniform,
         ..base
     };
+    let visible = PathSettings {
+        sampler: SamplerKind::Sobol,
+        wavelengths: WavelengthSampling::Visible,
+        ..before
+    };
     vec![
         Variant {
             name: "before (independent + uniform λ)",
@@ -53,10 +59,21 @@ pub fn variants() -> Vec<Variant> {
         },
         Variant {
             name: "+ visible λ",
+            path: visible,
+        },
+        Variant {
+            name: "+ normal probes 0.8",
             path: PathSettings {
-                sampler: SamplerKind::Sobol,
-                wavelengths: WavelengthSampling::Visible,
-                ..before
+                probe_axes: ProbeAxes::new(0.8).unwrap_or_default(),
+                ..visible
+            },
+        },
+        Variant {
+            name: "+ 2 light samples per exit",
+            path: PathSettings {
+                probe_axes: ProbeAxes::new(0.8).unwrap_or_default(),
+                exit_light_samples: 2,
+                ..visible
             },
         },
     ]
