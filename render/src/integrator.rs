@@ -13,9 +13,11 @@
 //! next-event estimation with S_ω (MIS against the cosine-weighted continuation), and the path
 //! continues from the exit point with a cosine-weighted direction (weight T(θ_i) / c).
 
-use crate::bssrdf::{ProbeAxes, ProbeFrame, texture_modulation};
+use crate::bssrdf::{Exit, ProbeAxes, ProbeFrame, Subsurface, texture_modulation};
+use crate::geometry::SurfaceHit;
+
 use crate::geometry::offset_origin;
-use crate::material::Material;
+use crate::material::{Material, SkinMaterial};
 use crate::sampler::{PathSampler, SamplerKind};
 use crate::sampling::cosine_hemisphere;
 use crate::scene::{Hit, Scene};
@@ -51,6 +53,9 @@ pub struct PathSettings {
     pub probe_axes: ProbeAxes,
     /// Light samples (next-event estimates, averaged) at each subsurface exit point, ≥ 1.
     pub exit_light_samples: u32,
+    /// Gather the light at a subsurface exit point at every skin hit, not only when the
+    /// subsurface branch is chosen for the continuation.
+    pub split_subsurface: bool,
 }
 
 impl Default for PathSettings {
@@ -62,6 +67,7 @@ impl Default for PathSettings {
             wavelengths: WavelengthSampling::default(),
             probe_axes: ProbeAxes::default(),
             exit_light_samples: 1,
+            split_subsurface: true,
         }
     }
 }
@@ -169,6 +175,68 @@ fn direct_light(
     f * ls.li * (w / light_pdf)
 }
 
+/// The shading point where a subsurface path leaves towards the viewer.
+struct Entry<'a> {
+    si: &'a SurfaceHit,
+    /// Shading normal facing the viewer.
+    ns: Vec3,
+    wo: Vec3,
+    frame: &'a Frame,
+}
+
+/// Sample where the light leaving skin at `entry` entered (probe rays, `crate::bssrdf`), and the
+/// throughput factor of the path through the skin: T(θ_o) · R(r) · N / pdf · √(m_o m_i), the
+/// texture's modulation capped so that no wavelength's R_tot · m exceeds 1
+/// (`bssrdf::separable`). None when the probe found nothing or the factor is 0 or not finite.
+#[allow(clippy::too_many_arguments)] // the entry, the skin and the random state
+fn subsurface_exit(
+    scene: &Scene,
+    settings: &PathSettings,
+    skin: &SkinMaterial,
+    ss: &Subsurface,
+    entry: &Entry<'_>,
+    wl: &SampledWavelengths,
+    sampler: &mut PathSampler,
+    rays: &mut u64,
+) -> Option<(Exit, SampledSpectrum)> {
+    let frame = ProbeFrame {
+        x: entry.frame.x,
+        y: entry.frame.y,
+        n: entry.frame.z,
+    };
+    sampler.seek(dims::PROBE);
+    let u = [
+        sampler.get_1d(),
+        sampler.get_1d(),
+        sampler.get_1d(),
+        sampler.get_1d(),
+    ];
+    let si = entry.si;
+    let flipped = entry.ns.dot(si.ns) < 0.0;
+    let exit = ss.sample_exit(
+        &scene.geometry,
+        si.material,
+        si.p,
+        &frame,
+        &settings.probe_axes,
+        flipped,
+        wl,
+        u,
+        rays,
+    )?;
+    let m_o = skin.texture_factor(si.uv, &scene.textures);
+    let m_i = exit
+        .hit
+        .map_or(m_o, |h| skin.texture_factor(h.uv, &scene.textures));
+    let m = texture_modulation(m_o, m_i);
+    let t_o = ss.directional.transmittance(entry.wo.dot(entry.ns));
+    let cap = SampledSpectrum(std::array::from_fn(|k| {
+        m.min(1.0 / ss.table.total(wl.nm(k)).max(1e-6))
+    }));
+    let weight = exit.weight * cap * t_o;
+    (!weight.is_black() && weight.is_finite()).then_some((exit, weight))
+}
+
 /// Where the previous scattering event was, for MIS of emission found by BSDF sampling.
 struct PrevVertex {
     ns: Vec3,
@@ -191,6 +259,7 @@ pub fn radiance(
 ) -> SampledSpectrum {
     let n_lights = scene.lights.len() + usize::from(scene.environment.is_some());
     let mut pick = Vec::with_capacity(n_lights);
+    let mut exit_pick = Vec::with_capacity(n_lights);
     let mut l = SampledSpectrum::zero();
     let mut beta = SampledSpectrum::splat(1.0);
     let (mut o, mut d) = (origin, dir);
@@ -243,102 +312,97 @@ pub fn radiance(
         }
 
         // Subsurface branch (skin rendered with the BSSRDF, crate::bssrdf): light leaving here
-        // entered at an exit point sampled with probe rays; continue from there.
+        // entered at an exit point sampled with probe rays; continue from there. With
+        // `split_subsurface` the light at the exit point is gathered at every skin hit (weight
+        // 1) and only the continuation is chosen between the two branches (weight 1/q); without
+        // it the whole branch is chosen (weight 1/q). Both are unbiased; splitting removes the
+        // variance of skipping the exit's light whenever the surface branch is taken.
         let q_sss = bsdf.subsurface_probability(wo);
         sampler.seek(dims::SUBSURFACE_CHOICE);
-        if q_sss > 0.0 && sampler.get_1d() < q_sss {
-            let Material::Skin(skin) = material else {
-                break;
-            };
-            let Some(ss) = &skin.subsurface else { break };
-            let frame = ProbeFrame {
-                x: bsdf.frame.x,
-                y: bsdf.frame.y,
-                n: bsdf.frame.z,
-            };
-            sampler.seek(dims::PROBE);
-            let u = [
-                sampler.get_1d(),
-                sampler.get_1d(),
-                sampler.get_1d(),
-                sampler.get_1d(),
-            ];
-            let flipped = ns.dot(si.ns) < 0.0;
-            let Some(exit) = ss.sample_exit(
-                &scene.geometry,
-                si.material,
-                si.p,
-                &frame,
-                &settings.probe_axes,
-                flipped,
-                wl,
-                u,
-                rays,
-            ) else {
-                break;
-            };
-            // S = T(θ_o) · R(r) · S_ω(ω_i) with the texture's √(m_o m_i) (bssrdf::separable); the
-            // modulation is capped so that no wavelength's R_tot · m exceeds 1.
-            let m_o = skin.texture_factor(si.uv, &scene.textures);
-            let m_i = exit
-                .hit
-                .map_or(m_o, |h| skin.texture_factor(h.uv, &scene.textures));
-            let m = texture_modulation(m_o, m_i);
-            let t_o = ss.directional.transmittance(wo.dot(ns));
-            let cap = SampledSpectrum(std::array::from_fn(|k| {
-                m.min(1.0 / ss.table.total(wl.nm(k)).max(1e-6))
-            }));
-            beta *= exit.weight * cap * (t_o / q_sss);
-            if beta.is_black() || !beta.is_finite() {
-                break;
+        let take_sss = q_sss > 0.0 && sampler.get_1d() < q_sss;
+        let found = match material {
+            Material::Skin(skin) if take_sss || (q_sss > 0.0 && settings.split_subsurface) => {
+                skin.subsurface.as_ref().and_then(|ss| {
+                    let entry = Entry {
+                        si: &si,
+                        ns,
+                        wo,
+                        frame: &bsdf.frame,
+                    };
+                    subsurface_exit(scene, settings, skin, ss, &entry, wl, sampler, rays)
+                        .map(|(exit, w)| (ss, exit, w))
+                })
             }
+            _ => None,
+        };
+        if let Some((ss, exit, weight)) = found {
+            let beta_exit = beta * weight;
+            let light_scale = if settings.split_subsurface {
+                1.0
+            } else {
+                1.0 / q_sss
+            };
             // At the exit point: next-event estimation with S_ω, then a cosine-weighted
             // continuation (weight S_ω cos / (cos / π) = T / c).
             let (eng, ens) = (exit.ng, exit.ns);
             sampler.seek(dims::EXIT_LIGHT);
-            let lit = n_lights > 0 && light_probabilities(scene, exit.p, ens, &mut pick);
-            if lit {
+            let lit_exit =
+                n_lights > 0 && light_probabilities(scene, exit.p, ens, &mut exit_pick);
+            if lit_exit {
                 // Several light samples share one probe (splitting): their mean is the estimate.
                 let n = settings.exit_light_samples.max(1);
                 let mut direct = SampledSpectrum::zero();
                 for j in 0..n {
                     sampler.seek(dims::EXIT_LIGHT + 4 * j.min(1));
-                    direct +=
-                        direct_light(scene, exit.p, eng, ens, wl, &pick, sampler, rays, |wi| {
+                    direct += direct_light(
+                        scene,
+                        exit.p,
+                        eng,
+                        ens,
+                        wl,
+                        &exit_pick,
+                        sampler,
+                        rays,
+                        |wi| {
                             let c = wi.dot(ens);
                             (
                                 SampledSpectrum::splat(ss.directional.s_omega(c) * c.max(0.0)),
                                 c.max(0.0) * FRAC_1_PI,
                             )
-                        });
+                        },
+                    );
                 }
-                l += beta * direct / n as f32;
+                l += beta_exit * direct * (light_scale / n as f32);
             }
-            sampler.seek(dims::EXIT_CONTINUATION);
-            let local = cosine_hemisphere(sampler.get_2d());
-            let wi = Frame::from_normal(ens).to_world(local);
-            if local.z <= 0.0 || wi.dot(eng) <= 0.0 {
-                break;
+            if take_sss {
+                sampler.seek(dims::EXIT_CONTINUATION);
+                let local = cosine_hemisphere(sampler.get_2d());
+                let wi = Frame::from_normal(ens).to_world(local);
+                if local.z <= 0.0 || wi.dot(eng) <= 0.0 {
+                    break;
+                }
+                beta = beta_exit * (ss.directional.cosine_sample_weight(local.z) / q_sss);
+                if !lit_exit {
+                    exit_pick.clear();
+                    exit_pick.resize(n_lights, 0.0);
+                }
+                let mut prev_pick = prev.take().map(|v| v.pick).unwrap_or_default();
+                std::mem::swap(&mut prev_pick, &mut exit_pick);
+                prev = Some(PrevVertex {
+                    p: exit.p,
+                    ns: ens,
+                    bsdf_pdf: local.z * FRAC_1_PI,
+                    pick: prev_pick,
+                });
+                if !russian_roulette(&mut beta, depth, settings, sampler) {
+                    break;
+                }
+                o = offset_origin(exit.p, eng, wi);
+                d = wi;
+                continue;
             }
-            beta *= ss.directional.cosine_sample_weight(local.z);
-            if !lit {
-                pick.clear();
-                pick.resize(n_lights, 0.0);
-            }
-            let mut prev_pick = prev.take().map(|v| v.pick).unwrap_or_default();
-            std::mem::swap(&mut prev_pick, &mut pick);
-            prev = Some(PrevVertex {
-                p: exit.p,
-                ns: ens,
-                bsdf_pdf: local.z * FRAC_1_PI,
-                pick: prev_pick,
-            });
-            if !russian_roulette(&mut beta, depth, settings, sampler) {
-                break;
-            }
-            o = offset_origin(exit.p, eng, wi);
-            d = wi;
-            continue;
+        } else if take_sss {
+            break;
         }
 
         // Continue the path by sampling the BSDF.

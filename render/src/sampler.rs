@@ -63,6 +63,9 @@ pub struct PathSampler {
     dim: u32,
     start: u32,
     end: u32,
+    /// The four values of dimension set `cached_set` (`u32::MAX`: none yet).
+    cache: [f32; 4],
+    cached_set: u32,
 }
 
 impl PathSampler {
@@ -81,6 +84,8 @@ impl PathSampler {
             dim: 0,
             start: 0,
             end: CAMERA_DIMENSIONS,
+            cache: [0.0; 4],
+            cached_set: u32::MAX,
         }
     }
 
@@ -111,9 +116,15 @@ impl PathSampler {
             SamplerKind::Sobol if self.dim < self.end => {
                 let d = self.dim;
                 self.dim += 1;
-                // Each set of four dimensions reuses Sobol dimensions 0–3 under its own seed.
-                let set_seed = mix64(self.sequence_seed ^ u64::from(d / 4)) as u32;
-                sobol_burley::sample(self.index, d % 4, set_seed)
+                let set = d / 4;
+                if set != self.cached_set {
+                    // Each set of four dimensions reuses Sobol dimensions 0–3 under its own seed;
+                    // the four are computed at once (SIMD in the crate).
+                    let set_seed = mix64(self.sequence_seed ^ u64::from(set)) as u32;
+                    self.cache = sobol_burley::sample_4d(self.index, 0, set_seed);
+                    self.cached_set = set;
+                }
+                self.cache[(d % 4) as usize]
             }
             SamplerKind::Sobol => self.rng.random(),
         }

@@ -34,49 +34,45 @@ pub struct Variant {
 /// renderer before any of them.
 #[must_use]
 pub fn variants() -> Vec<Variant> {
-    let base = PathSettings::default();
     let before = PathSettings {
         sampler: SamplerKind::Independent,
         wavelengths: WavelengthSampling::Uniform,
-        ..base
+        probe_axes: ProbeAxes::DEFAULT,
+        exit_light_samples: 1,
+        split_subsurface: false,
+        ..PathSettings::default()
     };
-    let visible = PathSettings {
+    let sobol = PathSettings {
         sampler: SamplerKind::Sobol,
-        wavelengths: WavelengthSampling::Visible,
         ..before
     };
-    vec![
-        Variant {
-            name: "before (independent + uniform λ)",
-            path: before,
-        },
-        Variant {
-            name: "+ Sobol",
-            path: PathSettings {
-                sampler: SamplerKind::Sobol,
-                ..before
-            },
-        },
-        Variant {
-            name: "+ visible λ",
-            path: visible,
-        },
-        Variant {
-            name: "+ normal probes 0.8",
-            path: PathSettings {
-                probe_axes: ProbeAxes::new(0.8).unwrap_or_default(),
-                ..visible
-            },
-        },
-        Variant {
-            name: "+ 2 light samples per exit",
-            path: PathSettings {
-                probe_axes: ProbeAxes::new(0.8).unwrap_or_default(),
-                exit_light_samples: 2,
-                ..visible
-            },
-        },
+    let visible = PathSettings {
+        wavelengths: WavelengthSampling::Visible,
+        ..sobol
+    };
+    let split = PathSettings {
+        split_subsurface: true,
+        ..visible
+    };
+    let normal = PathSettings {
+        probe_axes: ProbeAxes::new(0.8).unwrap_or_default(),
+        ..split
+    };
+    let two_lights = PathSettings {
+        exit_light_samples: 2,
+        ..normal
+    };
+    [
+        ("before (independent + uniform λ)", before),
+        ("+ Sobol", sobol),
+        ("+ visible λ", visible),
+        ("+ exit light at every skin hit", split),
+        ("+ normal probes 0.8", normal),
+        ("+ 2 light samples per exit", two_lights),
     ]
+    .into_iter()
+    .map(|(name, path)| Variant { name, path })
+    .collect()
 }
 
 /// The noise of one fixed-spp measurement.
