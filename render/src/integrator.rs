@@ -49,9 +49,10 @@ pub struct PathSettings {
     pub sampler: SamplerKind,
     /// How the path's wavelengths are drawn.
     pub wavelengths: WavelengthSampling,
-    /// How subsurface probe axes are chosen.
+    /// How subsurface probe axes are chosen (default [`ProbeAxes::RENDER`]).
     pub probe_axes: ProbeAxes,
-    /// Light samples (next-event estimates, averaged) at each subsurface exit point, ≥ 1.
+    /// Light samples (next-event estimates, averaged) at each subsurface exit point, ≥ 1
+    /// (default 2: BENCHMARKS.md, "Image noise").
     pub exit_light_samples: u32,
     /// Gather the light at a subsurface exit point at every skin hit, not only when the
     /// subsurface branch is chosen for the continuation.
@@ -65,8 +66,8 @@ impl Default for PathSettings {
             rr_depth: 3,
             sampler: SamplerKind::default(),
             wavelengths: WavelengthSampling::default(),
-            probe_axes: ProbeAxes::default(),
-            exit_light_samples: 1,
+            probe_axes: ProbeAxes::RENDER,
+            exit_light_samples: 2,
             split_subsurface: true,
         }
     }

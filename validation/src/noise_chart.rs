@@ -30,8 +30,9 @@ pub struct Variant {
     pub path: PathSettings,
 }
 
-/// The steps in the order they were added, each on top of the one before: the first is the
-/// renderer before any of them.
+/// The steps in the order they were added, each on top of the one before (the first is the
+/// renderer before any of them, the sixth today's default), then two other normal-probe
+/// probabilities on top of the fourth.
 #[must_use]
 pub fn variants() -> Vec<Variant> {
     let before = PathSettings {
@@ -55,7 +56,7 @@ pub fn variants() -> Vec<Variant> {
         ..visible
     };
     let normal = PathSettings {
-        probe_axes: ProbeAxes::new(0.8).unwrap_or_default(),
+        probe_axes: ProbeAxes::RENDER,
         ..split
     };
     let two_lights = PathSettings {
@@ -67,8 +68,22 @@ pub fn variants() -> Vec<Variant> {
         ("+ Sobol", sobol),
         ("+ visible λ", visible),
         ("+ exit light at every skin hit", split),
-        ("+ normal probes 0.8", normal),
+        ("+ normal probes 0.95", normal),
         ("+ 2 light samples per exit", two_lights),
+        (
+            "normal probes 0.8",
+            PathSettings {
+                probe_axes: ProbeAxes::new(0.8).unwrap_or_default(),
+                ..split
+            },
+        ),
+        (
+            "normal probes 0.9",
+            PathSettings {
+                probe_axes: ProbeAxes::new(0.9).unwrap_or_default(),
+                ..split
+            },
+        ),
     ]
     .into_iter()
     .map(|(name, path)| Variant { name, path })
