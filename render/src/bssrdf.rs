@@ -27,7 +27,7 @@ pub mod sampling;
 pub mod separable;
 pub mod table;
 
-pub use sampling::{ProbeFrame, choose_axis, pdf_exit, probe};
+pub use sampling::{ProbeAxes, ProbeFrame, pdf_exit, probe};
 pub use separable::{Directional, EnergySplit, texture_modulation};
 pub use table::{ProfileTable, RENDER_SHAPE_ESCAPES, RENDER_SHAPE_STEP_NM, TableOptions};
 
@@ -85,7 +85,7 @@ impl Subsurface {
     }
 
     /// Sample where light that leaves at `p_o` (outward frame `frame`, on material `material`)
-    /// entered, from four uniforms; `flipped` tells that the entry frame faces against the mesh's
+    /// entered, from four uniforms, choosing probe axes by `axes`; `flipped` tells that the entry frame faces against the mesh's
     /// vertex normals (a viewer inside the mesh), so exit normals are flipped alike; `rays` counts
     /// probe rays. None when the probe found nothing
     /// usable (a tangent probe missing is expected and unbiased, see the module doc).
@@ -97,13 +97,14 @@ impl Subsurface {
         material: u32,
         p_o: Vec3,
         frame: &ProbeFrame,
+        axes: &ProbeAxes,
         flipped: bool,
         wl: &SampledWavelengths,
         u: [f32; 4],
         rays: &mut u64,
     ) -> Option<Exit> {
         let hero = wl.nm(0);
-        let (axis, _) = choose_axis(u[0]);
+        let (axis, _) = axes.choose(u[0]);
         let r_max = self.table.r_max_mm(hero);
         let r = self.table.sample_radius(hero, u[1]);
         if r_max.is_nan() || r_max <= 0.0 {
@@ -133,7 +134,7 @@ impl Subsurface {
             }
         }
         if m == 0 {
-            return (axis == 0).then(|| self.local_fallback(p_o, frame, r, wl));
+            return (axis == 0).then(|| self.local_fallback(p_o, frame, axes, r, wl));
         }
         let pick = ((u[3] * m as f32) as usize).min(m - 1);
         let (t, triangle, bary) = hits[pick];
@@ -146,7 +147,7 @@ impl Subsurface {
         };
         let dist = (s.p - p_o).length();
         let pdf = Self::mean_over_wavelengths(wl, |nm| {
-            pdf_exit(frame, p_o, s.p, ng, |ra| self.table.pdf_area(nm, ra))
+            pdf_exit(axes, frame, p_o, s.p, ng, |ra| self.table.pdf_area(nm, ra))
         });
         if pdf.is_nan() || pdf <= 0.0 {
             return None;
@@ -173,10 +174,11 @@ impl Subsurface {
         &self,
         p_o: Vec3,
         frame: &ProbeFrame,
+        axes: &ProbeAxes,
         r: f32,
         wl: &SampledWavelengths,
     ) -> Exit {
-        let pdf = sampling::P_NORMAL_AXIS
+        let pdf = axes.p_normal()
             * Self::mean_over_wavelengths(wl, |nm| self.table.pdf_area(nm, r));
         let weight = if pdf > 0.0 {
             SampledSpectrum(std::array::from_fn(|k| {
@@ -237,6 +239,9 @@ mod tests {
         n: Vec3::Z,
     };
 
+    /// The default axis choice (normal ½).
+    const AXES: ProbeAxes = ProbeAxes::DEFAULT;
+
     /// χ² of the sampled exit distance on a flat slab against the multipole profile's own radial
     /// density 2πr R(r) / R_table (20 equiprobable bins from `multipole::Profile::sample_radius`,
     /// 19 degrees of freedom: 45.3 is the p = 0.0005 critical value). Also: normal probes on a
@@ -266,7 +271,7 @@ mod tests {
         let (mut hits, mut rays) = (0u32, 0u64);
         for _ in 0..120_000 {
             let u = [rng.random(), rng.random(), rng.random(), rng.random()];
-            if let Some(e) = ss.sample_exit(&geo, 0, Vec3::ZERO, &FRAME, false, &wl, u, &mut rays) {
+            if let Some(e) = ss.sample_exit(&geo, 0, Vec3::ZERO, &FRAME, &AXES, false, &wl, u, &mut rays) {
                 assert!(e.hit.is_some(), "fallback on an infinite plane");
                 let r = f64::from(e.p.length());
                 counts[edges.partition_point(|&x| x < r)] += 1;
@@ -304,7 +309,7 @@ mod tests {
         for s in 0..n {
             let wl = SampledWavelengths::sample_visible((u0 + (s % 4) as f32 * 0.25).fract());
             let u = [rng.random(), rng.random(), rng.random(), rng.random()];
-            if let Some(e) = ss.sample_exit(geo, 0, Vec3::ZERO, &FRAME, false, &wl, u, &mut rays) {
+            if let Some(e) = ss.sample_exit(geo, 0, Vec3::ZERO, &FRAME, &AXES, false, &wl, u, &mut rays) {
                 for c in 0..4 {
                     let slot = acc
                         .iter_mut()

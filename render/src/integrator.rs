@@ -13,16 +13,30 @@
 //! next-event estimation with S_ω (MIS against the cosine-weighted continuation), and the path
 //! continues from the exit point with a cosine-weighted direction (weight T(θ_i) / c).
 
-use crate::bssrdf::{ProbeFrame, texture_modulation};
+use crate::bssrdf::{Exit, ProbeAxes, ProbeFrame, Subsurface, texture_modulation};
+use crate::geometry::SurfaceHit;
+
 use crate::geometry::offset_origin;
-use crate::material::Material;
+use crate::material::{Material, SkinMaterial};
+use crate::sampler::{PathSampler, SamplerKind};
 use crate::sampling::cosine_hemisphere;
 use crate::scene::{Hit, Scene};
-use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use crate::spectrum::{SampledSpectrum, SampledWavelengths, WavelengthSampling};
 use brdf::Frame;
-use glam::{Vec2, Vec3};
-use rand::Rng;
+use glam::Vec3;
 use std::f32::consts::FRAC_1_PI;
+
+/// Where each decision of a bounce reads its uniforms in the bounce's region of
+/// [`PathSampler`] (sets of four dimensions: light choice and position at the hit with the
+/// subsurface decision; the probe, or the BSDF sample and roulette; light at the exit point (two
+/// sets: up to two light samples stratified); the continuation from the exit point and roulette).
+mod dims {
+    pub const SUBSURFACE_CHOICE: u32 = 3;
+    pub const PROBE: u32 = 4;
+    pub const CONTINUATION: u32 = 4;
+    pub const EXIT_LIGHT: u32 = 8;
+    pub const EXIT_CONTINUATION: u32 = 16;
+}
 
 /// Knobs of the path tracer.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -34,6 +48,18 @@ pub struct PathSettings {
     /// Angle one pixel subtends, radians (`Camera::pixel_angle_rad`): times the distance a path
     /// has travelled, the footprint of skin's level of detail (`crate::fidelity::lod`; 0: off).
     pub pixel_angle_rad: f32,
+    /// Where the path's uniforms come from.
+    pub sampler: SamplerKind,
+    /// How the path's wavelengths are drawn.
+    pub wavelengths: WavelengthSampling,
+    /// How subsurface probe axes are chosen (default [`ProbeAxes::RENDER`]).
+    pub probe_axes: ProbeAxes,
+    /// Light samples (next-event estimates, averaged) at each subsurface exit point, ≥ 1
+    /// (default 2: BENCHMARKS.md, "Image noise").
+    pub exit_light_samples: u32,
+    /// Gather the light at a subsurface exit point at every skin hit, not only when the
+    /// subsurface branch is chosen for the continuation.
+    pub split_subsurface: bool,
 }
 
 impl Default for PathSettings {
@@ -42,6 +68,11 @@ impl Default for PathSettings {
             max_depth: 16,
             rr_depth: 3,
             pixel_angle_rad: 0.0,
+            sampler: SamplerKind::default(),
+            wavelengths: WavelengthSampling::default(),
+            probe_axes: ProbeAxes::RENDER,
+            exit_light_samples: 2,
+            split_subsurface: true,
         }
     }
 }
@@ -72,15 +103,15 @@ fn light_probabilities(scene: &Scene, p: Vec3, n: Vec3, probs: &mut Vec<f32>) ->
 
 /// Russian roulette after `settings.rr_depth` bounces: false when the path ends, else `beta`
 /// is rescaled by the survival probability.
-fn russian_roulette<R: Rng>(
+fn russian_roulette(
     beta: &mut SampledSpectrum,
     depth: u32,
     settings: &PathSettings,
-    rng: &mut R,
+    sampler: &mut PathSampler,
 ) -> bool {
     if depth + 1 >= settings.rr_depth {
         let survive = beta.max_value().min(1.0);
-        if survive <= 0.0 || rng.random::<f32>() >= survive {
+        if survive <= 0.0 || sampler.get_1d() >= survive {
             return false;
         }
         *beta = *beta / survive;
@@ -93,20 +124,20 @@ fn russian_roulette<R: Rng>(
 /// against the scattering density; `scatter(wi)` gives (f(wi) · |cos θ_i| per wavelength, its
 /// sampling density sr⁻¹).
 #[allow(clippy::too_many_arguments)] // the shading point and its random state, nothing to group
-fn direct_light<R: Rng>(
+fn direct_light(
     scene: &Scene,
     p: Vec3,
     ng: Vec3,
     ns: Vec3,
     wl: &SampledWavelengths,
     pick: &[f32],
-    rng: &mut R,
+    sampler: &mut PathSampler,
     rays: &mut u64,
     scatter: impl Fn(Vec3) -> (SampledSpectrum, f32),
 ) -> SampledSpectrum {
     let n_lights = pick.len();
     // Pick a light by its selection probability (inverse CDF over a handful of lights).
-    let u_pick: f32 = rng.random();
+    let u_pick = sampler.get_1d();
     let mut k = 0;
     let mut cdf = pick[0];
     while u_pick >= cdf && k + 1 < n_lights {
@@ -114,7 +145,7 @@ fn direct_light<R: Rng>(
         cdf += pick[k];
     }
     let pick_pdf = pick[k];
-    let u = Vec2::new(rng.random(), rng.random());
+    let u = sampler.get_2d();
     let sample = if k < scene.lights.len() {
         scene.lights[k].sample(p, u, wl)
     } else {
@@ -149,6 +180,68 @@ fn direct_light<R: Rng>(
     f * ls.li * (w / light_pdf)
 }
 
+/// The shading point where a subsurface path leaves towards the viewer.
+struct Entry<'a> {
+    si: &'a SurfaceHit,
+    /// Shading normal facing the viewer.
+    ns: Vec3,
+    wo: Vec3,
+    frame: &'a Frame,
+}
+
+/// Sample where the light leaving skin at `entry` entered (probe rays, `crate::bssrdf`), and the
+/// throughput factor of the path through the skin: T(θ_o) · R(r) · N / pdf · √(m_o m_i), the
+/// texture's modulation capped so that no wavelength's R_tot · m exceeds 1
+/// (`bssrdf::separable`). None when the probe found nothing or the factor is 0 or not finite.
+#[allow(clippy::too_many_arguments)] // the entry, the skin and the random state
+fn subsurface_exit(
+    scene: &Scene,
+    settings: &PathSettings,
+    skin: &SkinMaterial,
+    ss: &Subsurface,
+    entry: &Entry<'_>,
+    wl: &SampledWavelengths,
+    sampler: &mut PathSampler,
+    rays: &mut u64,
+) -> Option<(Exit, SampledSpectrum)> {
+    let frame = ProbeFrame {
+        x: entry.frame.x,
+        y: entry.frame.y,
+        n: entry.frame.z,
+    };
+    sampler.seek(dims::PROBE);
+    let u = [
+        sampler.get_1d(),
+        sampler.get_1d(),
+        sampler.get_1d(),
+        sampler.get_1d(),
+    ];
+    let si = entry.si;
+    let flipped = entry.ns.dot(si.ns) < 0.0;
+    let exit = ss.sample_exit(
+        &scene.geometry,
+        si.material,
+        si.p,
+        &frame,
+        &settings.probe_axes,
+        flipped,
+        wl,
+        u,
+        rays,
+    )?;
+    let m_o = skin.texture_factor(si.uv, &scene.textures);
+    let m_i = exit
+        .hit
+        .map_or(m_o, |h| skin.texture_factor(h.uv, &scene.textures));
+    let m = texture_modulation(m_o, m_i);
+    let t_o = ss.directional.transmittance(entry.wo.dot(entry.ns));
+    let cap = SampledSpectrum(std::array::from_fn(|k| {
+        m.min(1.0 / ss.table.total(wl.nm(k)).max(1e-6))
+    }));
+    let weight = exit.weight * cap * t_o;
+    (!weight.is_black() && weight.is_finite()).then_some((exit, weight))
+}
+
 /// Where the previous scattering event was, for MIS of emission found by BSDF sampling.
 struct PrevVertex {
     ns: Vec3,
@@ -160,17 +253,18 @@ struct PrevVertex {
 
 /// Radiance arriving at `origin` from direction `-dir` (i.e. along the ray), at the path's
 /// wavelengths; `rays` counts the rays traced (closest hit and shadow).
-pub fn radiance<R: Rng>(
+pub fn radiance(
     scene: &Scene,
     settings: &PathSettings,
     origin: Vec3,
     dir: Vec3,
     wl: &SampledWavelengths,
-    rng: &mut R,
+    sampler: &mut PathSampler,
     rays: &mut u64,
 ) -> SampledSpectrum {
     let n_lights = scene.lights.len() + usize::from(scene.environment.is_some());
     let mut pick = Vec::with_capacity(n_lights);
+    let mut exit_pick = Vec::with_capacity(n_lights);
     let mut l = SampledSpectrum::zero();
     let mut beta = SampledSpectrum::splat(1.0);
     let (mut o, mut d) = (origin, dir);
@@ -178,6 +272,7 @@ pub fn radiance<R: Rng>(
     let mut travelled_mm = 0.0f32;
 
     for depth in 0..settings.max_depth {
+        sampler.start_bounce(depth);
         *rays += 1;
         let hit = scene.intersect(o, d, 0.0, f32::INFINITY);
         let si = match hit {
@@ -213,103 +308,116 @@ pub fn radiance<R: Rng>(
         let material = &scene.materials[si.material as usize];
         travelled_mm += si.t;
         let footprint_mm = settings.pixel_angle_rad * travelled_mm;
-        let collapse = crate::fidelity::lod::collapse(material, footprint_mm, rng);
+        let collapse = crate::fidelity::lod::collapse(material, footprint_mm, sampler.independent_1d());
         let bsdf = material.bsdf_lod(ns, si.uv, wl, &scene.textures, collapse);
 
         // Next-event estimation.
         let lit = n_lights > 0 && light_probabilities(scene, si.p, ns, &mut pick);
         if lit {
             l += beta
-                * direct_light(scene, si.p, ng, ns, wl, &pick, rng, rays, |wi| {
+                * direct_light(scene, si.p, ng, ns, wl, &pick, sampler, rays, |wi| {
                     (bsdf.eval(wo, wi) * wi.dot(ns).abs(), bsdf.pdf(wo, wi))
                 });
         }
 
         // Subsurface branch (skin rendered with the BSSRDF, crate::bssrdf): light leaving here
-        // entered at an exit point sampled with probe rays; continue from there.
+        // entered at an exit point sampled with probe rays; continue from there. With
+        // `split_subsurface` the light at the exit point is gathered at every skin hit (weight
+        // 1) and only the continuation is chosen between the two branches (weight 1/q); without
+        // it the whole branch is chosen (weight 1/q). Both are unbiased; splitting removes the
+        // variance of skipping the exit's light whenever the surface branch is taken.
         let q_sss = bsdf.subsurface_probability(wo);
-        if q_sss > 0.0 && rng.random::<f32>() < q_sss {
-            let Material::Skin(skin) = material else {
-                break;
-            };
-            let Some(ss) = &skin.subsurface else { break };
-            let frame = ProbeFrame {
-                x: bsdf.frame.x,
-                y: bsdf.frame.y,
-                n: bsdf.frame.z,
-            };
-            let u = [rng.random(), rng.random(), rng.random(), rng.random()];
-            let flipped = ns.dot(si.ns) < 0.0;
-            let Some(exit) = ss.sample_exit(
-                &scene.geometry,
-                si.material,
-                si.p,
-                &frame,
-                flipped,
-                wl,
-                u,
-                rays,
-            ) else {
-                break;
-            };
-            // S = T(θ_o) · R(r) · S_ω(ω_i) with the texture's √(m_o m_i) (bssrdf::separable); the
-            // modulation is capped so that no wavelength's R_tot · m exceeds 1.
-            let m_o = skin.texture_factor(si.uv, &scene.textures);
-            let m_i = exit
-                .hit
-                .map_or(m_o, |h| skin.texture_factor(h.uv, &scene.textures));
-            let m = texture_modulation(m_o, m_i);
-            let t_o = ss.directional.transmittance(wo.dot(ns));
-            let cap = SampledSpectrum(std::array::from_fn(|k| {
-                m.min(1.0 / ss.table.total(wl.nm(k)).max(1e-6))
-            }));
-            beta *= exit.weight * cap * (t_o / q_sss);
-            if beta.is_black() || !beta.is_finite() {
-                break;
+        sampler.seek(dims::SUBSURFACE_CHOICE);
+        let take_sss = q_sss > 0.0 && sampler.get_1d() < q_sss;
+        let found = match material {
+            Material::Skin(skin) if take_sss || (q_sss > 0.0 && settings.split_subsurface) => {
+                skin.subsurface.as_ref().and_then(|ss| {
+                    let entry = Entry {
+                        si: &si,
+                        ns,
+                        wo,
+                        frame: &bsdf.frame,
+                    };
+                    subsurface_exit(scene, settings, skin, ss, &entry, wl, sampler, rays)
+                        .map(|(exit, w)| (ss, exit, w))
+                })
             }
+            _ => None,
+        };
+        if let Some((ss, exit, weight)) = found {
+            let beta_exit = beta * weight;
+            let light_scale = if settings.split_subsurface {
+                1.0
+            } else {
+                1.0 / q_sss
+            };
             // At the exit point: next-event estimation with S_ω, then a cosine-weighted
             // continuation (weight S_ω cos / (cos / π) = T / c).
             let (eng, ens) = (exit.ng, exit.ns);
-            let lit = n_lights > 0 && light_probabilities(scene, exit.p, ens, &mut pick);
-            if lit {
-                l += beta
-                    * direct_light(scene, exit.p, eng, ens, wl, &pick, rng, rays, |wi| {
-                        let c = wi.dot(ens);
-                        (
-                            SampledSpectrum::splat(ss.directional.s_omega(c) * c.max(0.0)),
-                            c.max(0.0) * FRAC_1_PI,
-                        )
-                    });
+            sampler.seek(dims::EXIT_LIGHT);
+            let lit_exit =
+                n_lights > 0 && light_probabilities(scene, exit.p, ens, &mut exit_pick);
+            if lit_exit {
+                // Several light samples share one probe (splitting): their mean is the estimate.
+                let n = settings.exit_light_samples.max(1);
+                let mut direct = SampledSpectrum::zero();
+                for j in 0..n {
+                    sampler.seek(dims::EXIT_LIGHT + 4 * j.min(1));
+                    direct += direct_light(
+                        scene,
+                        exit.p,
+                        eng,
+                        ens,
+                        wl,
+                        &exit_pick,
+                        sampler,
+                        rays,
+                        |wi| {
+                            let c = wi.dot(ens);
+                            (
+                                SampledSpectrum::splat(ss.directional.s_omega(c) * c.max(0.0)),
+                                c.max(0.0) * FRAC_1_PI,
+                            )
+                        },
+                    );
+                }
+                l += beta_exit * direct * (light_scale / n as f32);
             }
-            let local = cosine_hemisphere(Vec2::new(rng.random(), rng.random()));
-            let wi = Frame::from_normal(ens).to_world(local);
-            if local.z <= 0.0 || wi.dot(eng) <= 0.0 {
-                break;
+            if take_sss {
+                sampler.seek(dims::EXIT_CONTINUATION);
+                let local = cosine_hemisphere(sampler.get_2d());
+                let wi = Frame::from_normal(ens).to_world(local);
+                if local.z <= 0.0 || wi.dot(eng) <= 0.0 {
+                    break;
+                }
+                beta = beta_exit * (ss.directional.cosine_sample_weight(local.z) / q_sss);
+                if !lit_exit {
+                    exit_pick.clear();
+                    exit_pick.resize(n_lights, 0.0);
+                }
+                let mut prev_pick = prev.take().map(|v| v.pick).unwrap_or_default();
+                std::mem::swap(&mut prev_pick, &mut exit_pick);
+                prev = Some(PrevVertex {
+                    p: exit.p,
+                    ns: ens,
+                    bsdf_pdf: local.z * FRAC_1_PI,
+                    pick: prev_pick,
+                });
+                if !russian_roulette(&mut beta, depth, settings, sampler) {
+                    break;
+                }
+                o = offset_origin(exit.p, eng, wi);
+                d = wi;
+                continue;
             }
-            beta *= ss.directional.cosine_sample_weight(local.z);
-            if !lit {
-                pick.clear();
-                pick.resize(n_lights, 0.0);
-            }
-            let mut prev_pick = prev.take().map(|v| v.pick).unwrap_or_default();
-            std::mem::swap(&mut prev_pick, &mut pick);
-            prev = Some(PrevVertex {
-                p: exit.p,
-                ns: ens,
-                bsdf_pdf: local.z * FRAC_1_PI,
-                pick: prev_pick,
-            });
-            if !russian_roulette(&mut beta, depth, settings, rng) {
-                break;
-            }
-            o = offset_origin(exit.p, eng, wi);
-            d = wi;
-            continue;
+        } else if take_sss {
+            break;
         }
 
         // Continue the path by sampling the BSDF.
-        let u_lobe: f32 = rng.random();
-        let u = Vec2::new(rng.random(), rng.random());
+        sampler.seek(dims::CONTINUATION);
+        let u_lobe = sampler.get_1d();
+        let u = sampler.get_2d();
         let Some(bs) = bsdf.sample(wo, u_lobe, u) else {
             break;
         };
@@ -329,7 +437,7 @@ pub fn radiance<R: Rng>(
             bsdf_pdf: bs.pdf,
             pick: prev_pick,
         });
-        if !russian_roulette(&mut beta, depth, settings, rng) {
+        if !russian_roulette(&mut beta, depth, settings, sampler) {
             break;
         }
         o = offset_origin(si.p, ng, bs.wi);

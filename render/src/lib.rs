@@ -21,6 +21,7 @@ pub mod noise;
 pub mod passes;
 pub mod plot;
 pub mod renderer;
+pub mod sampler;
 pub mod sampling;
 pub mod scene;
 pub mod scene_file;

@@ -4,7 +4,8 @@
 //! (see [`crate::adaptive`]); the decision is taken between passes from the film alone, so it
 //! does not depend on the thread count either.
 //!
-//! Every pixel sample has its own RNG seeded from (seed, pixel, sample index), and passes are added
+//! Every pixel sample draws its uniforms from a [`PathSampler`] seeded from (seed, pixel, sample
+//! index), and passes are added
 //! to the film in order, so the image for a given seed and sample count does not depend on the
 //! number of threads or on the tile schedule.
 
@@ -12,12 +13,11 @@ use crate::adaptive::{Accumulator, MIN_SPP};
 use crate::error::RenderError;
 use crate::film::Film;
 use crate::integrator::{PathSettings, radiance};
+use crate::sampler::PathSampler;
 use crate::scene::Scene;
 use crate::spectrum::SampledWavelengths;
 use glam::Vec2;
 use indicatif::{ProgressBar, ProgressStyle};
-use rand::{Rng, SeedableRng};
-use rand_xoshiro::Xoshiro256PlusPlus;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::{Duration, Instant};
@@ -32,6 +32,8 @@ pub const MAX_SIDE: usize = 16384;
 pub const MAX_THREADS: usize = 1024;
 /// Longest path accepted, scattering events.
 pub const MAX_DEPTH: u32 = 1024;
+/// Most light samples per subsurface exit point accepted.
+pub const MAX_EXIT_LIGHT_SAMPLES: u32 = 64;
 
 /// What to render and how long, as requested; [`RenderOptions::validate`] checks it once and
 /// gives the [`RenderSettings`] that [`render`] takes.
@@ -116,6 +118,13 @@ impl RenderOptions {
         {
             return Err(bad("threads", t.to_string(), "[1, 1024]"));
         }
+        if !(1..=MAX_EXIT_LIGHT_SAMPLES).contains(&self.path.exit_light_samples) {
+            return Err(bad(
+                "path.exit_light_samples",
+                self.path.exit_light_samples.to_string(),
+                "[1, 64]",
+            ));
+        }
         if !(1..=MAX_DEPTH).contains(&self.path.max_depth) {
             return Err(bad(
                 "path.max_depth",
@@ -173,14 +182,6 @@ impl RenderStats {
 /// A tile's sampled pixels (row-major index) and their XYZ.
 type TileResult = Vec<(usize, [f32; 3])>;
 
-/// Seed of pixel `pixel`'s sample `sample`: a SplitMix64-style mix, decorrelated per sample.
-fn sample_seed(seed: u64, pixel: u64, sample: u32) -> u64 {
-    let mut z = seed ^ pixel.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ (u64::from(sample) << 40);
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
-}
-
 /// Render `scene` into a new film with validated `settings`.
 pub fn render(
     scene: &Scene,
@@ -232,17 +233,19 @@ fn render_passes(scene: &Scene, s: &RenderSettings) -> Result<(Film, RenderStats
                         if !active[i] {
                             continue;
                         }
-                        let mut rng = Xoshiro256PlusPlus::seed_from_u64(sample_seed(
-                            s.seed, i as u64, sample,
-                        ));
-                        let wl = SampledWavelengths::sample_visible(rng.random());
+                        let mut sampler =
+                            PathSampler::new(s.path.sampler, s.seed, i as u64, sample);
+                        sampler.start_camera();
+                        let wl =
+                            SampledWavelengths::sample(sampler.get_1d(), s.path.wavelengths);
+                        let jitter = sampler.get_2d();
                         let film_pos = Vec2::new(
-                            (x as f32 + rng.random::<f32>()) / w as f32,
-                            (y as f32 + rng.random::<f32>()) / h as f32,
+                            (x as f32 + jitter.x) / w as f32,
+                            (y as f32 + jitter.y) / h as f32,
                         );
-                        let lens = Vec2::new(rng.random(), rng.random());
+                        let lens = sampler.get_2d();
                         let (o, d) = scene.camera.generate_ray(film_pos, aspect, lens);
-                        let l = radiance(scene, &s.path, o, d, &wl, &mut rng, &mut tile_rays);
+                        let l = radiance(scene, &s.path, o, d, &wl, &mut sampler, &mut tile_rays);
                         // A non-finite sample is dropped and counted by the accumulator.
                         out.push((i, wl.to_xyz(&l)));
                     }

@@ -8,4 +8,5 @@ pub use multipole::montecarlo;
 pub mod measured;
 pub mod measured_colour;
 pub mod measured_report;
+pub mod noise_chart;
 pub mod presets;

@@ -14,7 +14,6 @@
 
 use super::FidelityError;
 use crate::material::Material;
-use rand::Rng;
 use serde::{Deserialize, Serialize};
 
 /// The band of x = footprint / r₉₉ over which the BSSRDF blends into the diffuse body.
@@ -96,8 +95,8 @@ impl Lod {
 }
 
 /// Whether this hit on `material` shades skin with its diffuse body instead of the BSSRDF, at a
-/// pixel footprint of `footprint_mm`; draws from `rng` only inside the band.
-pub fn collapse<R: Rng>(material: &Material, footprint_mm: f32, rng: &mut R) -> bool {
+/// pixel footprint of `footprint_mm`; `u` (uniform in [0, 1)) decides inside the band.
+pub fn collapse(material: &Material, footprint_mm: f32, u: f32) -> bool {
     let Material::Skin(skin) = material else {
         return false;
     };
@@ -113,7 +112,7 @@ pub fn collapse<R: Rng>(material: &Material, footprint_mm: f32, rng: &mut R) -> 
     } else if p >= 1.0 {
         true
     } else {
-        rng.random::<f32>() < p
+        u < p
     }
 }
 

@@ -36,6 +36,9 @@ enum Command {
     /// Per-pixel relative luminance noise of one render, from two renders with different seeds:
     /// sqrt(mean((L₁ − L₂)² / (2 L̄²))) over pixels with L̄ ≥ 15% of the 95th percentile.
     Noise(NoiseArgs),
+    /// Noise against CPU time of a scene at fixed sample counts (two seeds each), for every
+    /// sampling variant from the renderer before variance reduction to now: CSV and PNG into --out.
+    NoiseChart(NoiseChartArgs),
     /// Fit the measured ISSA spectra (explore or held-out subjects) with the seed model and a
     /// chosen one; residual bands and fitted parameters as CSV and PNG into --out.
     Measured(MeasuredArgs),
@@ -66,6 +69,35 @@ struct NoiseArgs {
     a: PathBuf,
     /// Second render of the same scene with another seed (RGB OpenEXR).
     b: PathBuf,
+}
+
+#[derive(Args, Debug)]
+struct NoiseChartArgs {
+    /// Scene file or built-in scene.
+    #[arg(long, value_name = "FILE", default_value = "builtin:three-heads")]
+    scene: String,
+    /// Image width, pixels.
+    #[arg(long, default_value_t = 768)]
+    width: usize,
+    /// Image height, pixels.
+    #[arg(long, default_value_t = 384)]
+    height: usize,
+    /// Sample counts per pixel, comma-separated.
+    #[arg(long, value_delimiter = ',', default_value = "4,16,64")]
+    spp: Vec<u32>,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Only these variants (indices into the list, comma-separated; default all).
+    #[arg(long, value_delimiter = ',')]
+    variants: Vec<usize>,
+    /// Instead of the chart: where the noise comes from (each light alone, without subsurface)
+    /// for the last variant at the first sample count.
+    #[arg(long)]
+    breakdown: bool,
+    /// Output folder.
+    #[arg(long, value_name = "DIR", default_value = "out/noise-chart")]
+    out: PathBuf,
 }
 
 #[derive(Args, Debug)]
@@ -236,6 +268,7 @@ fn main() {
         Some(Command::Mc(args)) => run_mc(args),
         Some(Command::Exact(args)) => validation::compare::run_exact(args.quick, &args.out),
         Some(Command::Noise(args)) => run_noise(args),
+        Some(Command::NoiseChart(args)) => run_noise_chart(args),
         Some(Command::Measured(args)) => run_measured(args),
         Some(Command::Presets(args)) => validation::presets::run_presets(args.noise, &args.out),
         Some(Command::TableKnobs(args)) => {
@@ -307,6 +340,44 @@ fn run_noise(args: &NoiseArgs) -> anyhow::Result<()> {
         r.pixels,
         r.threshold
     );
+    Ok(())
+}
+
+fn run_noise_chart(args: &NoiseChartArgs) -> anyhow::Result<()> {
+    use render::scene::{Scene, SceneOptions};
+    use validation::noise_chart;
+    let all = noise_chart::variants();
+    let chosen: Vec<_> = if args.variants.is_empty() {
+        all.clone()
+    } else {
+        args.variants
+            .iter()
+            .map(|&i| {
+                all.get(i).copied().ok_or_else(|| {
+                    anyhow::anyhow!("--variants {i}: outside [0, {}]", all.len() - 1)
+                })
+            })
+            .collect::<anyhow::Result<_>>()?
+    };
+    let Some(&last) = chosen.last() else {
+        anyhow::bail!("--variants: none chosen");
+    };
+    let size = (args.width, args.height);
+    let mut scene = Scene::load(&args.scene, &SceneOptions::default())?;
+    if args.breakdown {
+        let lambert = Scene::load(
+            &args.scene,
+            &SceneOptions {
+                no_subsurface: true,
+                ..SceneOptions::default()
+            },
+        )?;
+        let spp = args.spp.first().copied().unwrap_or(16);
+        noise_chart::breakdown(&mut scene, Some(&lambert), size, spp, args.threads, last.path)?;
+        return Ok(());
+    }
+    noise_chart::run(&scene, size, &args.spp, args.threads, &chosen, &args.out)?;
+    println!("wrote {}", args.out.join("noise_vs_time.png").display());
     Ok(())
 }
 

@@ -1,0 +1,306 @@
+//! Image noise against CPU time for a scene (`skin-validate noise-chart`): renders at fixed sample
+//! counts with two seeds, the two-seed metric of `render::noise` over the lit pixels (and over
+//! the skin and non-skin pixels apart, by the first-hit skin mask), for each sampling variant, so
+//! each variance-reduction step is seen as noise at equal CPU time.
+//!
+//! CPU time (user + system of the whole process while a render runs) is the x axis, not wall
+//! time: on a shared machine the wall clock depends on the other processes, the CPU time much less.
+//! For an unbiased estimator noise ∝ 1/√t, so noise · √(CPU s) is the efficiency figure (lower is
+//! better) and the ratio of two variants' figures squared is their speed-up at equal noise.
+
+use cpu_time::ProcessTime;
+use render::bssrdf::ProbeAxes;
+use render::integrator::PathSettings;
+use render::noise::lit_threshold;
+use render::passes::Passes;
+use render::plot::{LineChart, Panel, Series, SeriesStyle, save_png};
+use render::renderer::{RenderOptions, render};
+use render::sampler::SamplerKind;
+use render::scene::Scene;
+use render::spectrum::WavelengthSampling;
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// One sampling configuration of the path tracer.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Variant {
+    /// Legend and CSV name.
+    pub name: &'static str,
+    /// The path tracer's knobs.
+    pub path: PathSettings,
+}
+
+/// The steps in the order they were added, each on top of the one before (the first is the
+/// renderer before any of them, the sixth today's default), then two other normal-probe
+/// probabilities on top of the fourth.
+#[must_use]
+pub fn variants() -> Vec<Variant> {
+    let before = PathSettings {
+        sampler: SamplerKind::Independent,
+        wavelengths: WavelengthSampling::Uniform,
+        probe_axes: ProbeAxes::DEFAULT,
+        exit_light_samples: 1,
+        split_subsurface: false,
+        ..PathSettings::default()
+    };
+    let sobol = PathSettings {
+        sampler: SamplerKind::Sobol,
+        ..before
+    };
+    let visible = PathSettings {
+        wavelengths: WavelengthSampling::Visible,
+        ..sobol
+    };
+    let split = PathSettings {
+        split_subsurface: true,
+        ..visible
+    };
+    let normal = PathSettings {
+        probe_axes: ProbeAxes::RENDER,
+        ..split
+    };
+    let two_lights = PathSettings {
+        exit_light_samples: 2,
+        ..normal
+    };
+    [
+        ("before (independent + uniform λ)", before),
+        ("+ Sobol", sobol),
+        ("+ visible λ", visible),
+        ("+ exit light at every skin hit", split),
+        ("+ normal probes 0.95", normal),
+        ("+ 2 light samples per exit", two_lights),
+        (
+            "normal probes 0.8",
+            PathSettings {
+                probe_axes: ProbeAxes::new(0.8).unwrap_or_default(),
+                ..split
+            },
+        ),
+        (
+            "normal probes 0.9",
+            PathSettings {
+                probe_axes: ProbeAxes::new(0.9).unwrap_or_default(),
+                ..split
+            },
+        ),
+    ]
+    .into_iter()
+    .map(|(name, path)| Variant { name, path })
+    .collect()
+}
+
+/// The noise of one fixed-spp measurement.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Point {
+    /// Samples per pixel.
+    pub spp: u32,
+    /// CPU seconds of one render (mean of the two seeds).
+    pub cpu_s: f64,
+    /// Wall seconds of one render (mean of the two seeds).
+    pub wall_s: f64,
+    /// RMS relative noise over the lit pixels.
+    pub noise: f64,
+    /// The same over lit skin pixels.
+    pub noise_skin: f64,
+    /// The same over lit non-skin pixels.
+    pub noise_other: f64,
+}
+
+impl Point {
+    /// noise · √(CPU s): lower is more efficient.
+    #[must_use]
+    pub fn efficiency(&self) -> f64 {
+        self.noise * self.cpu_s.sqrt()
+    }
+}
+
+/// The two-seed metric over the lit pixels where `keep` holds (NaN when none).
+fn masked_noise(a: &[f64], b: &[f64], threshold: f64, keep: impl Fn(usize) -> bool) -> f64 {
+    let (mut s, mut n) = (0.0, 0usize);
+    for (i, (x, y)) in a.iter().zip(b).enumerate() {
+        let m = 0.5 * (x + y);
+        if m > 0.0 && m >= threshold && m.is_finite() && keep(i) {
+            s += (x - y).powi(2) / (2.0 * m * m);
+            n += 1;
+        }
+    }
+    if n == 0 { f64::NAN } else { (s / n as f64).sqrt() }
+}
+
+/// Render `scene` at `spp` with seeds 1 and 2 and measure the noise; `skin` is the skin mask.
+pub fn measure(
+    scene: &Scene,
+    (width, height): (usize, usize),
+    spp: u32,
+    threads: Option<usize>,
+    path: PathSettings,
+    skin: &[f32],
+) -> anyhow::Result<Point> {
+    let mut lum = Vec::new();
+    let (mut cpu, mut wall) = (0.0, 0.0);
+    for seed in [1, 2] {
+        let settings = RenderOptions {
+            width,
+            height,
+            spp,
+            seed,
+            threads,
+            path,
+            ..Default::default()
+        }
+        .validate()?;
+        let t = ProcessTime::now();
+        let (film, stats) = render(scene, &settings)?;
+        cpu += t.elapsed().as_secs_f64();
+        wall += stats.elapsed.as_secs_f64();
+        lum.push(
+            (0..width * height)
+                .map(|i| f64::from(film.xyz(i % width, i / width)[1]))
+                .collect::<Vec<f64>>(),
+        );
+    }
+    let mean: Vec<f64> = lum[0].iter().zip(&lum[1]).map(|(x, y)| 0.5 * (x + y)).collect();
+    let t = lit_threshold(&mean);
+    Ok(Point {
+        spp,
+        cpu_s: 0.5 * cpu,
+        wall_s: 0.5 * wall,
+        noise: masked_noise(&lum[0], &lum[1], t, |_| true),
+        noise_skin: masked_noise(&lum[0], &lum[1], t, |i| skin[i] > 0.5),
+        noise_other: masked_noise(&lum[0], &lum[1], t, |i| skin[i] <= 0.5),
+    })
+}
+
+/// Where the noise comes from, for one variant at `spp`: the whole scene, each light alone (the
+/// environment counted as a light), and, when `no_subsurface` (the same scene loaded with skin
+/// as its Lambertian stand-in) is given, the scene without subsurface transport. Rows are
+/// (what, point).
+pub fn breakdown(
+    scene: &mut Scene,
+    no_subsurface: Option<&Scene>,
+    size: (usize, usize),
+    spp: u32,
+    threads: Option<usize>,
+    path: PathSettings,
+) -> anyhow::Result<Vec<(String, Point)>> {
+    let skin = Passes::first_hit(scene, size.0, size.1).skin;
+    let mut rows = vec![(
+        "all lights".to_string(),
+        measure(scene, size, spp, threads, path, &skin)?,
+    )];
+    if let Some(lambert) = no_subsurface {
+        rows.push((
+            "no subsurface".to_string(),
+            measure(lambert, size, spp, threads, path, &skin)?,
+        ));
+    }
+    // Each light alone: the scene's lights are moved out and put back one at a time.
+    let lights = std::mem::take(&mut scene.lights);
+    let environment = scene.environment.take();
+    let mut alone = Ok(());
+    for (k, light) in lights.iter().enumerate() {
+        scene.lights = vec![light.clone()];
+        match measure(scene, size, spp, threads, path, &skin) {
+            Ok(p) => rows.push((format!("light {k} alone"), p)),
+            Err(e) => {
+                alone = Err(e);
+                break;
+            }
+        }
+    }
+    scene.lights.clear();
+    scene.environment = environment;
+    if alone.is_ok() && scene.environment.is_some() {
+        match measure(scene, size, spp, threads, path, &skin) {
+            Ok(p) => rows.push(("environment alone".to_string(), p)),
+            Err(e) => alone = Err(e),
+        }
+    }
+    scene.lights = lights;
+    alone?;
+    for (what, p) in &rows {
+        eprintln!(
+            "{what:<20} {spp} spp: {:7.1} CPU s, noise {:6.2}% (skin {:.2}%, other {:.2}%), noise·√CPU-s {:.4}",
+            p.cpu_s,
+            100.0 * p.noise,
+            100.0 * p.noise_skin,
+            100.0 * p.noise_other,
+            p.efficiency()
+        );
+    }
+    Ok(rows)
+}
+
+/// Measure every variant at every sample count, write `noise_vs_time.csv` and
+/// `noise_vs_time.png` into `out`, and return the rows (variant name, point).
+pub fn run(
+    scene: &Scene,
+    size: (usize, usize),
+    spps: &[u32],
+    threads: Option<usize>,
+    variants: &[Variant],
+    out: &Path,
+) -> anyhow::Result<Vec<(&'static str, Point)>> {
+    std::fs::create_dir_all(out)?;
+    let skin = Passes::first_hit(scene, size.0, size.1).skin;
+    let mut rows = Vec::new();
+    for v in variants {
+        for &spp in spps {
+            let p = measure(scene, size, spp, threads, v.path, &skin)?;
+            eprintln!(
+                "{:<34} {spp:>5} spp: {:7.1} CPU s, noise {:6.2}% (skin {:.2}%, other {:.2}%), noise·√CPU-s {:.4}",
+                v.name,
+                p.cpu_s,
+                100.0 * p.noise,
+                100.0 * p.noise_skin,
+                100.0 * p.noise_other,
+                p.efficiency()
+            );
+            rows.push((v.name, p));
+        }
+    }
+    write_csv(&out.join("noise_vs_time.csv"), &rows)?;
+    let mut chart = LineChart::new(
+        format!("noise against CPU time, {}×{}", size.0, size.1),
+        "CPU time of one render, s",
+        "RMS relative noise over lit pixels, %",
+    )
+    .log_x()
+    .log_y();
+    for v in variants {
+        let pts = rows
+            .iter()
+            .filter(|(n, _)| *n == v.name)
+            .map(|(_, p)| (p.cpu_s, 100.0 * p.noise))
+            .collect();
+        chart = chart.with_series(Series::line(v.name, pts).with_style(SeriesStyle::LinePoints));
+    }
+    save_png(
+        &out.join("noise_vs_time.png"),
+        &[Panel::Line(chart)],
+        900,
+        600,
+    )?;
+    Ok(rows)
+}
+
+fn write_csv(path: &Path, rows: &[(&'static str, Point)]) -> anyhow::Result<()> {
+    let mut s =
+        String::from("variant,spp,cpu_s,wall_s,noise,noise_skin,noise_other,noise_sqrt_cpu_s\n");
+    for (name, p) in rows {
+        writeln!(
+            s,
+            "{name},{},{:.3},{:.3},{:.6},{:.6},{:.6},{:.6}",
+            p.spp,
+            p.cpu_s,
+            p.wall_s,
+            p.noise,
+            p.noise_skin,
+            p.noise_other,
+            p.efficiency()
+        )?;
+    }
+    render::atomic::write_bytes(path, s.as_bytes())?;
+    Ok(())
+}
