@@ -19,6 +19,7 @@ use crate::material::Material;
 use crate::sampling::cosine_hemisphere;
 use crate::scene::{Hit, Scene};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use crate::volumetric;
 use brdf::Frame;
 use glam::{Vec2, Vec3};
 use rand::Rng;
@@ -45,6 +46,9 @@ impl Default for PathSettings {
 /// Power heuristic with β = 2 for one sample from each of two strategies.
 #[must_use]
 pub fn power_heuristic(pdf_a: f32, pdf_b: f32) -> f32 {
+    if pdf_a == f32::INFINITY {
+        return 1.0; // a delta strategy: the other cannot sample it
+    }
     let (a, b) = (pdf_a * pdf_a, pdf_b * pdf_b);
     if a == 0.0 { 0.0 } else { a / (a + b) }
 }
@@ -225,6 +229,34 @@ pub fn radiance<R: Rng>(
                 break;
             };
             let Some(ss) = &skin.subsurface else { break };
+            if let Some(vol) = scene.volumetric.as_ref().and_then(|v| v.medium(si.material)) {
+                // The volumetric reference (crate::volumetric): refract in, walk, leave.
+                let t_o = ss.directional.transmittance(wo.dot(ng));
+                let Some(d_in) = volumetric::walk::refract(-wo, ng, 1.0 / vol.eta) else {
+                    break;
+                };
+                let walk = volumetric::walk(
+                    scene,
+                    vol,
+                    &ss.directional,
+                    si.p,
+                    ng,
+                    d_in,
+                    wl.nm(0),
+                    rng,
+                    rays,
+                );
+                let Some(exit) = walk.exit else { break };
+                beta = volumetric::hero_only(beta) * (exit.weight * t_o / q_sss);
+                // No light was sampled at the exit: emission found next takes MIS weight 1.
+                prev = None;
+                if beta.is_black() || !russian_roulette(&mut beta, depth, settings, rng) {
+                    break;
+                }
+                o = offset_origin(exit.p, exit.ng, exit.dir);
+                d = exit.dir;
+                continue;
+            }
             let frame = ProbeFrame {
                 x: bsdf.frame.x,
                 y: bsdf.frame.y,
@@ -318,7 +350,7 @@ pub fn radiance<R: Rng>(
         prev = Some(PrevVertex {
             p: si.p,
             ns,
-            bsdf_pdf: bs.pdf,
+            bsdf_pdf: if bs.delta { f32::INFINITY } else { bs.pdf },
             pick: prev_pick,
         });
         if !russian_roulette(&mut beta, depth, settings, rng) {

@@ -13,7 +13,7 @@ use crate::error::RenderError;
 use crate::film::Film;
 use crate::integrator::{PathSettings, radiance};
 use crate::scene::Scene;
-use crate::spectrum::SampledWavelengths;
+use crate::spectrum::{LAMBDA_MAX_NM, LAMBDA_MIN_NM, SampledWavelengths};
 use glam::Vec2;
 use indicatif::{ProgressBar, ProgressStyle};
 use rand::{Rng, SeedableRng};
@@ -59,6 +59,9 @@ pub struct RenderOptions {
     pub path: PathSettings,
     /// Show a progress bar on stderr.
     pub progress: bool,
+    /// Render one wavelength, nm, in [380, 780]: each pixel holds the spectral radiance there
+    /// as a grey (R = G = B) instead of the colour of the visible spectrum (None = colour).
+    pub wavelength_nm: Option<f32>,
 }
 
 impl Default for RenderOptions {
@@ -74,6 +77,7 @@ impl Default for RenderOptions {
             threads: None,
             path: PathSettings::default(),
             progress: false,
+            wavelength_nm: None,
         }
     }
 }
@@ -115,6 +119,11 @@ impl RenderOptions {
             && !(1..=MAX_THREADS).contains(&t)
         {
             return Err(bad("threads", t.to_string(), "[1, 1024]"));
+        }
+        if let Some(nm) = self.wavelength_nm
+            && !(LAMBDA_MIN_NM..=LAMBDA_MAX_NM).contains(&nm)
+        {
+            return Err(bad("wavelength_nm", nm.to_string(), "[380, 780] nm"));
         }
         if !(1..=MAX_DEPTH).contains(&self.path.max_depth) {
             return Err(bad(
@@ -235,7 +244,11 @@ fn render_passes(scene: &Scene, s: &RenderSettings) -> Result<(Film, RenderStats
                         let mut rng = Xoshiro256PlusPlus::seed_from_u64(sample_seed(
                             s.seed, i as u64, sample,
                         ));
-                        let wl = SampledWavelengths::sample_visible(rng.random());
+                        let u_wl = rng.random();
+                        let wl = s.wavelength_nm.map_or_else(
+                            || SampledWavelengths::sample_visible(u_wl),
+                            SampledWavelengths::fixed,
+                        );
                         let film_pos = Vec2::new(
                             (x as f32 + rng.random::<f32>()) / w as f32,
                             (y as f32 + rng.random::<f32>()) / h as f32,
@@ -246,10 +259,12 @@ fn render_passes(scene: &Scene, s: &RenderSettings) -> Result<(Film, RenderStats
                         // A non-finite sample would poison the pixel: drop it (counted as black).
                         out.push((
                             i,
-                            if l.is_finite() {
-                                wl.to_xyz(&l)
-                            } else {
+                            if !l.is_finite() {
                                 [0.0; 3]
+                            } else if s.wavelength_nm.is_some() {
+                                wl.to_grey_xyz(&l)
+                            } else {
+                                wl.to_xyz(&l)
                             },
                         ));
                     }

@@ -71,6 +71,31 @@ pub struct RenderArgs {
     /// No progress bar.
     #[arg(long)]
     pub quiet: bool,
+    /// How skin's body is rendered: bssrdf (the separable BSSRDF, fast) or volumetric (an
+    /// unbiased random walk through the two layers inside each closed skin mesh: the reference).
+    #[arg(long, value_name = "KIND", value_enum, default_value_t = Integrator::Bssrdf)]
+    pub integrator: Integrator,
+    /// Render one wavelength, nm, in [380, 780]: the EXR holds the spectral radiance there as a
+    /// grey (R = G = B), in the scene's emission units.
+    #[arg(long, value_name = "NM", value_parser = Checked(parse_wavelength), allow_hyphen_values = true)]
+    pub wavelength: Option<f32>,
+}
+
+/// The integrator of skin's body (`--integrator`).
+#[derive(clap::ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Integrator {
+    /// The separable BSSRDF (`render::bssrdf`).
+    Bssrdf,
+    /// The volumetric random walk (`render::volumetric`).
+    Volumetric,
+}
+
+fn parse_wavelength(s: &str) -> Result<f32, String> {
+    let v = parse_number(s, "[380, 780] nm")?;
+    if !(380.0..=780.0).contains(&v) {
+        return Err(format!("{} outside [380, 780] nm", Num(v)));
+    }
+    Ok(v as f32)
 }
 
 /// Run `skin render`.
@@ -95,6 +120,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
             ..Default::default()
         },
         progress: !args.quiet,
+        wavelength_nm: args.wavelength,
         ..Default::default()
     }
     .validate()
@@ -106,14 +132,21 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
             anyhow::anyhow!("--out {}: not a writable folder ({e})", args.out.display())
         })?;
     let t0 = Instant::now();
-    let scene = Scene::load(
+    if args.integrator == Integrator::Volumetric && args.no_subsurface {
+        anyhow::bail!("--integrator volumetric renders the subsurface: drop --no-subsurface");
+    }
+    let mut scene = Scene::load(
         &args.scene,
         &SceneOptions {
             method: args.method,
             no_subsurface: args.no_subsurface,
             shape_escapes: args.shape_escapes,
+            ..SceneOptions::default()
         },
     )?;
+    if args.integrator == Integrator::Volumetric {
+        scene.use_volumetric()?;
+    }
     let load = t0.elapsed();
     eprintln!(
         "scene {}: {} triangles, {} lights, {} materials, loaded in {:.2} s",
@@ -171,6 +204,7 @@ fn flag_error(e: SettingError) -> anyhow::Error {
         "noise" => "--noise",
         "threads" => "--threads",
         "path.max_depth" => "--max-depth",
+        "wavelength_nm" => "--wavelength",
         other => other,
     };
     anyhow::anyhow!("{flag} = {} outside {}", e.value, e.range)

@@ -4,7 +4,10 @@
 
 use super::load::Loader;
 use crate::error::RenderError;
-use crate::material::{DiffuseMaterial, Material, SkinBuildError, SkinMaterial, TextureRef};
+use crate::material::{
+    DiffuseMaterial, Material, SkinBuildError, SkinKnobs, SkinMaterial, SurfaceKind, TextureRef,
+};
+use skin_optics::echo::Num;
 use crate::scene_file::MaterialDesc;
 use crate::spectrum::{SpectrumTable, linear_srgb_to_spectrum};
 use crate::texture::{Texture, luminance};
@@ -53,6 +56,8 @@ impl Loader<'_> {
                     oil,
                     roughness,
                     albedo_texture,
+                    phase_g,
+                    surface,
                 } => {
                     let params =
                         self.skin_params(&key, preset, [*melanin, *eumelanin, *hemoglobin, *oil])?;
@@ -61,7 +66,8 @@ impl Loader<'_> {
                         |e: brdf::BrdfError| self.err(format!("{key}.roughness"), e.to_string());
                     brdf::check_roughness(m_rough).map_err(rough_err)?;
                     let tex = texture(albedo_texture)?;
-                    let skin = SkinMaterial::build(params, m_rough, tex, self.opts).map_err(
+                    let knobs = self.skin_knobs(&key, *phase_g, surface.as_deref())?;
+                    let skin = SkinMaterial::build(params, m_rough, tex, &knobs).map_err(
                         |e| match e {
                             SkinBuildError::Surface(e) => rough_err(e),
                             other => self.err(&key, other.to_string()),
@@ -119,6 +125,31 @@ impl Loader<'_> {
             materials.push(material);
         }
         Ok((materials, material_names, textures))
+    }
+
+    /// The scene's skin knobs with this material's `phase_g` and `surface` keys applied.
+    fn skin_knobs(
+        &self,
+        key: &str,
+        phase_g: Option<f64>,
+        surface: Option<&str>,
+    ) -> Result<SkinKnobs, RenderError> {
+        let mut knobs = *self.opts;
+        if let Some(g) = phase_g {
+            if !(0.0..=0.99).contains(&g) {
+                return Err(self.err(
+                    format!("{key}.phase_g"),
+                    format!("expected a value in [0, 0.99], got {}", Num(g)),
+                ));
+            }
+            knobs.phase_g = Some(g);
+        }
+        if let Some(s) = surface {
+            knobs.surface = s
+                .parse::<SurfaceKind>()
+                .map_err(|e| self.err(format!("{key}.surface"), e))?;
+        }
+        Ok(knobs)
     }
 
     fn unit(&self, key: &str, v: f32) -> Result<f32, RenderError> {
