@@ -231,7 +231,8 @@ pub fn radiance<R: Rng>(
             let Some(ss) = &skin.subsurface else { break };
             if let Some(vol) = scene.volumetric.as_ref().and_then(|v| v.medium(si.material)) {
                 // The volumetric reference (crate::volumetric): refract in, walk, leave.
-                let t_o = ss.directional.transmittance(wo.dot(ng));
+                // T at the shading normal, as the surface lobe's split (energy: ρ + T = 1).
+                let t_o = ss.directional.transmittance(wo.dot(ns));
                 let Some(d_in) = volumetric::walk::refract(-wo, ng, 1.0 / vol.eta) else {
                     break;
                 };

@@ -250,15 +250,14 @@ impl Bsdf<'_> {
             _ => None,
         };
         if let Some(Surface::Smooth { eta }) = surface {
-            // Mirror reflection with the Fresnel weight, chosen with probability p (`Lobes::Skin`)
-            // or already chosen by the integrator (`SkinSurface`, which divides by p itself).
+            // Mirror reflection with the Fresnel weight, chosen with probability p (by `u_lobe`
+            // for `Lobes::Skin`, by the integrator's branch for `SkinSurface`).
             let i = Vec3::new(-o.x, -o.y, o.z);
-            let pick = if matches!(self.lobes, Lobes::Skin { .. }) { p } else { 1.0 };
             let fresnel = brdf::fresnel::dielectric_reflectance_f32(o.z, *eta);
             return Some(BsdfSample {
                 wi: self.frame.to_world(i),
                 f: SampledSpectrum::splat(fresnel / o.z),
-                pdf: pick,
+                pdf: p,
                 delta: true,
             });
         }

@@ -4,7 +4,7 @@
 //! A sparse uniform grid (cell h = max(2d, extent / 256)) lists, per cell, the triangles whose
 //! distance to the cell's centre is at most d + h√3/2: every triangle within d of any point of the
 //! cell is listed there (triangle inequality), so one cell's list answers the query exactly. The
-//! point–triangle distance is Ericson's closest-point test ([Ericson 2005] §5.1.5).
+//! point–triangle distance is Ericson's closest-point test ([Ericson05] §5.1.5).
 
 use glam::Vec3;
 use std::collections::HashMap;
@@ -79,7 +79,7 @@ fn cell_of(p: Vec3, h: f32) -> [i32; 3] {
     (p / h).floor().as_ivec3().to_array()
 }
 
-/// Squared distance from `p` to the triangle `t`, mm² ([Ericson 2005] §5.1.5, closest point by
+/// Squared distance from `p` to the triangle `t`, mm² ([Ericson05] §5.1.5, closest point by
 /// Voronoi regions).
 #[must_use]
 pub fn distance_squared(p: Vec3, t: &[Vec3; 3]) -> f32 {

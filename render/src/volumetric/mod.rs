@@ -9,6 +9,7 @@
 //! hero wavelength.
 
 pub mod distance;
+pub mod shapes;
 pub mod walk;
 
 use crate::material::Material;

@@ -110,6 +110,9 @@ pub fn walk<R: RngCore>(
             }
             out.collisions += 1;
             w *= f64::from(ss / (sa + ss));
+            if w == 0.0 {
+                return out;
+            }
             if w < ROULETTE_THRESHOLD {
                 if rng.random::<f64>() >= ROULETTE_SURVIVAL {
                     return out;

@@ -41,6 +41,19 @@ enum Command {
     Measured(MeasuredArgs),
     /// Fit the ISSA group/site medians (SCI, model auto) and write the measured-preset table.
     Presets(PresetArgs),
+    /// The BSSRDF against the volumetric reference in image space: per-pixel error maps, region
+    /// means by shape and skin tone, error against render time (PNG, CSV, render.md) into --out.
+    Render(RenderStudyArgs),
+}
+
+#[derive(Args, Debug)]
+struct RenderStudyArgs {
+    /// Smaller images and sample counts (minutes on two cores).
+    #[arg(long)]
+    quick: bool,
+    /// Output folder.
+    #[arg(long, value_name = "DIR", default_value = "out/render-study")]
+    out: PathBuf,
 }
 
 #[derive(Args, Debug)]
@@ -220,6 +233,15 @@ fn main() {
         Some(Command::Noise(args)) => run_noise(args),
         Some(Command::Measured(args)) => run_measured(args),
         Some(Command::Presets(args)) => validation::presets::run_presets(args.noise, &args.out),
+        Some(Command::Render(args)) => {
+            use validation::compare::render::{RenderStudy, run_render};
+            let study = if args.quick {
+                RenderStudy::QUICK
+            } else {
+                RenderStudy::FULL
+            };
+            run_render(study, &args.out)
+        }
         None => validation::compare::run_comparison(cli.quick, &cli.out),
     };
     if let Err(e) = result {
