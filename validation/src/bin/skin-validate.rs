@@ -234,7 +234,7 @@ fn main() {
         Some(Command::Measured(args)) => run_measured(args),
         Some(Command::Presets(args)) => validation::presets::run_presets(args.noise, &args.out),
         Some(Command::Render(args)) => {
-            use validation::compare::render::{RenderStudy, run_render};
+            use validation::compare::render_study::{RenderStudy, run_render};
             let study = if args.quick {
                 RenderStudy::QUICK
             } else {

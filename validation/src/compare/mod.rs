@@ -15,7 +15,7 @@
 pub mod exact;
 pub mod knobs;
 pub mod profiles;
-pub mod render;
+pub mod render_study;
 pub mod spectra;
 pub mod stability;
 
