@@ -100,6 +100,17 @@ impl Geometry {
         self.triangles.len()
     }
 
+    /// The vertices (world mm) of every triangle of material `material`.
+    #[must_use]
+    pub fn triangles_of(&self, material: u32) -> Vec<[Vec3; 3]> {
+        self.triangles
+            .iter()
+            .zip(&self.materials)
+            .filter(|&(_, &m)| m == material)
+            .map(|(t, _)| t.map(|i| self.positions[i as usize]))
+            .collect()
+    }
+
     /// Material index of a triangle.
     #[must_use]
     pub fn material_of(&self, triangle: u32) -> u32 {

@@ -22,6 +22,7 @@ use crate::sampler::{PathSampler, SamplerKind};
 use crate::sampling::cosine_hemisphere;
 use crate::scene::{Hit, Scene};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths, WavelengthSampling};
+use crate::volumetric;
 use brdf::Frame;
 use glam::Vec3;
 use std::f32::consts::FRAC_1_PI;
@@ -80,6 +81,9 @@ impl Default for PathSettings {
 /// Power heuristic with β = 2 for one sample from each of two strategies.
 #[must_use]
 pub fn power_heuristic(pdf_a: f32, pdf_b: f32) -> f32 {
+    if pdf_a == f32::INFINITY {
+        return 1.0; // a delta strategy: the other cannot sample it
+    }
     let (a, b) = (pdf_a * pdf_a, pdf_b * pdf_b);
     if a == 0.0 { 0.0 } else { a / (a + b) }
 }
@@ -308,7 +312,8 @@ pub fn radiance(
         let material = &scene.materials[si.material as usize];
         travelled_mm += si.t;
         let footprint_mm = settings.pixel_angle_rad * travelled_mm;
-        let collapse = crate::fidelity::lod::collapse(material, footprint_mm, sampler.independent_1d());
+        let collapse =
+            crate::fidelity::lod::collapse(material, footprint_mm, sampler.independent_1d());
         let bsdf = material.bsdf_lod(ns, si.uv, wl, &scene.textures, collapse);
 
         // Next-event estimation.
@@ -329,8 +334,47 @@ pub fn radiance(
         let q_sss = bsdf.subsurface_probability(wo);
         sampler.seek(dims::SUBSURFACE_CHOICE);
         let take_sss = q_sss > 0.0 && sampler.get_1d() < q_sss;
+        let volume = scene
+            .volumetric
+            .as_ref()
+            .and_then(|v| v.medium(si.material));
+        // A skin rendered by the volumetric reference takes no BSSRDF exit: its body is walked.
+        if take_sss
+            && let (Some(vol), Material::Skin(skin)) = (volume, material)
+            && let Some(ss) = &skin.subsurface
+        {
+            // The volumetric reference (crate::volumetric): refract in, walk, leave.
+            // T at the shading normal, as the surface lobe's split (energy: ρ + T = 1).
+            let t_o = ss.directional.transmittance(wo.dot(ns));
+            let Some(d_in) = volumetric::walk::refract(-wo, ng, 1.0 / vol.eta) else {
+                break;
+            };
+            let walk = volumetric::walk(
+                scene,
+                vol,
+                &ss.directional,
+                si.p,
+                ng,
+                d_in,
+                wl.nm(0),
+                sampler.rng(),
+                rays,
+            );
+            let Some(exit) = walk.exit else { break };
+            beta = volumetric::hero_only(beta) * (exit.weight * t_o / q_sss);
+            // No light was sampled at the exit: emission found next takes MIS weight 1.
+            prev = None;
+            if beta.is_black() || !russian_roulette(&mut beta, depth, settings, sampler) {
+                break;
+            }
+            o = offset_origin(exit.p, exit.ng, exit.dir);
+            d = exit.dir;
+            continue;
+        }
         let found = match material {
-            Material::Skin(skin) if take_sss || (q_sss > 0.0 && settings.split_subsurface) => {
+            Material::Skin(skin)
+                if volume.is_none() && (take_sss || (q_sss > 0.0 && settings.split_subsurface)) =>
+            {
                 skin.subsurface.as_ref().and_then(|ss| {
                     let entry = Entry {
                         si: &si,
@@ -355,8 +399,7 @@ pub fn radiance(
             // continuation (weight S_ω cos / (cos / π) = T / c).
             let (eng, ens) = (exit.ng, exit.ns);
             sampler.seek(dims::EXIT_LIGHT);
-            let lit_exit =
-                n_lights > 0 && light_probabilities(scene, exit.p, ens, &mut exit_pick);
+            let lit_exit = n_lights > 0 && light_probabilities(scene, exit.p, ens, &mut exit_pick);
             if lit_exit {
                 // Several light samples share one probe (splitting): their mean is the estimate.
                 let n = settings.exit_light_samples.max(1);
@@ -434,7 +477,7 @@ pub fn radiance(
         prev = Some(PrevVertex {
             p: si.p,
             ns,
-            bsdf_pdf: bs.pdf,
+            bsdf_pdf: if bs.delta { f32::INFINITY } else { bs.pdf },
             pick: prev_pick,
         });
         if !russian_roulette(&mut beta, depth, settings, sampler) {

@@ -27,3 +27,4 @@ pub mod scene;
 pub mod scene_file;
 pub mod spectrum;
 pub mod texture;
+pub mod volumetric;

@@ -15,7 +15,7 @@ use crate::film::Film;
 use crate::integrator::{PathSettings, radiance};
 use crate::sampler::PathSampler;
 use crate::scene::Scene;
-use crate::spectrum::SampledWavelengths;
+use crate::spectrum::{LAMBDA_MAX_NM, LAMBDA_MIN_NM, SampledWavelengths};
 use glam::Vec2;
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
@@ -61,6 +61,9 @@ pub struct RenderOptions {
     pub path: PathSettings,
     /// Show a progress bar on stderr.
     pub progress: bool,
+    /// Render one wavelength, nm, in [380, 780]: each pixel holds the spectral radiance there
+    /// as a grey (R = G = B) instead of the colour of the visible spectrum (None = colour).
+    pub wavelength_nm: Option<f32>,
 }
 
 impl Default for RenderOptions {
@@ -76,6 +79,7 @@ impl Default for RenderOptions {
             threads: None,
             path: PathSettings::default(),
             progress: false,
+            wavelength_nm: None,
         }
     }
 }
@@ -124,6 +128,11 @@ impl RenderOptions {
                 self.path.exit_light_samples.to_string(),
                 "[1, 64]",
             ));
+        }
+        if let Some(nm) = self.wavelength_nm
+            && !(LAMBDA_MIN_NM..=LAMBDA_MAX_NM).contains(&nm)
+        {
+            return Err(bad("wavelength_nm", nm.to_string(), "[380, 780] nm"));
         }
         if !(1..=MAX_DEPTH).contains(&self.path.max_depth) {
             return Err(bad(
@@ -236,8 +245,11 @@ fn render_passes(scene: &Scene, s: &RenderSettings) -> Result<(Film, RenderStats
                         let mut sampler =
                             PathSampler::new(s.path.sampler, s.seed, i as u64, sample);
                         sampler.start_camera();
-                        let wl =
-                            SampledWavelengths::sample(sampler.get_1d(), s.path.wavelengths);
+                        let u_wl = sampler.get_1d();
+                        let wl = s.wavelength_nm.map_or_else(
+                            || SampledWavelengths::sample(u_wl, s.path.wavelengths),
+                            SampledWavelengths::fixed,
+                        );
                         let jitter = sampler.get_2d();
                         let film_pos = Vec2::new(
                             (x as f32 + jitter.x) / w as f32,
@@ -247,7 +259,12 @@ fn render_passes(scene: &Scene, s: &RenderSettings) -> Result<(Film, RenderStats
                         let (o, d) = scene.camera.generate_ray(film_pos, aspect, lens);
                         let l = radiance(scene, &s.path, o, d, &wl, &mut sampler, &mut tile_rays);
                         // A non-finite sample is dropped and counted by the accumulator.
-                        out.push((i, wl.to_xyz(&l)));
+                        let xyz = if s.wavelength_nm.is_some() {
+                            wl.to_grey_xyz(&l)
+                        } else {
+                            wl.to_xyz(&l)
+                        };
+                        out.push((i, xyz));
                     }
                 }
                 rays.fetch_add(tile_rays, Ordering::Relaxed);

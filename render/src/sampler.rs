@@ -136,6 +136,11 @@ impl PathSampler {
         self.rng.random()
     }
 
+    /// The independent stream itself, for walks of unbounded dimension (the volumetric walk).
+    pub fn rng(&mut self) -> &mut Xoshiro256PlusPlus {
+        &mut self.rng
+    }
+
     /// The next two uniforms.
     pub fn get_2d(&mut self) -> Vec2 {
         let x = self.get_1d();

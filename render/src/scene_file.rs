@@ -10,12 +10,15 @@
 //! [environment]            # optional; absent = black
 //! spectrum = "d65"         # "d65", "constant" or "blackbody" (+ temperature_k); or exr = "sky.exr"
 //! intensity = 0.05         # luminance Y of the emitted radiance
+//! # spectral_radiance = 1  # instead: the same spectral radiance at every wavelength (validation)
 //!
 //! [materials.face]
 //! type = "skin"
 //! preset = "light"         # light (= paper), medium, dark, or a measured preset (`skin presets`:
 //!                          # ca-forehead, ..., ita-tan); melanin, eumelanin, hemoglobin, oil override it
 //! albedo_texture = "builtin:Map-COL.jpg"
+//! phase_g = 0.9            # HG anisotropy of both layers, [0, 0.99] (default 0.9)
+//! surface = "oily"         # "oily" (Torrance–Sparrow lobe, default) or "smooth" (dielectric, η = 1.4)
 //!
 //! [materials.wall]
 //! type = "diffuse"
@@ -255,9 +258,14 @@ pub struct EnvironmentDesc {
     pub temperature_k: Option<f64>,
     /// Lat-long linear-sRGB OpenEXR map.
     pub exr: Option<String>,
-    /// Luminance of a constant environment, or the map's multiplier.
-    #[serde(deserialize_with = "finite")]
-    pub intensity: f32,
+    /// Luminance of a constant environment, or the map's multiplier (required unless
+    /// `spectral_radiance` is given).
+    #[serde(default, deserialize_with = "opt_finite")]
+    pub intensity: Option<f32>,
+    /// A constant environment of this spectral radiance at every wavelength, in the scene's
+    /// emission units (instead of `spectrum` and `intensity`; ≥ 0).
+    #[serde(default, deserialize_with = "opt_finite")]
+    pub spectral_radiance: Option<f32>,
 }
 
 /// `[materials.NAME]`.
@@ -281,6 +289,11 @@ pub enum MaterialDesc {
         roughness: Option<f32>,
         /// sRGB albedo texture (JPEG/PNG).
         albedo_texture: Option<String>,
+        /// Henyey–Greenstein anisotropy g of both layers, [0, 0.99] (default 0.9).
+        #[serde(default, deserialize_with = "opt_finite_f64")]
+        phase_g: Option<f64>,
+        /// Surface model: "oily" (default) or "smooth".
+        surface: Option<String>,
     },
     /// Lambertian.
     Diffuse {

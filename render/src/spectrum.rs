@@ -189,6 +189,25 @@ impl SampledWavelengths {
         }
     }
 
+    /// All four wavelengths at `nm` (a one-wavelength render, `--wavelength`): the radiance is
+    /// read with [`SampledWavelengths::to_grey_xyz`], not integrated over the visible range.
+    #[must_use]
+    pub fn fixed(nm: f32) -> Self {
+        Self {
+            lambda_nm: [nm; N_WAVELENGTHS],
+            pdf: [1.0; N_WAVELENGTHS],
+        }
+    }
+
+    /// The XYZ of a grey of linear sRGB R = G = B = L, L the radiance at a [`Self::fixed`]
+    /// wavelength (the mean over the lanes still carried; a terminated lane holds 0 and the hero
+    /// carries N times its share).
+    #[must_use]
+    pub fn to_grey_xyz(&self, l: &SampledSpectrum) -> [f32; 3] {
+        let grey = l.average();
+        grey_white_xyz().map(|w| w * grey)
+    }
+
     /// Wavelength `i`, nm (`i = 0` is the hero).
     #[must_use]
     pub fn nm(&self, i: usize) -> f32 {
@@ -238,6 +257,22 @@ impl SampledWavelengths {
         let norm = 1.0 / (N_WAVELENGTHS as f32 * table.y_integral);
         xyz.map(|v| v * norm)
     }
+}
+
+/// The XYZ that the film's XYZ → linear sRGB matrix maps to R = G = B = 1: the sRGB white, refined
+/// by fixed-point steps so the round trip through the two four-digit matrices is exact to f32.
+fn grey_white_xyz() -> [f32; 3] {
+    use skin_optics::color::{LinearSrgb, Xyz};
+    static W: OnceLock<[f32; 3]> = OnceLock::new();
+    *W.get_or_init(|| {
+        let mut w = LinearSrgb([1.0; 3]).to_xyz().0;
+        for _ in 0..4 {
+            let rgb = Xyz(w).to_linear_srgb().0;
+            let fix = LinearSrgb(rgb.map(|c| c - 1.0)).to_xyz().0;
+            w = std::array::from_fn(|i| w[i] - fix[i]);
+        }
+        w.map(|v| v as f32)
+    })
 }
 
 /// CIE 1931 x̄ȳz̄ re-tabulated in f32 at 1 nm over 380–780 nm from `skin_optics::color`.

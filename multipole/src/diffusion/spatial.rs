@@ -43,6 +43,10 @@ pub struct ProfileOptions {
     /// rows between two shape wavelengths mix their unit-energy shapes linearly in λ, each row
     /// scaled to its own exact total.
     pub shape_step_nm: f64,
+    /// Henyey–Greenstein anisotropy g of both skin layers for `Method::Exact` (default
+    /// [`crate::DEFAULT_G`] = 0.9; [0, 0.99], adding-doubling's range): σs = σs'/(1 − g), the
+    /// totals and the exact shapes are computed at this g (diffusion sees only σs').
+    pub phase_g: f64,
 }
 
 impl Default for ProfileOptions {
@@ -57,6 +61,7 @@ impl Default for ProfileOptions {
             transform_tolerance: 1e-5,
             exact_shape: ExactShape::default(),
             shape_step_nm: 10.0,
+            phase_g: crate::DEFAULT_G,
         }
     }
 }
@@ -85,6 +90,7 @@ impl ProfileOptions {
                 Err(MultipoleError::InvalidOption { name, value, range })
             }
         };
+        opt("phase_g", self.phase_g, 0.0, 0.99, "[0, 0.99]")?;
         opt(
             "shape_step_nm",
             self.shape_step_nm,

@@ -75,11 +75,25 @@ pub fn total_reflectance(
     lambda: Wavelength,
     method: Method,
 ) -> Result<f64, MultipoleError> {
+    total_reflectance_at_g(skin, lambda, method, DEFAULT_G)
+}
+
+/// [`total_reflectance`] with both layers' Henyey–Greenstein anisotropy `g` in [0, 0.99]
+/// (`Method::Exact`: adding-doubling at that g; diffusion depends on σs' only).
+pub fn total_reflectance_at_g(
+    skin: &SkinParams,
+    lambda: Wavelength,
+    method: Method,
+    g: f64,
+) -> Result<f64, MultipoleError> {
     match method {
         Method::Exact => Ok(crate::exact::adding_doubling::skin_total_reflectance(
             skin,
             lambda,
-            &crate::exact::adding_doubling::AddingDoublingOptions::default(),
+            &crate::exact::adding_doubling::AddingDoublingOptions::new(
+                crate::exact::adding_doubling::DEFAULT_QUADRATURE_POINTS,
+                g,
+            )?,
         )?),
         Method::Multipole => Ok(stack(skin, lambda)?.total_reflectance(Poles::Exact)),
     }
@@ -134,7 +148,7 @@ impl SpectralProfiles {
         let lambdas: Vec<Wavelength> = grid.iter().collect();
         let profiles = match (method, opts.exact_shape) {
             (Method::Exact, ExactShape::MonteCarlo { escapes }) => {
-                monte_carlo_rows(skin, grid, escapes, opts.shape_step_nm)?
+                monte_carlo_rows(skin, grid, escapes, opts.shape_step_nm, opts.phase_g)?
             }
             _ => lambdas
                 .par_iter()
@@ -172,11 +186,12 @@ fn monte_carlo_rows(
     grid: &WavelengthGrid,
     escapes: u64,
     step_nm: f64,
+    g: f64,
 ) -> Result<Vec<Profile>, MultipoleError> {
     let n = grid.len();
     let totals = (0..n)
         .into_par_iter()
-        .map(|i| total_reflectance(skin, grid.wavelength(i), Method::Exact))
+        .map(|i| total_reflectance_at_g(skin, grid.wavelength(i), Method::Exact, g))
         .collect::<Result<Vec<_>, _>>()?;
     let stride = ((step_nm / grid.step_nm()).round() as usize).max(1);
     let mut anchors: Vec<usize> = (0..n).step_by(stride).collect();
@@ -185,7 +200,7 @@ fn monte_carlo_rows(
     }
     let shapes = anchors
         .par_iter()
-        .map(|&i| monte_carlo_shape(skin, grid.wavelength(i), escapes, totals[i]))
+        .map(|&i| monte_carlo_shape(skin, grid.wavelength(i), g, escapes, totals[i]))
         .collect::<Result<Vec<_>, _>>()?;
     (0..n)
         .map(|i| {

@@ -2,7 +2,7 @@
 //! shape either from diffusion (rescaled as a whole or per layer) or from the layered Monte Carlo
 //! (exact transport, cached per material by whoever tabulates it, e.g. the renderer's tables).
 
-use super::{Method, stack, total_reflectance};
+use super::{Method, stack, total_reflectance_at_g};
 use crate::diffusion::boundary::observable_reflectance;
 use crate::diffusion::profile::Profile;
 use crate::diffusion::slab::Poles;
@@ -11,7 +11,7 @@ use crate::diffusion::stack::Response;
 use crate::error::MultipoleError;
 use crate::exact::adding_doubling::{AddingDoublingOptions, LayerTotals, skin_layer_totals};
 use crate::exact::montecarlo::{self, McOptions, RadialGrid};
-use crate::layered::{DEFAULT_G, LayeredMedium};
+use crate::layered::LayeredMedium;
 use skin_optics::{SkinParams, Wavelength};
 
 /// Escaping photons per wavelength of the default Monte Carlo shape (the accuracy knob: the
@@ -123,10 +123,11 @@ pub fn exact_profile(
     shape: ExactShape,
     opts: &ProfileOptions,
 ) -> Result<Profile, MultipoleError> {
+    let g = opts.phase_g;
     let (table, total) = match shape {
         ExactShape::RescaledTotal => (
             stack_profile(&stack(skin, lambda)?, opts)?,
-            total_reflectance(skin, lambda, Method::Exact)?,
+            total_reflectance_at_g(skin, lambda, Method::Exact, g)?,
         ),
         ExactShape::PerLayer => {
             let (scales, exact) = layer_scales(skin, lambda)?;
@@ -134,16 +135,16 @@ pub fn exact_profile(
             (stack_profile(&st, opts)?, exact.total)
         }
         ExactShape::MonteCarlo { escapes } => {
-            let total = total_reflectance(skin, lambda, Method::Exact)?;
-            return shape_profile(&monte_carlo_shape(skin, lambda, escapes, total)?, total);
+            let total = total_reflectance_at_g(skin, lambda, Method::Exact, g)?;
+            return shape_profile(&monte_carlo_shape(skin, lambda, g, escapes, total)?, total);
         }
         ExactShape::Table(table_opts) => {
-            let total = total_reflectance(skin, lambda, Method::Exact)?;
-            if let Some(p) = table_profile(skin, lambda, &table_opts, total)? {
+            let total = total_reflectance_at_g(skin, lambda, Method::Exact, g)?;
+            if let Some(p) = table_profile(skin, lambda, g, &table_opts, total)? {
                 return Ok(p);
             }
             let escapes = DEFAULT_SHAPE_ESCAPES;
-            return shape_profile(&monte_carlo_shape(skin, lambda, escapes, total)?, total);
+            return shape_profile(&monte_carlo_shape(skin, lambda, g, escapes, total)?, total);
         }
     };
     rescale(&table, total)
@@ -174,12 +175,13 @@ pub fn shape_photons(escapes: u64, total: f64, eta: f64) -> u64 {
     ((escapes as f64 / escaping_fraction).ceil() as u64).clamp(escapes, cap)
 }
 
-/// The Monte Carlo R(r) of `skin` at `lambda` on the shape grid (one value per annulus, its mean,
-/// mm⁻²), normalised to unit energy in the trapezoid rule of [`Profile`] on the annuli's
-/// representative radii; `total` (exact, per unit flux entering) sets the photon count.
+/// The Monte Carlo R(r) of `skin` at `lambda` with HG anisotropy `g` on the shape grid (one value
+/// per annulus, its mean, mm⁻²), normalised to unit energy in the trapezoid rule of [`Profile`] on
+/// the annuli's representative radii; `total` (exact, per unit flux entering) sets the photon count.
 pub fn monte_carlo_shape(
     skin: &SkinParams,
     lambda: Wavelength,
+    g: f64,
     escapes: u64,
     total: f64,
 ) -> Result<Vec<f64>, MultipoleError> {
@@ -190,7 +192,7 @@ pub fn monte_carlo_shape(
             range: "[100, 1e12]",
         });
     }
-    let stack = LayeredMedium::skin(skin, lambda, DEFAULT_G)?;
+    let stack = LayeredMedium::skin(skin, lambda, g)?;
     let grid = shape_grid()?;
     let photons = shape_photons(escapes, total, skin.eta());
     let opts = McOptions::new(photons, 8, SHAPE_SEED)?.with_grid(grid);
@@ -224,15 +226,17 @@ pub fn shape_radii() -> Result<Vec<f64>, MultipoleError> {
         .collect())
 }
 
-/// The [`ExactShape::Table`] profile of `skin` at `lambda` scaled to `total`, or `None` where the
-/// table does not cover the skin.
+/// The [`ExactShape::Table`] profile of `skin` at `lambda` with HG anisotropy `g` (the table of
+/// that g, built once and cached) scaled to `total`, or `None` where the table does not cover the
+/// skin.
 pub fn table_profile(
     skin: &SkinParams,
     lambda: Wavelength,
+    g: f64,
     opts: &super::ShapeTableOptions,
     total: f64,
 ) -> Result<Option<Profile>, MultipoleError> {
-    medium_table_profile(&LayeredMedium::skin(skin, lambda, DEFAULT_G)?, opts, total)
+    medium_table_profile(&LayeredMedium::skin(skin, lambda, g)?, opts, total)
 }
 
 /// The table profile of a two-layer `medium` scaled to `total`: `None` unless it is a slab over a

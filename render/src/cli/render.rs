@@ -101,6 +101,31 @@ pub struct RenderArgs {
     /// shapes, level of detail, BSSRDF or volumetric, cache).
     #[arg(long)]
     pub explain: bool,
+    /// How skin's body is rendered: bssrdf (the separable BSSRDF, fast) or volumetric (an
+    /// unbiased random walk through the two layers inside each closed skin mesh: the reference).
+    #[arg(long, value_name = "KIND", value_enum, default_value_t = Integrator::Bssrdf)]
+    pub integrator: Integrator,
+    /// Render one wavelength, nm, in [380, 780]: the EXR holds the spectral radiance there as a
+    /// grey (R = G = B), in the scene's emission units.
+    #[arg(long, value_name = "NM", value_parser = Checked(parse_wavelength), allow_hyphen_values = true)]
+    pub wavelength: Option<f32>,
+}
+
+/// The integrator of skin's body (`--integrator`).
+#[derive(clap::ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Integrator {
+    /// The separable BSSRDF (`render::bssrdf`).
+    Bssrdf,
+    /// The volumetric random walk (`render::volumetric`).
+    Volumetric,
+}
+
+fn parse_wavelength(s: &str) -> Result<f32, String> {
+    let v = parse_number(s, "[380, 780] nm")?;
+    if !(380.0..=780.0).contains(&v) {
+        return Err(format!("{} outside [380, 780] nm", Num(v)));
+    }
+    Ok(v as f32)
 }
 
 /// Run `skin render`.
@@ -125,6 +150,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
             ..Default::default()
         },
         progress: !args.quiet,
+        wavelength_nm: args.wavelength,
         ..Default::default()
     };
     options.clone().validate().map_err(flag_error)?;
@@ -146,15 +172,22 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
             anyhow::anyhow!("--out {}: not a writable folder ({e})", args.out.display())
         })?;
     let t0 = Instant::now();
-    let scene = Scene::load(
+    if args.integrator == Integrator::Volumetric && args.no_subsurface {
+        anyhow::bail!("--integrator volumetric renders the subsurface: drop --no-subsurface");
+    }
+    let mut scene = Scene::load(
         &args.scene,
         &SceneOptions {
             method: args.method,
             no_subsurface: args.no_subsurface,
             shape_escapes: args.shape_escapes,
             fidelity,
+            ..SceneOptions::default()
         },
     )?;
+    if args.integrator == Integrator::Volumetric {
+        scene.use_volumetric()?;
+    }
     let load = t0.elapsed();
     crate::fidelity::explain::report(&scene, args.explain);
     // The level of detail needs the pixel footprint: the camera's pixel angle at this height.
@@ -219,6 +252,7 @@ fn flag_error(e: SettingError) -> anyhow::Error {
         "noise" => "--noise",
         "threads" => "--threads",
         "path.max_depth" => "--max-depth",
+        "wavelength_nm" => "--wavelength",
         other => other,
     };
     anyhow::anyhow!("{flag} = {} outside {}", e.value, e.range)

@@ -19,14 +19,20 @@ struct Stored {
     wavelengths: WavelengthChoice,
 }
 
-/// The table options of `resolved` at wavelength step `step_nm`.
-fn table_options(resolved: &Resolved, shape_escapes: Option<u64>, step_nm: f64) -> TableOptions {
+/// The table options of `resolved` at wavelength step `step_nm` and phase `phase_g`.
+fn table_options(
+    resolved: &Resolved,
+    shape_escapes: Option<u64>,
+    phase_g: f64,
+    step_nm: f64,
+) -> TableOptions {
     let mut opts = TableOptions {
         step_nm,
         energy_tolerance: resolved.energy_tolerance,
         radial_error: resolved.radial_error,
         ..TableOptions::default()
     };
+    opts.profile.phase_g = phase_g;
     if let Some(escapes) = shape_escapes {
         opts.profile.exact_shape = ExactShape::MonteCarlo { escapes };
     }
@@ -44,11 +50,12 @@ fn key(params: &SkinParams, method: Method, opts: &TableOptions, resolved: &Reso
 }
 
 /// Build (or read from the cache) the profile table of `params` with `method`, the shape knob
-/// and the fidelity `knobs`, and record the choices.
+/// the layers' Henyey–Greenstein `phase_g` and the fidelity `knobs`, and record the choices.
 pub fn skin_table(
     params: &SkinParams,
     method: Method,
     shape_escapes: Option<u64>,
+    phase_g: f64,
     knobs: &FidelityKnobs,
 ) -> Result<(ProfileTable, SkinChoices), MultipoleError> {
     let t0 = Instant::now();
@@ -58,7 +65,7 @@ pub fn skin_table(
         range: e.range,
     })?;
     // The key holds the options before the wavelength choice (the choice is part of the value).
-    let probe = table_options(&resolved, shape_escapes, 10.0);
+    let probe = table_options(&resolved, shape_escapes, phase_g, 10.0);
     let key = key(params, method, &probe, &resolved);
     let dir = knobs
         .cache
@@ -73,11 +80,12 @@ pub fn skin_table(
                     nodes: ((wavelengths::TO_NM - wavelengths::FROM_NM) / step_nm) as usize + 1,
                     delta_e: None,
                 },
-                StepChoice::Colour { max_delta_e } => {
-                    wavelengths::choose_step(&wavelengths::totals_1nm(params, method)?, max_delta_e)
-                }
+                StepChoice::Colour { max_delta_e } => wavelengths::choose_step(
+                    &wavelengths::totals_1nm(params, method, phase_g)?,
+                    max_delta_e,
+                ),
             };
-            let opts = table_options(&resolved, shape_escapes, wavelengths.step_nm);
+            let opts = table_options(&resolved, shape_escapes, phase_g, wavelengths.step_nm);
             let table = ProfileTable::build(params, method, &opts)?;
             Ok::<_, MultipoleError>(Stored { table, wavelengths })
         })?;
@@ -141,13 +149,14 @@ mod tests {
             ..FidelityKnobs::default()
         };
         let resolved = knobs.resolve().unwrap();
-        let probe = table_options(&resolved, None, 10.0);
+        let probe = table_options(&resolved, None, multipole::DEFAULT_G, 10.0);
         let k = key(params, Method::Exact, &probe, &resolved);
         let build = || {
             let (t, c) = skin_table(
                 params,
                 Method::Exact,
                 None,
+                multipole::DEFAULT_G,
                 &FidelityKnobs {
                     cache: false,
                     ..knobs

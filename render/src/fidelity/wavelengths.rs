@@ -31,14 +31,18 @@ pub struct WavelengthChoice {
 }
 
 /// R_tot of `skin` with `method` at every nm from [`FROM_NM`] to [`TO_NM`] (in parallel).
-pub fn totals_1nm(skin: &SkinParams, method: Method) -> Result<Vec<f64>, MultipoleError> {
+pub fn totals_1nm(
+    skin: &SkinParams,
+    method: Method,
+    phase_g: f64,
+) -> Result<Vec<f64>, MultipoleError> {
     (0..=(TO_NM - FROM_NM) as usize)
         .into_par_iter()
         .map(|i| {
             let lambda = Wavelength::new(FROM_NM + i as f64).map_err(|_| {
                 MultipoleError::Profile("table wavelength outside the model's range")
             })?;
-            multipole::skin::total_reflectance(skin, lambda, method)
+            multipole::skin::total_reflectance_at_g(skin, lambda, method, phase_g)
         })
         .collect()
 }
@@ -91,7 +95,7 @@ mod tests {
         for method in [Method::Exact, Method::Multipole] {
             for preset in Preset::ALL {
                 let skin = SkinParams::preset(preset);
-                let fine = totals_1nm(&skin, method).unwrap();
+                let fine = totals_1nm(&skin, method, multipole::DEFAULT_G).unwrap();
                 let c = choose_step(&fine, 0.5);
                 let de = c.delta_e.unwrap();
                 assert!(de <= 0.5, "{preset:?} {method}: {c:?}");

@@ -29,13 +29,18 @@
 
 use crate::spectrum::{SampledSpectrum, SampledWavelengths, SpectrumTable, linear_srgb_at_nm};
 use crate::texture::Texture;
-use brdf::{Frame, TorranceSparrow};
+use brdf::Frame;
+#[cfg(test)]
+use brdf::TorranceSparrow;
 use glam::{Vec2, Vec3};
 use std::f32::consts::FRAC_1_PI;
 
 mod skin;
+mod surface;
 
 pub use skin::{SKIN_TABLE_STEP_NM, SkinBuildError, SkinKnobs, SkinMaterial};
+use surface::Surface;
+pub use surface::SurfaceKind;
 
 /// An albedo texture used by a material.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -75,7 +80,7 @@ pub struct Bsdf<'a> {
 #[derive(Debug, Clone)]
 enum Lobes<'a> {
     Skin {
-        surface: &'a TorranceSparrow,
+        surface: Surface<'a>,
         /// R_d(λ) m(uv) / (π T̄).
         body: SampledSpectrum,
     },
@@ -86,7 +91,7 @@ enum Lobes<'a> {
     /// Skin whose body is rendered by the BSSRDF: only the surface lobe is a BSDF here; the
     /// integrator takes the subsurface branch with probability 1 − p (`subsurface_probability`).
     SkinSurface {
-        surface: &'a TorranceSparrow,
+        surface: Surface<'a>,
         /// Mean over the path's wavelengths of R_tot(λ) m(uv), for choosing the branch.
         subsurface_albedo: f32,
     },
@@ -99,8 +104,11 @@ pub struct BsdfSample {
     pub wi: Vec3,
     /// f(ωo, ωi) per wavelength, sr⁻¹.
     pub f: SampledSpectrum,
-    /// Density of ωi, sr⁻¹.
+    /// Density of ωi, sr⁻¹; for a delta lobe (`delta`), the probability of choosing it, and `f`
+    /// is then the lobe's weight divided by |cos θ_i|, so f |cos θ_i| / pdf is still the throughput.
     pub pdf: f32,
+    /// True for the mirror reflection of a smooth surface (no density: no light sampling, no MIS).
+    pub delta: bool,
 }
 
 impl Material {
@@ -132,7 +140,7 @@ impl Material {
             Material::Skin(s) if s.subsurface.is_some() && !collapsed => {
                 let m = s.texture_factor(uv, textures);
                 Lobes::SkinSurface {
-                    surface: &s.surface,
+                    surface: Surface::of(s),
                     subsurface_albedo: (s.total_reflectance.eval(wl).average() * m).min(1.0),
                 }
             }
@@ -140,7 +148,7 @@ impl Material {
                 let m = s.texture_factor(uv, textures);
                 let rd = s.total_reflectance.eval(wl).map(|r| (r * m).min(1.0));
                 Lobes::Skin {
-                    surface: &s.surface,
+                    surface: Surface::of(s),
                     body: rd * (FRAC_1_PI / s.mean_transmitted),
                 }
             }
@@ -172,7 +180,7 @@ impl Bsdf<'_> {
         }
         match &self.lobes {
             Lobes::Skin { surface, body } => {
-                let split = surface.transmitted_fraction(i.z) * surface.transmitted_fraction(o.z);
+                let split = surface.transmitted(i.z) * surface.transmitted(o.z);
                 *body * split + SampledSpectrum::splat(surface.eval(o, i))
             }
             Lobes::Lambert { body } => *body,
@@ -196,8 +204,8 @@ impl Bsdf<'_> {
     fn specular_probability(&self, o_z: f32) -> f32 {
         match &self.lobes {
             Lobes::Skin { surface, body } => {
-                let s = surface.directional_albedo(o_z);
-                let d = body.average() * std::f32::consts::PI * surface.transmitted_fraction(o_z);
+                let s = surface.albedo(o_z);
+                let d = body.average() * std::f32::consts::PI * surface.transmitted(o_z);
                 if s <= 0.0 {
                     0.0
                 } else if d <= 0.0 {
@@ -210,8 +218,8 @@ impl Bsdf<'_> {
                 surface,
                 subsurface_albedo,
             } => {
-                let s = surface.directional_albedo(o_z);
-                let d = subsurface_albedo * surface.transmitted_fraction(o_z);
+                let s = surface.albedo(o_z);
+                let d = subsurface_albedo * surface.transmitted(o_z);
                 if s <= 0.0 {
                     0.05
                 } else if d <= 0.0 {
@@ -249,11 +257,27 @@ impl Bsdf<'_> {
             return None;
         }
         let p = self.specular_probability(o.z);
-        let i = match &self.lobes {
-            Lobes::Skin { surface, .. } if u_lobe < p => surface.sample(o, [u.x, u.y])?.wi,
+        let surface = match &self.lobes {
+            Lobes::Skin { surface, .. } if u_lobe < p => Some(surface),
             // The integrator already chose the surface branch (with probability p).
-            Lobes::SkinSurface { surface, .. } => surface.sample(o, [u.x, u.y])?.wi,
-            _ => crate::sampling::cosine_hemisphere(u),
+            Lobes::SkinSurface { surface, .. } => Some(surface),
+            _ => None,
+        };
+        if let Some(Surface::Smooth { eta }) = surface {
+            // Mirror reflection with the Fresnel weight, chosen with probability p (by `u_lobe`
+            // for `Lobes::Skin`, by the integrator's branch for `SkinSurface`).
+            let i = Vec3::new(-o.x, -o.y, o.z);
+            let fresnel = brdf::fresnel::dielectric_reflectance_f32(o.z, *eta);
+            return Some(BsdfSample {
+                wi: self.frame.to_world(i),
+                f: SampledSpectrum::splat(fresnel / o.z),
+                pdf: p,
+                delta: true,
+            });
+        }
+        let i = match surface {
+            Some(s) => s.sample(o, [u.x, u.y])?,
+            None => crate::sampling::cosine_hemisphere(u),
         };
         if i.z <= 0.0 {
             return None;
@@ -264,6 +288,7 @@ impl Bsdf<'_> {
             wi,
             f: self.eval(wo, wi),
             pdf,
+            delta: false,
         })
     }
 }

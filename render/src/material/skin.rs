@@ -9,7 +9,7 @@
 //! on the same 10-nm grid.
 
 use crate::bssrdf::{Directional, EnergySplit, Subsurface};
-use crate::material::TextureRef;
+use crate::material::{SurfaceKind, TextureRef};
 use crate::spectrum::SpectrumTable;
 use crate::texture::{Texture, luminance};
 use brdf::TorranceSparrow;
@@ -38,6 +38,11 @@ pub struct SkinKnobs {
     pub shape_escapes: Option<u64>,
     /// The fidelity of the tables and of the shading (default auto; `crate::fidelity`).
     pub fidelity: crate::fidelity::FidelityKnobs,
+    /// Henyey–Greenstein g of the skin's layers (scene key `phase_g`; `None` = 0.9,
+    /// `multipole::DEFAULT_G`): the totals and shapes come from exact transport at this g.
+    pub phase_g: Option<f64>,
+    /// The surface model (scene key `surface`; default oily).
+    pub surface: SurfaceKind,
 }
 
 /// Why a skin material could not be built.
@@ -83,6 +88,10 @@ pub struct SkinMaterial {
     pub subsurface: Option<Subsurface>,
     /// What the fidelity chose for this skin's tables (`None` without a BSSRDF).
     pub choices: Option<Box<crate::fidelity::SkinChoices>>,
+    /// The surface model: the oily lobe `surface`, or a smooth dielectric of index `surface.eta()`.
+    pub surface_kind: SurfaceKind,
+    /// Henyey–Greenstein g of both layers (what the totals, the shapes and the volumetric walk use).
+    pub phase_g: f64,
 }
 
 impl SkinMaterial {
@@ -97,14 +106,17 @@ impl SkinMaterial {
     ) -> Result<Self, SkinBuildError> {
         let surface =
             TorranceSparrow::new(roughness_m, params.oiliness() as f32, params.eta() as f32)?;
+        let g = knobs.phase_g.unwrap_or(multipole::DEFAULT_G);
         if knobs.no_subsurface {
-            let totals = total_table(&params, knobs.method)?;
-            return Ok(Self::new(params, surface, totals, albedo_texture));
+            let totals = total_table(&params, knobs.method, g)?;
+            return Ok(Self::new(params, surface, totals, albedo_texture)
+                .with_surface_kind(knobs.surface, g));
         }
         let (table, choices) = crate::fidelity::tables::skin_table(
             &params,
             knobs.method,
             knobs.shape_escapes,
+            g,
             &knobs.fidelity,
         )
         .map_err(SkinBuildError::Profiles)?;
@@ -116,10 +128,15 @@ impl SkinMaterial {
             return Err(SkinBuildError::OutOfRange(bad));
         }
         let totals = SpectrumTable::from_fn(|nm| f64::from(table.total(nm as f32)));
-        let directional = Directional::new(surface.clone(), EnergySplit::default());
+        let split = match knobs.surface {
+            SurfaceKind::Oily => EnergySplit::SpecularLobe,
+            SurfaceKind::Smooth => EnergySplit::Fresnel,
+        };
+        let directional = Directional::new(surface.clone(), split);
         let subsurface = Subsurface::new(Arc::new(table), directional);
-        let mut skin =
-            Self::new(params, surface, totals, albedo_texture).with_subsurface(subsurface);
+        let mut skin = Self::new(params, surface, totals, albedo_texture)
+            .with_surface_kind(knobs.surface, g)
+            .with_subsurface(subsurface);
         skin.choices = Some(Box::new(choices));
         Ok(skin)
     }
@@ -148,7 +165,28 @@ impl SkinMaterial {
             mean_transmitted,
             subsurface: None,
             choices: None,
+            surface_kind: SurfaceKind::Oily,
+            phase_g: multipole::DEFAULT_G,
         }
+    }
+
+    /// The same skin with surface model `kind` and layer anisotropy `phase_g` (T̄ recomputed for
+    /// the smooth surface's Fresnel split, T = 1 − F(θ)).
+    #[must_use]
+    pub fn with_surface_kind(mut self, kind: SurfaceKind, phase_g: f64) -> Self {
+        self.surface_kind = kind;
+        self.phase_g = phase_g;
+        if kind == SurfaceKind::Smooth {
+            let eta = self.surface.eta();
+            let n = 256;
+            self.mean_transmitted = (0..n)
+                .map(|i| {
+                    let mu = (i as f32 + 0.5) / n as f32;
+                    (1.0 - brdf::fresnel::dielectric_reflectance_f32(mu, eta)) * 2.0 * mu / n as f32
+                })
+                .sum();
+        }
+        self
     }
 
     /// The same skin shading its body with the BSSRDF `subsurface` instead of the Lambertian term.
@@ -173,11 +211,12 @@ impl SkinMaterial {
     }
 }
 
-/// R_tot(λ) of `params` with `method` at [`SKIN_TABLE_STEP_NM`] steps over 380–780 nm, computed in
+/// R_tot(λ) of `params` with `method` and HG anisotropy `g` at [`SKIN_TABLE_STEP_NM`] steps over 380–780 nm, computed in
 /// parallel and interpolated linearly.
 fn total_table(
     params: &SkinParams,
     method: multipole::Method,
+    g: f64,
 ) -> Result<SpectrumTable, SkinBuildError> {
     let n = ((780.0 - 380.0) / SKIN_TABLE_STEP_NM) as usize + 1;
     let rd = (0..n)
@@ -186,7 +225,7 @@ fn total_table(
             let nm = 380.0 + SKIN_TABLE_STEP_NM * i as f64;
             let lambda =
                 Wavelength::new(nm).map_err(|e| SkinBuildError::Wavelength(e.to_string()))?;
-            multipole::skin::total_reflectance(params, lambda, method)
+            multipole::skin::total_reflectance_at_g(params, lambda, method, g)
                 .map_err(|source| SkinBuildError::Reflectance { nm, source })
         })
         .collect::<Result<Vec<f64>, _>>()?;

@@ -274,6 +274,7 @@ impl Loader<'_> {
             textures,
             geometry: Geometry::new(meshes),
             exposure_stops: desc.film.exposure_stops,
+            volumetric: None,
         })
     }
 
@@ -413,9 +414,34 @@ impl Loader<'_> {
     }
 
     fn environment(&self, e: &EnvironmentDesc) -> Result<Environment, RenderError> {
+        let intensity = match (e.intensity, e.spectral_radiance) {
+            (Some(_), Some(_)) => {
+                return Err(self.err(
+                    "environment.spectral_radiance",
+                    "give either intensity or spectral_radiance, not both",
+                ));
+            }
+            (None, Some(x)) => {
+                if e.exr.is_some() || e.spectrum.is_some() || e.temperature_k.is_some() {
+                    return Err(self.err(
+                        "environment.spectral_radiance",
+                        "a constant spectral radiance takes no exr, spectrum or temperature_k",
+                    ));
+                }
+                let x = self.intensity("environment.spectral_radiance", x)?;
+                return Ok(Environment::Constant(SpectrumTable::constant(x)));
+            }
+            (Some(i), None) => i,
+            (None, None) => {
+                return Err(self.err(
+                    "environment.intensity",
+                    "expected intensity (or spectral_radiance)",
+                ));
+            }
+        };
         match &e.exr {
             Some(file) => {
-                let scale = self.intensity("environment.intensity", e.intensity)?;
+                let scale = self.intensity("environment.intensity", intensity)?;
                 let (bytes, path) = self.read(input::ENVIRONMENT, file)?;
                 Ok(Environment::LatLong {
                     map: Texture::from_exr_bytes(&bytes, &path)?,
@@ -426,7 +452,7 @@ impl Loader<'_> {
                 "environment",
                 e.spectrum,
                 e.temperature_k,
-                e.intensity,
+                intensity,
             )?)),
         }
     }

@@ -6,11 +6,12 @@ use super::load::Loader;
 use crate::error::RenderError;
 use crate::fidelity::{FidelityKnobs, LodBand, LodSetting};
 use crate::material::{
-    DiffuseMaterial, Material, SkinBuildError, SkinKnobs, SkinMaterial, TextureRef,
+    DiffuseMaterial, Material, SkinBuildError, SkinKnobs, SkinMaterial, SurfaceKind, TextureRef,
 };
 use crate::scene_file::{FidelityDesc, LodDesc, MaterialDesc};
 use crate::spectrum::{SpectrumTable, linear_srgb_to_spectrum};
 use crate::texture::{Texture, luminance};
+use skin_optics::echo::Num;
 use skin_optics::measured::named_skin;
 use skin_optics::{Preset, SkinParams};
 use std::collections::{BTreeMap, HashMap};
@@ -58,6 +59,8 @@ impl Loader<'_> {
                     oil,
                     roughness,
                     albedo_texture,
+                    phase_g,
+                    surface,
                 } => {
                     let params =
                         self.skin_params(&key, preset, [*melanin, *eumelanin, *hemoglobin, *oil])?;
@@ -66,8 +69,9 @@ impl Loader<'_> {
                         |e: brdf::BrdfError| self.err(format!("{key}.roughness"), e.to_string());
                     brdf::check_roughness(m_rough).map_err(rough_err)?;
                     let tex = texture(albedo_texture)?;
+                    let knobs = self.skin_knobs(knobs, &key, *phase_g, surface.as_deref())?;
                     let skin =
-                        SkinMaterial::build(params, m_rough, tex, knobs).map_err(|e| match e {
+                        SkinMaterial::build(params, m_rough, tex, &knobs).map_err(|e| match e {
                             SkinBuildError::Surface(e) => rough_err(e),
                             other => self.err(&key, other.to_string()),
                         })?;
@@ -161,6 +165,32 @@ impl Loader<'_> {
         knobs
             .resolve()
             .map_err(|e| self.err(e.name, format!("{} outside {}", e.value, e.range)))?;
+        Ok(knobs)
+    }
+
+    /// The scene's skin knobs with this material's `phase_g` and `surface` keys applied.
+    fn skin_knobs(
+        &self,
+        base: &SkinKnobs,
+        key: &str,
+        phase_g: Option<f64>,
+        surface: Option<&str>,
+    ) -> Result<SkinKnobs, RenderError> {
+        let mut knobs = *base;
+        if let Some(g) = phase_g {
+            if !(0.0..=0.99).contains(&g) {
+                return Err(self.err(
+                    format!("{key}.phase_g"),
+                    format!("expected a value in [0, 0.99], got {}", Num(g)),
+                ));
+            }
+            knobs.phase_g = Some(g);
+        }
+        if let Some(s) = surface {
+            knobs.surface = s
+                .parse::<SurfaceKind>()
+                .map_err(|e| self.err(format!("{key}.surface"), e))?;
+        }
         Ok(knobs)
     }
 

@@ -57,6 +57,8 @@ pub struct Scene {
     pub geometry: Geometry,
     /// PNG exposure, stops.
     pub exposure_stops: f32,
+    /// The skin media of the volumetric reference integrator (None = skin by its BSSRDF).
+    pub volumetric: Option<crate::volumetric::Volumetric>,
 }
 
 impl Scene {
@@ -99,6 +101,12 @@ impl Scene {
             opts,
         }
         .load(desc)
+    }
+
+    /// Render skin with the volumetric random walk instead of its BSSRDF from now on.
+    pub fn use_volumetric(&mut self) -> Result<(), crate::volumetric::VolumetricError> {
+        self.volumetric = Some(crate::volumetric::Volumetric::build(self)?);
+        Ok(())
     }
 
     /// First thing hit along (`o`, unit `d`) within (`tmin`, `tmax`): triangles and area lights.

@@ -47,6 +47,9 @@ enum Command {
     /// Error against cost (build CPU-s, evaluation ms) for every knob of the exact profile's shape
     /// table, against Monte Carlo references; CSV and PNG into --out.
     TableKnobs(TableKnobArgs),
+    /// The BSSRDF against the volumetric reference in image space: per-pixel error maps, region
+    /// means by shape and skin tone, error against render time (PNG, CSV, render.md) into --out.
+    Render(RenderStudyArgs),
 }
 
 #[derive(Args, Debug)]
@@ -56,6 +59,16 @@ struct TableKnobArgs {
     photons: u64,
     /// Output folder.
     #[arg(long, value_name = "DIR", default_value = "out/table_knobs")]
+    out: PathBuf,
+}
+
+#[derive(Args, Debug)]
+struct RenderStudyArgs {
+    /// Smaller images and sample counts (minutes on two cores).
+    #[arg(long)]
+    quick: bool,
+    /// Output folder.
+    #[arg(long, value_name = "DIR", default_value = "out/render-study")]
     out: PathBuf,
 }
 
@@ -274,6 +287,15 @@ fn main() {
         Some(Command::TableKnobs(args)) => {
             validation::compare::table_knobs::run_table_knobs(args.photons, &args.out)
         }
+        Some(Command::Render(args)) => {
+            use validation::compare::render_study::{RenderStudy, run_render};
+            let study = if args.quick {
+                RenderStudy::QUICK
+            } else {
+                RenderStudy::FULL
+            };
+            run_render(study, &args.out)
+        }
         None => validation::compare::run_comparison(cli.quick, &cli.out),
     };
     if let Err(e) = result {
@@ -373,7 +395,14 @@ fn run_noise_chart(args: &NoiseChartArgs) -> anyhow::Result<()> {
             },
         )?;
         let spp = args.spp.first().copied().unwrap_or(16);
-        noise_chart::breakdown(&mut scene, Some(&lambert), size, spp, args.threads, last.path)?;
+        noise_chart::breakdown(
+            &mut scene,
+            Some(&lambert),
+            size,
+            spp,
+            args.threads,
+            last.path,
+        )?;
         return Ok(());
     }
     noise_chart::run(&scene, size, &args.spp, args.threads, &chosen, &args.out)?;

@@ -18,6 +18,7 @@
 pub mod exact;
 pub mod knobs;
 pub mod profiles;
+pub mod render_study;
 pub mod spectra;
 pub mod stability;
 pub mod table_knobs;

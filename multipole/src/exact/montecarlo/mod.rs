@@ -26,7 +26,7 @@ mod transport;
 pub use crate::layered::{DEFAULT_G, Layer, LayeredMedium};
 pub use tally::{Estimate, McResult, RadialGrid, RadialProfile};
 pub(crate) use transport::white::{WhiteMedium, trace_white};
-pub use transport::{ROULETTE_SURVIVAL, ROULETTE_THRESHOLD};
+pub use transport::{HgSampler, ROULETTE_SURVIVAL, ROULETTE_THRESHOLD, scatter_direction};
 
 use crate::error::MultipoleError;
 use rand::SeedableRng;

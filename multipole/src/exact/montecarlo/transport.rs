@@ -15,7 +15,8 @@ use crate::layered::LayeredMedium;
 use brdf::fresnel::dielectric_reflectance;
 use rand_distr::{Distribution, Exp1};
 use rand_xoshiro::Xoshiro256StarStar;
-use sampling::{HgSampler, scatter, uniform};
+pub use sampling::{HgSampler, scatter_direction};
+use sampling::{scatter, uniform};
 
 /// Russian roulette starts below this weight ([WJZ95] §3.7: 1e-4).
 pub const ROULETTE_THRESHOLD: f64 = 1.0e-4;

@@ -20,7 +20,7 @@ const ONE_BITS: u64 = 0x3ff0_0000_0000_0000;
 /// Henyey–Greenstein cosine sampling ([WJZ95] eq 3.15) with the per-layer constants hoisted:
 /// cos θ = (1 + g² − t²) / (2g), t = (1 − g²) / (1 − g + 2gξ); isotropic (2ξ − 1) when g ≈ 0.
 #[derive(Debug, Clone, Copy)]
-pub(super) struct HgSampler {
+pub struct HgSampler {
     isotropic: bool,
     one_plus_g2: f64,
     one_minus_g2: f64,
@@ -30,7 +30,9 @@ pub(super) struct HgSampler {
 }
 
 impl HgSampler {
-    pub(super) fn new(g: f64) -> Self {
+    /// The sampler of HG anisotropy `g` in (−1, 1) (|g| < 1e-6 samples the isotropic phase).
+    #[must_use]
+    pub fn new(g: f64) -> Self {
         let isotropic = g.abs() < 1.0e-6;
         Self {
             isotropic,
@@ -42,8 +44,10 @@ impl HgSampler {
         }
     }
 
+    /// The scattering cosine for a uniform `xi` in [0, 1) ([WJZ95] eq 3.15).
     #[inline(always)]
-    fn cos_theta(&self, xi: f64) -> f64 {
+    #[must_use]
+    pub fn cos_theta(&self, xi: f64) -> f64 {
         if self.isotropic {
             return 2.0 * xi - 1.0;
         }
@@ -97,6 +101,17 @@ fn cos_sin_small(d: f64) -> (f64, f64) {
         s = s * d2 + S[j];
     }
     (1.0 + d2 * c, d + d * d2 * s)
+}
+
+/// The unit direction `u` = (u_x, u_y, u_z) after one Henyey–Greenstein scattering with `hg`
+/// ([WJZ95] eqs 3.15–3.20): the photon physics of this Monte Carlo, for walks in other geometries
+/// (the renderer's volumetric integrator).
+#[inline]
+pub fn scatter_direction(u: [f64; 3], hg: &HgSampler, rng: &mut impl RngCore) -> [f64; 3] {
+    let mut p = Photon::launched(1.0);
+    (p.ux, p.uy, p.uz) = (u[0], u[1], u[2]);
+    scatter(&mut p, hg, rng);
+    [p.ux, p.uy, p.uz]
 }
 
 /// New direction after a Henyey–Greenstein scattering ([WJZ95] eqs 3.15–3.20).

@@ -1,0 +1,169 @@
+//! One random walk through a skin volume (docs/physics.md §15): delta (Woodcock) tracking against
+//! the majorant σ̄ = max(σt_epidermis, σt_dermis) at the hero wavelength, so the layer boundary
+//! (a distance from the surface, not a plane) is crossed exactly without ever being intersected;
+//! at a real collision the weight keeps σs/σt (implicit capture) and the direction turns by
+//! Henyey–Greenstein — both from `multipole::montecarlo`, the photon physics of the layered Monte
+//! Carlo; below its roulette threshold the walk plays its Russian roulette. At the surface the
+//! walk meets the skin's boundary: total internal reflection beyond the critical angle, else it
+//! leaves with probability T(θ_out) (the same energy split as the BSSRDF's, `Directional`:
+//! 1 − F for the smooth surface, 1 − ρ_dr for the oily lobe), refracted by Snell's law, or is
+//! reflected back in.
+
+use super::SkinVolume;
+use crate::bssrdf::Directional;
+use crate::geometry::offset_origin;
+use crate::scene::Scene;
+use glam::{DVec3, Vec3};
+use multipole::montecarlo::{ROULETTE_SURVIVAL, ROULETTE_THRESHOLD, scatter_direction};
+use rand::{Rng, RngCore};
+
+/// Most real collisions per walk (a bound on the cost; a walk reaching it is dropped, a bias
+/// below 1e-6 of the energy for skin — BENCHMARKS.md).
+pub const MAX_COLLISIONS: u32 = 1_000_000;
+
+/// Where and how a walk left the skin.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Exit {
+    /// Exit point on the surface, mm.
+    pub p: Vec3,
+    /// Geometric normal there, pointing out of the skin.
+    pub ng: Vec3,
+    /// Direction of the light leaving, outside the skin (unit).
+    pub dir: Vec3,
+    /// Throughput of the walk at its wavelength (σs/σt per real collision, roulette gains).
+    pub weight: f32,
+}
+
+/// What happened to a walk, with its event counts (for the statistics).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Walk {
+    /// The exit, or `None` when the light was absorbed (or lost).
+    pub exit: Option<Exit>,
+    /// Real collisions.
+    pub collisions: u32,
+    /// Tentative collisions (real + null).
+    pub tentative: u32,
+}
+
+/// Refraction of unit `d` through a face of unit normal `n` (n · d < 0, n on the incident side)
+/// with relative index `eta` = n_incident / n_transmitted; `None` under total internal reflection.
+#[must_use]
+pub fn refract(d: Vec3, n: Vec3, eta: f32) -> Option<Vec3> {
+    let cos_i = -n.dot(d);
+    let sin2_t = eta * eta * (1.0 - cos_i * cos_i).max(0.0);
+    if sin2_t >= 1.0 {
+        return None;
+    }
+    let cos_t = (1.0 - sin2_t).sqrt();
+    Some((d * eta + n * (eta * cos_i - cos_t)).normalize())
+}
+
+/// Walk light that has just entered the skin volume `vol` (material `material`) at `p` along the
+/// refracted direction `dir` (pointing in), at wavelength `nm`; `rays` counts the rays cast.
+#[allow(clippy::too_many_arguments)] // the walk's medium, start and random state
+pub fn walk<R: RngCore>(
+    scene: &Scene,
+    vol: &SkinVolume,
+    directional: &Directional,
+    p: Vec3,
+    ng_out: Vec3,
+    dir: Vec3,
+    nm: f32,
+    rng: &mut R,
+    rays: &mut u64,
+) -> Walk {
+    let (sa_e, ss_e) = (
+        vol.epidermis.sigma_a.at_nm(nm),
+        vol.epidermis.sigma_s.at_nm(nm),
+    );
+    let (sa_d, ss_d) = (vol.dermis.sigma_a.at_nm(nm), vol.dermis.sigma_s.at_nm(nm));
+    let (st_e, st_d) = (sa_e + ss_e, sa_d + ss_d);
+    let majorant = st_e.max(st_d);
+    let mut out = Walk {
+        exit: None,
+        collisions: 0,
+        tentative: 0,
+    };
+    let mut x = offset_origin(p, -ng_out, dir);
+    let mut d = dir;
+    let mut w = 1.0f64;
+    while out.collisions < MAX_COLLISIONS {
+        *rays += 1;
+        let Some(hit) = scene.geometry.intersect(x, d, 0.0, f32::INFINITY) else {
+            // Not a closed mesh around x: the light is lost.
+            return out;
+        };
+        let mut left = hit.t;
+        let mut scattered = false;
+        while majorant > 0.0 {
+            let step = -(1.0 - rng.random::<f32>()).ln() / majorant;
+            if step >= left {
+                break;
+            }
+            left -= step;
+            x += d * step;
+            out.tentative += 1;
+            let (sa, ss) = if vol.epidermis_region.within(x) {
+                (sa_e, ss_e)
+            } else {
+                (sa_d, ss_d)
+            };
+            if rng.random::<f32>() * majorant >= sa + ss {
+                continue; // null collision
+            }
+            out.collisions += 1;
+            w *= f64::from(ss / (sa + ss));
+            if w == 0.0 {
+                return out;
+            }
+            if w < ROULETTE_THRESHOLD {
+                if rng.random::<f64>() >= ROULETTE_SURVIVAL {
+                    return out;
+                }
+                w /= ROULETTE_SURVIVAL;
+            }
+            let u = scatter_direction(d.as_dvec3().to_array(), &vol.hg, rng);
+            d = DVec3::from_array(u).normalize().as_vec3();
+            scattered = true;
+            break;
+        }
+        if scattered {
+            continue;
+        }
+        // At the surface, from inside.
+        let n_out = if hit.ng.dot(d) > 0.0 { hit.ng } else { -hit.ng };
+        let leaving = refract(d, -n_out, vol.eta);
+        if let Some(t) = leaving {
+            let cos_out = t.dot(n_out);
+            if rng.random::<f32>() < directional.transmittance(cos_out) {
+                out.exit = Some(Exit {
+                    p: hit.p,
+                    ng: n_out,
+                    dir: t,
+                    weight: w as f32,
+                });
+                return out;
+            }
+        }
+        d -= n_out * (2.0 * d.dot(n_out));
+        x = offset_origin(hit.p, -n_out, d);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Snell's law: n₁ sin θ₁ = n₂ sin θ₂, and total internal reflection past the critical angle.
+    #[test]
+    fn refraction_obeys_snell() {
+        let n = Vec3::Z;
+        let d = Vec3::new(0.6, 0.0, -0.8);
+        let t = refract(d, n, 1.0 / 1.4).unwrap();
+        assert!((t.x - 0.6 / 1.4).abs() < 1e-6 && t.z < 0.0, "{t}");
+        assert!(refract(Vec3::new(0.8, 0.0, -0.6), n, 1.4).is_none());
+        let t = refract(Vec3::new(0.6, 0.0, -0.8), n, 1.4).unwrap();
+        assert!((t.x - 0.84).abs() < 1e-6, "{t}");
+    }
+}

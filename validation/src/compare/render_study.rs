@@ -1,0 +1,389 @@
+//! `skin-validate render`: the BSSRDF (`render::bssrdf`) against the volumetric reference
+//! (`render::volumetric`, docs/physics.md §15) in image space.
+//!
+//! Every case is rendered twice with the same seed, camera and lights: by the BSSRDF at
+//! `bssrdf_spp` and by the volumetric walk at `reference_spp`. The per-pixel relative error of the
+//! luminance, (Y_bssrdf − Y_ref) / Y_ref, is drawn as a heat map (PNG) over the skin pixels lit above
+//! 15% of the reference's 95th percentile; the region's mean signed and mean absolute errors go to
+//! `render_cases.csv` with the reference's own noise (standard error of the region mean, from each
+//! pixel's variance pass), so a difference can be told from noise. A case *fails* when
+//! |mean signed error| exceeds 5% and three reference standard errors.
+//!
+//! The error-against-time chart renders one case (the sphere, light skin) with both integrators at
+//! increasing spp, each image's RMS relative error taken against a separate volumetric run at the
+//! largest count, CPU seconds of the process on the x axis.
+
+use anyhow::Context;
+use render::film::Film;
+use render::passes::Passes;
+use render::plot::{HeatMap, LineChart, Panel, Series, SeriesStyle, save_png};
+use render::renderer::{RenderOptions, render};
+use render::scene::{Scene, SceneOptions};
+use render::volumetric::shapes::box_obj;
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// How much each render of the study samples.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RenderStudy {
+    /// Image side, pixels (analytic shapes; the ear and the head use 2× wide images).
+    pub side: usize,
+    /// Samples per pixel of the BSSRDF renders.
+    pub bssrdf_spp: u32,
+    /// Samples per pixel of the volumetric reference.
+    pub reference_spp: u32,
+    /// spp ladder of the error-against-time chart.
+    pub ladder: &'static [u32],
+}
+
+impl RenderStudy {
+    /// Modest counts: minutes on two cores.
+    pub const QUICK: Self = Self {
+        side: 48,
+        bssrdf_spp: 64,
+        reference_spp: 64,
+        ladder: &[1, 4, 16],
+    };
+    /// The counts of BENCHMARKS.md.
+    pub const FULL: Self = Self {
+        side: 64,
+        bssrdf_spp: 256,
+        reference_spp: 256,
+        ladder: &[1, 4, 16, 64],
+    };
+}
+
+/// One scene of the study and where its error is measured.
+struct Case {
+    name: String,
+    tone: &'static str,
+    toml: String,
+    width: usize,
+    height: usize,
+}
+
+const TONES: [&str; 3] = ["light", "medium", "dark"];
+
+/// The analytic cases: a flat slab (central quarter of the view, away from the edges), a 10-mm
+/// sphere, and 1-, 2- and 3-mm slabs lit from behind; each skin tone.
+fn analytic_cases(side: usize, dir: &Path) -> anyhow::Result<Vec<Case>> {
+    let slab = dir.join("slab.obj");
+    std::fs::write(&slab, box_obj([100.0, 100.0, 20.0]))?;
+    let mut cases = Vec::new();
+    for tone in TONES {
+        let skin = format!("[materials.skin]\ntype = \"skin\"\npreset = \"{tone}\"\n");
+        // Flat slab seen from above: 20 mm of its top face fill the view.
+        let slab_toml = format!(
+            "[camera]\nposition_mm = [0, 0, 300]\nlook_at_mm = [0, 0, 0]\nfov_deg = 3.9\n\
+             [environment]\nspectrum = \"d65\"\nintensity = 0.2\n{skin}\
+             [[meshes]]\nfile = \"{}\"\nmaterial = \"skin\"\n\
+             [[lights]]\ntype = \"sphere\"\ncenter_mm = [150, 0, 200]\nradius_mm = 60\nintensity = 3\n",
+            slab.display()
+        );
+        cases.push(case("slab", tone, slab_toml, side));
+        let sphere = format!(
+            "[camera]\nposition_mm = [0, 0, 120]\nlook_at_mm = [0, 0, 0]\nfov_deg = 11\n\
+             [environment]\nspectrum = \"d65\"\nintensity = 0.2\n{skin}\
+             [[meshes]]\nshape = \"sphere\"\nmaterial = \"skin\"\nunits_mm = 10\n\
+             [[lights]]\ntype = \"sphere\"\ncenter_mm = [120, 60, 80]\nradius_mm = 30\nintensity = 12\n"
+        );
+        cases.push(case("sphere r=10 mm", tone, sphere, side));
+        for mm in [1.0f32, 2.0, 3.0] {
+            let file = dir.join(format!("thin{mm}.obj"));
+            std::fs::write(&file, box_obj([60.0, 60.0, mm]))?;
+            // Lit from behind by a large quad; a weak sky from the front.
+            let thin = format!(
+                "[camera]\nposition_mm = [0, 0, 300]\nlook_at_mm = [0, 0, 0]\nfov_deg = 5.7\n\
+                 [environment]\nspectrum = \"d65\"\nintensity = 0.02\n{skin}\
+                 [[meshes]]\nfile = \"{}\"\nmaterial = \"skin\"\n\
+                 [[lights]]\ntype = \"quad\"\ncenter_mm = [0, 0, -60]\nlook_at_mm = [0, 0, 0]\n\
+                 size_mm = [200, 200]\nintensity = 5\n",
+                file.display()
+            );
+            cases.push(case(
+                &format!("thin slab {mm} mm (backlit)"),
+                tone,
+                thin,
+                side,
+            ));
+        }
+    }
+    Ok(cases)
+}
+
+fn case(name: &str, tone: &'static str, toml: String, side: usize) -> Case {
+    Case {
+        name: name.to_string(),
+        tone,
+        toml,
+        width: side,
+        height: side,
+    }
+}
+
+/// The built-in backlit ear in each tone, and the default three-head scene (its three tones).
+fn builtin_cases(side: usize) -> Vec<Case> {
+    let mut cases: Vec<Case> = TONES
+        .iter()
+        .map(|tone| Case {
+            name: "backlit ear".into(),
+            tone,
+            toml: untextured(render::builtin::EAR)
+                .replace("preset = \"light\"", &format!("preset = \"{tone}\"")),
+            width: 2 * side,
+            height: 2 * side,
+        })
+        .collect();
+    cases.push(Case {
+        name: "head, default lights".into(),
+        tone: "all three",
+        toml: untextured(render::builtin::THREE_HEADS),
+        width: 4 * side,
+        height: 2 * side,
+    });
+    cases
+}
+
+/// The scene without skin albedo textures (the volumetric walk has no texture modulation, so both
+/// integrators see the same skin).
+fn untextured(toml: &str) -> String {
+    toml.lines()
+        .filter(|l| !l.trim_start().starts_with("albedo_texture"))
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+/// A render of `scene` and the CPU seconds it took.
+fn timed(scene: &Scene, w: usize, h: usize, spp: u32, seed: u64) -> anyhow::Result<(Film, f64)> {
+    let opts = RenderOptions {
+        width: w,
+        height: h,
+        spp,
+        seed,
+        ..Default::default()
+    };
+    let settings = opts.validate()?;
+    let t0 = cpu_time::ProcessTime::now();
+    let (film, _) = render(scene, &settings)?;
+    Ok((film, t0.elapsed().as_secs_f64()))
+}
+
+fn load(toml: &str, volumetric: bool) -> anyhow::Result<Scene> {
+    let mut scene = Scene::from_toml(toml, "study.toml", None, &SceneOptions::default())?;
+    if volumetric {
+        scene.use_volumetric()?;
+    }
+    Ok(scene)
+}
+
+/// Pixels compared: skin at the first hit, lit above 15% of the reference's 95th percentile.
+fn compared_pixels(reference: &Film, skin: &[f32]) -> Vec<usize> {
+    let (w, h) = reference.size();
+    let y: Vec<f64> = (0..w * h)
+        .map(|i| f64::from(reference.xyz(i % w, i / w)[1]))
+        .collect();
+    let mut sorted: Vec<f64> = y
+        .iter()
+        .zip(skin)
+        .filter(|&(_, &s)| s > 0.5)
+        .map(|(v, _)| *v)
+        .collect();
+    sorted.sort_by(f64::total_cmp);
+    let Some(&p95) = sorted.get(sorted.len() * 95 / 100) else {
+        return Vec::new();
+    };
+    (0..w * h)
+        .filter(|&i| skin[i] > 0.5 && y[i] > 0.15 * p95 && y[i] > 0.0)
+        .collect()
+}
+
+/// Per-pixel relative luminance error of `test` against `reference` (NaN outside `pixels`).
+fn error_map(test: &Film, reference: &Film, pixels: &[usize]) -> Vec<f64> {
+    let (w, h) = reference.size();
+    let mut map = vec![f64::NAN; w * h];
+    for &i in pixels {
+        let (x, y) = (i % w, i / w);
+        let r = f64::from(reference.xyz(x, y)[1]);
+        map[i] = (f64::from(test.xyz(x, y)[1]) - r) / r;
+    }
+    map
+}
+
+/// One row of the case table.
+struct CaseResult {
+    mean_signed: f64,
+    mean_abs: f64,
+    ref_noise: f64,
+    pixels: usize,
+}
+
+fn measure(test: &Film, reference: &Film, pixels: &[usize], map: &[f64]) -> CaseResult {
+    let (w, _) = reference.size();
+    let n = pixels.len().max(1) as f64;
+    let mean_signed = pixels.iter().map(|&i| map[i]).sum::<f64>() / n;
+    let mean_abs = pixels.iter().map(|&i| map[i].abs()).sum::<f64>() / n;
+    // Standard error of the region's mean relative value: √Σ var_i / Y_i² / n.
+    let var: f64 = pixels
+        .iter()
+        .map(|&i| {
+            let y = f64::from(reference.xyz(i % w, i / w)[1]);
+            reference.variance(i % w, i / w) / (y * y)
+        })
+        .sum();
+    let _ = test;
+    CaseResult {
+        mean_signed,
+        mean_abs,
+        ref_noise: var.sqrt() / n,
+        pixels: pixels.len(),
+    }
+}
+
+fn heat(title: &str, film: &Film, map: Vec<f64>) -> Panel {
+    let (w, h) = film.size();
+    // Rows from the top of the image down, y axis upwards: flip so the map is upright.
+    let mut values = Vec::with_capacity(w * h);
+    for y in (0..h).rev() {
+        values.extend_from_slice(&map[y * w..(y + 1) * w]);
+    }
+    Panel::Heat(HeatMap {
+        title: title.to_string(),
+        x_label: "pixel x".into(),
+        y_label: "pixel y (up)".into(),
+        value_label: "(BSSRDF − volumetric) / volumetric".into(),
+        x_range: (0.0, w as f64),
+        y_range: (0.0, h as f64),
+        log_x: false,
+        log_y: false,
+        nx: w,
+        ny: h,
+        values,
+        value_range: Some((-0.5, 0.5)),
+        overlay: Vec::new(),
+    })
+}
+
+/// Run the study into `out`: error maps, `render_cases.csv`, `render_time.csv`, `render_time.png`
+/// and `render.md` (the table).
+pub fn run_render(study: RenderStudy, out: &Path) -> anyhow::Result<()> {
+    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    let meshes = tempfile::tempdir()?;
+    let mut cases = analytic_cases(study.side, meshes.path())?;
+    cases.extend(builtin_cases(study.side));
+    let mut csv = String::from(
+        "case,tone,pixels,mean_signed_error,mean_abs_error,reference_noise,fails,bssrdf_cpu_s,volumetric_cpu_s\n",
+    );
+    let mut table = String::from(
+        "| case | tone | pixels | mean error | mean abs error | reference noise | BSSRDF fails? | CPU s (BSSRDF / volumetric) |\n|---|---|---|---|---|---|---|---|\n",
+    );
+    for (k, c) in cases.iter().enumerate() {
+        eprintln!("[{}/{}] {} ({})", k + 1, cases.len(), c.name, c.tone);
+        let bssrdf = load(&c.toml, false)?;
+        let (test, t_b) = timed(&bssrdf, c.width, c.height, study.bssrdf_spp, 1)?;
+        let vol = load(&c.toml, true)?;
+        let (reference, t_v) = timed(&vol, c.width, c.height, study.reference_spp, 2)?;
+        let skin = Passes::first_hit(&bssrdf, c.width, c.height).skin;
+        let pixels = compared_pixels(&reference, &skin);
+        let map = error_map(&test, &reference, &pixels);
+        let r = measure(&test, &reference, &pixels, &map);
+        let fails = r.mean_signed.abs() > 0.05 && r.mean_signed.abs() > 3.0 * r.ref_noise;
+        let stem: String = format!("{}-{}", c.name, c.tone)
+            .chars()
+            .map(|ch| if ch.is_ascii_alphanumeric() { ch } else { '_' })
+            .collect();
+        let title = format!("{} ({}): BSSRDF vs volumetric", c.name, c.tone);
+        save_png(
+            &out.join(format!("error_{stem}.png")),
+            &[heat(&title, &reference, map)],
+            900,
+            700,
+        )?;
+        let _ = writeln!(
+            csv,
+            "{},{},{},{:.5},{:.5},{:.5},{},{:.2},{:.2}",
+            c.name, c.tone, r.pixels, r.mean_signed, r.mean_abs, r.ref_noise, fails, t_b, t_v
+        );
+        let _ = writeln!(
+            table,
+            "| {} | {} | {} | {:+.1}% | {:.1}% | {:.1}% | {} | {:.1} / {:.1} |",
+            c.name,
+            c.tone,
+            r.pixels,
+            100.0 * r.mean_signed,
+            100.0 * r.mean_abs,
+            100.0 * r.ref_noise,
+            if fails { "**yes**" } else { "no" },
+            t_b,
+            t_v
+        );
+    }
+    render::atomic::write_bytes(&out.join("render_cases.csv"), csv.as_bytes())?;
+    let chart = time_chart(study, &cases[1], out)?;
+    let md = format!(
+        "# BSSRDF against the volumetric reference\n\nspp: BSSRDF {}, volumetric {}; image side {} px.\n\n{table}\n{chart}\n",
+        study.bssrdf_spp, study.reference_spp, study.side
+    );
+    render::atomic::write_bytes(&out.join("render.md"), md.as_bytes())?;
+    println!("{md}");
+    Ok(())
+}
+
+/// RMS relative luminance error of `test` against `reference` over `pixels`.
+fn rms_error(test: &Film, reference: &Film, pixels: &[usize]) -> f64 {
+    let map = error_map(test, reference, pixels);
+    let n = pixels.len().max(1) as f64;
+    (pixels.iter().map(|&i| map[i] * map[i]).sum::<f64>() / n).sqrt()
+}
+
+/// Error against CPU time for both integrators on `case`; returns the markdown lines.
+fn time_chart(study: RenderStudy, case: &Case, out: &Path) -> anyhow::Result<String> {
+    let top = *study.ladder.last().unwrap_or(&16);
+    let vol = load(&case.toml, true)?;
+    let bssrdf = load(&case.toml, false)?;
+    let (reference, t_ref) = timed(&vol, case.width, case.height, 4 * top, 99)?;
+    let skin = Passes::first_hit(&bssrdf, case.width, case.height).skin;
+    let pixels = compared_pixels(&reference, &skin);
+    let mut csv = String::from("integrator,spp,cpu_s,rms_relative_error,paths_per_cpu_s\n");
+    let mut lines = format!(
+        "Error against time ({} {}, reference: volumetric at {} spp, {:.1} CPU s):\n\n| integrator | spp | CPU s | RMS rel. error | camera paths per CPU-s |\n|---|---|---|---|---|\n",
+        case.name,
+        case.tone,
+        4 * top,
+        t_ref
+    );
+    let mut series = Vec::new();
+    for (name, scene) in [("BSSRDF", &bssrdf), ("volumetric", &vol)] {
+        let mut pts = Vec::new();
+        for &spp in study.ladder {
+            let (film, t) = timed(scene, case.width, case.height, spp, 7)?;
+            let e = rms_error(&film, &reference, &pixels);
+            let paths = (case.width * case.height) as f64 * f64::from(spp) / t.max(1e-9);
+            let _ = writeln!(csv, "{name},{spp},{t:.3},{e:.5},{paths:.0}");
+            let _ = writeln!(
+                lines,
+                "| {name} | {spp} | {t:.2} | {:.1}% | {paths:.0} |",
+                100.0 * e
+            );
+            pts.push((t, e));
+        }
+        series.push(Series::line(name, pts).with_style(SeriesStyle::LinePoints));
+    }
+    render::atomic::write_bytes(&out.join("render_time.csv"), csv.as_bytes())?;
+    let mut chart = LineChart::new(
+        "Image error against render time",
+        "CPU seconds",
+        "RMS relative luminance error",
+    )
+    .log_x()
+    .log_y();
+    for s in series {
+        chart = chart.with_series(s);
+    }
+    save_png(
+        &out.join("render_time.png"),
+        &[Panel::Line(chart)],
+        900,
+        600,
+    )?;
+    Ok(lines)
+}
