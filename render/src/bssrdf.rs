@@ -178,8 +178,8 @@ impl Subsurface {
         r: f32,
         wl: &SampledWavelengths,
     ) -> Exit {
-        let pdf = axes.p_normal()
-            * Self::mean_over_wavelengths(wl, |nm| self.table.pdf_area(nm, r));
+        let pdf =
+            axes.p_normal() * Self::mean_over_wavelengths(wl, |nm| self.table.pdf_area(nm, r));
         let weight = if pdf > 0.0 {
             SampledSpectrum(std::array::from_fn(|k| {
                 if wl.pdf()[k] > 0.0 {
@@ -271,7 +271,9 @@ mod tests {
         let (mut hits, mut rays) = (0u32, 0u64);
         for _ in 0..120_000 {
             let u = [rng.random(), rng.random(), rng.random(), rng.random()];
-            if let Some(e) = ss.sample_exit(&geo, 0, Vec3::ZERO, &FRAME, &AXES, false, &wl, u, &mut rays) {
+            if let Some(e) =
+                ss.sample_exit(&geo, 0, Vec3::ZERO, &FRAME, &AXES, false, &wl, u, &mut rays)
+            {
                 assert!(e.hit.is_some(), "fallback on an infinite plane");
                 let r = f64::from(e.p.length());
                 counts[edges.partition_point(|&x| x < r)] += 1;
@@ -309,7 +311,9 @@ mod tests {
         for s in 0..n {
             let wl = SampledWavelengths::sample_visible((u0 + (s % 4) as f32 * 0.25).fract());
             let u = [rng.random(), rng.random(), rng.random(), rng.random()];
-            if let Some(e) = ss.sample_exit(geo, 0, Vec3::ZERO, &FRAME, &AXES, false, &wl, u, &mut rays) {
+            if let Some(e) =
+                ss.sample_exit(geo, 0, Vec3::ZERO, &FRAME, &AXES, false, &wl, u, &mut rays)
+            {
                 for c in 0..4 {
                     let slot = acc
                         .iter_mut()

@@ -347,8 +347,7 @@ pub fn radiance(
             // continuation (weight S_ω cos / (cos / π) = T / c).
             let (eng, ens) = (exit.ng, exit.ns);
             sampler.seek(dims::EXIT_LIGHT);
-            let lit_exit =
-                n_lights > 0 && light_probabilities(scene, exit.p, ens, &mut exit_pick);
+            let lit_exit = n_lights > 0 && light_probabilities(scene, exit.p, ens, &mut exit_pick);
             if lit_exit {
                 // Several light samples share one probe (splitting): their mean is the estimate.
                 let n = settings.exit_light_samples.max(1);

@@ -236,8 +236,7 @@ fn render_passes(scene: &Scene, s: &RenderSettings) -> Result<(Film, RenderStats
                         let mut sampler =
                             PathSampler::new(s.path.sampler, s.seed, i as u64, sample);
                         sampler.start_camera();
-                        let wl =
-                            SampledWavelengths::sample(sampler.get_1d(), s.path.wavelengths);
+                        let wl = SampledWavelengths::sample(sampler.get_1d(), s.path.wavelengths);
                         let jitter = sampler.get_2d();
                         let film_pos = Vec2::new(
                             (x as f32 + jitter.x) / w as f32,

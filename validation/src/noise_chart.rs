@@ -125,7 +125,11 @@ fn masked_noise(a: &[f64], b: &[f64], threshold: f64, keep: impl Fn(usize) -> bo
             n += 1;
         }
     }
-    if n == 0 { f64::NAN } else { (s / n as f64).sqrt() }
+    if n == 0 {
+        f64::NAN
+    } else {
+        (s / n as f64).sqrt()
+    }
 }
 
 /// Render `scene` at `spp` with seeds 1 and 2 and measure the noise; `skin` is the skin mask.
@@ -160,7 +164,11 @@ pub fn measure(
                 .collect::<Vec<f64>>(),
         );
     }
-    let mean: Vec<f64> = lum[0].iter().zip(&lum[1]).map(|(x, y)| 0.5 * (x + y)).collect();
+    let mean: Vec<f64> = lum[0]
+        .iter()
+        .zip(&lum[1])
+        .map(|(x, y)| 0.5 * (x + y))
+        .collect();
     let t = lit_threshold(&mean);
     Ok(Point {
         spp,

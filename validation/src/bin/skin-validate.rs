@@ -352,7 +352,14 @@ fn run_noise_chart(args: &NoiseChartArgs) -> anyhow::Result<()> {
             },
         )?;
         let spp = args.spp.first().copied().unwrap_or(16);
-        noise_chart::breakdown(&mut scene, Some(&lambert), size, spp, args.threads, last.path)?;
+        noise_chart::breakdown(
+            &mut scene,
+            Some(&lambert),
+            size,
+            spp,
+            args.threads,
+            last.path,
+        )?;
         return Ok(());
     }
     noise_chart::run(&scene, size, &args.spp, args.threads, &chosen, &args.out)?;
