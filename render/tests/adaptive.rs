@@ -6,7 +6,9 @@ mod common;
 use common::SceneText;
 use render::film::Film;
 use render::noise::{luminance, relative_noise};
+use render::integrator::PathSettings;
 use render::renderer::{RenderOptions, RenderStats, render};
+use render::sampler::SamplerKind;
 use render::scene::Scene;
 
 /// A grey plane lit by a small sphere light and a dim environment: every pixel is noisy (light
@@ -73,20 +75,46 @@ fn adaptive_mean_equals_fixed_mean() {
     assert!(stats.mean_spp < 256.0 && stats.converged > 0, "{stats:?}");
 }
 
-/// The noise a render estimates from its own samples is within 20% of the two-seed metric
-/// (576 lit pixels: the metric itself fluctuates by about 1/√(2·576) ≈ 3%).
-#[test]
-fn noise_estimate_matches_two_seed_measurement() {
-    let s = lit_plane();
-    let (a, sa) = run(&s, 32, None, 1, 2);
-    let (b, sb) = run(&s, 32, None, 2, 2);
+/// The two-seed noise at 32 spp with `path`, and the noise the two renders estimated (mean).
+fn measured_and_estimated(s: &Scene, path: PathSettings) -> (f64, f64) {
+    let o = |seed| RenderOptions {
+        width: 24,
+        height: 24,
+        spp: 32,
+        seed,
+        threads: Some(2),
+        path,
+        ..Default::default()
+    };
+    let (a, sa) = render(s, &o(1).validate().unwrap()).unwrap();
+    let (b, sb) = render(s, &o(2).validate().unwrap()).unwrap();
     let measured = relative_noise(&luminances(&a), &luminances(&b))
         .unwrap()
         .relative_noise;
-    let estimated = 0.5 * (sa.noise + sb.noise);
+    (measured, 0.5 * (sa.noise + sb.noise))
+}
+
+/// With independent samples the noise a render estimates from its own samples is within 20% of
+/// the two-seed metric (576 lit pixels: the metric itself fluctuates by about 1/√(2·576) ≈ 3%).
+/// With the default Owen-scrambled Sobol points the sample variance overstates the error of the
+/// mean (measured here 7.2% estimated against 2.7%), so the estimate is an upper bound: it must
+/// not fall below the measurement (10% margin for the metric's own fluctuation).
+#[test]
+fn noise_estimate_matches_two_seed_measurement() {
+    let s = lit_plane();
+    let independent = PathSettings {
+        sampler: SamplerKind::Independent,
+        ..PathSettings::default()
+    };
+    let (measured, estimated) = measured_and_estimated(&s, independent);
     assert!(
         (estimated / measured - 1.0).abs() < 0.2,
-        "estimated {estimated}, measured {measured}"
+        "independent: estimated {estimated}, measured {measured}"
+    );
+    let (measured, estimated) = measured_and_estimated(&s, PathSettings::default());
+    assert!(
+        estimated >= 0.9 * measured,
+        "Sobol: estimated {estimated}, measured {measured}"
     );
 }
 
