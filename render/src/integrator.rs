@@ -229,7 +229,11 @@ pub fn radiance<R: Rng>(
                 break;
             };
             let Some(ss) = &skin.subsurface else { break };
-            if let Some(vol) = scene.volumetric.as_ref().and_then(|v| v.medium(si.material)) {
+            if let Some(vol) = scene
+                .volumetric
+                .as_ref()
+                .and_then(|v| v.medium(si.material))
+            {
                 // The volumetric reference (crate::volumetric): refract in, walk, leave.
                 // T at the shading normal, as the surface lobe's split (energy: ρ + T = 1).
                 let t_o = ss.directional.transmittance(wo.dot(ns));

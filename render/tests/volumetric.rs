@@ -7,9 +7,9 @@
 //! on a flat skin slab with the smooth surface, that is F(0) + R_d, R_d the diffuse reflectance of a
 //! collimated normal beam (what adding-doubling and the Monte Carlo compute).
 
+use multipole::LayeredMedium;
 use multipole::adding_doubling::{AddingDoublingOptions, DEFAULT_QUADRATURE_POINTS, skin_totals};
 use multipole::montecarlo::{self, McOptions};
-use multipole::LayeredMedium;
 use render::film::Film;
 use render::material::{Material, SkinMaterial, SurfaceKind};
 use render::renderer::{RenderOptions, render};

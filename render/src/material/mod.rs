@@ -39,8 +39,8 @@ mod skin;
 mod surface;
 
 pub use skin::{SKIN_TABLE_STEP_NM, SkinBuildError, SkinKnobs, SkinMaterial};
-pub use surface::SurfaceKind;
 use surface::Surface;
+pub use surface::SurfaceKind;
 
 /// An albedo texture used by a material.
 #[derive(Debug, Clone, Copy, PartialEq)]

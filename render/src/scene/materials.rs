@@ -7,10 +7,10 @@ use crate::error::RenderError;
 use crate::material::{
     DiffuseMaterial, Material, SkinBuildError, SkinKnobs, SkinMaterial, SurfaceKind, TextureRef,
 };
-use skin_optics::echo::Num;
 use crate::scene_file::MaterialDesc;
 use crate::spectrum::{SpectrumTable, linear_srgb_to_spectrum};
 use crate::texture::{Texture, luminance};
+use skin_optics::echo::Num;
 use skin_optics::{Preset, SkinParams};
 use std::collections::{BTreeMap, HashMap};
 
@@ -67,12 +67,11 @@ impl Loader<'_> {
                     brdf::check_roughness(m_rough).map_err(rough_err)?;
                     let tex = texture(albedo_texture)?;
                     let knobs = self.skin_knobs(&key, *phase_g, surface.as_deref())?;
-                    let skin = SkinMaterial::build(params, m_rough, tex, &knobs).map_err(
-                        |e| match e {
+                    let skin =
+                        SkinMaterial::build(params, m_rough, tex, &knobs).map_err(|e| match e {
                             SkinBuildError::Surface(e) => rough_err(e),
                             other => self.err(&key, other.to_string()),
-                        },
-                    )?;
+                        })?;
                     Material::Skin(skin)
                 }
                 MaterialDesc::Diffuse {

@@ -113,13 +113,14 @@ impl Volumetric {
             };
             let name = &scene.material_names[index];
             let triangles = scene.geometry.triangles_of(index as u32);
-            let (epidermis, dermis) = layer_tables(&skin.params, skin.phase_g).map_err(
-                |(nm, source)| VolumetricError::Layers {
-                    material: name.clone(),
-                    nm,
-                    source,
-                },
-            )?;
+            let (epidermis, dermis) =
+                layer_tables(&skin.params, skin.phase_g).map_err(|(nm, source)| {
+                    VolumetricError::Layers {
+                        material: name.clone(),
+                        nm,
+                        source,
+                    }
+                })?;
             media.push(Some(SkinVolume::new(
                 epidermis,
                 dermis,

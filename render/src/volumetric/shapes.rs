@@ -10,7 +10,13 @@ pub fn box_obj(size_mm: [f32; 3]) -> String {
     let mut obj = String::from("# box\n");
     for i in 0..8 {
         let sign = |bit: usize| if i & bit == 0 { -1.0 } else { 1.0 };
-        let _ = writeln!(obj, "v {} {} {}", sign(1) * h[0], sign(2) * h[1], sign(4) * h[2]);
+        let _ = writeln!(
+            obj,
+            "v {} {} {}",
+            sign(1) * h[0],
+            sign(2) * h[1],
+            sign(4) * h[2]
+        );
     }
     // Corners are 1 + (x bit) + 2·(y bit) + 4·(z bit); each face counter-clockwise seen from outside.
     let faces = [
@@ -25,7 +31,10 @@ pub fn box_obj(size_mm: [f32; 3]) -> String {
     let normals = ["-1 0 0", "1 0 0", "0 -1 0", "0 1 0", "0 0 -1", "0 0 1"];
     for (k, ([a, b, c, d], n)) in faces.iter().zip(normals).enumerate() {
         let k = k + 1;
-        let _ = writeln!(obj, "vn {n}\nf {a}//{k} {b}//{k} {c}//{k}\nf {a}//{k} {c}//{k} {d}//{k}");
+        let _ = writeln!(
+            obj,
+            "vn {n}\nf {a}//{k} {b}//{k} {c}//{k}\nf {a}//{k} {c}//{k} {d}//{k}"
+        );
     }
     obj
 }

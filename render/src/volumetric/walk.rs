@@ -72,7 +72,10 @@ pub fn walk<R: RngCore>(
     rng: &mut R,
     rays: &mut u64,
 ) -> Walk {
-    let (sa_e, ss_e) = (vol.epidermis.sigma_a.at_nm(nm), vol.epidermis.sigma_s.at_nm(nm));
+    let (sa_e, ss_e) = (
+        vol.epidermis.sigma_a.at_nm(nm),
+        vol.epidermis.sigma_s.at_nm(nm),
+    );
     let (sa_d, ss_d) = (vol.dermis.sigma_a.at_nm(nm), vol.dermis.sigma_s.at_nm(nm));
     let (st_e, st_d) = (sa_e + ss_e, sa_d + ss_d);
     let majorant = st_e.max(st_d);
@@ -92,8 +95,13 @@ pub fn walk<R: RngCore>(
         };
         let mut left = hit.t;
         let mut scattered = false;
-        while majorant > 0.0 {
-            let step = -(1.0 - rng.random::<f32>()).ln() / majorant;
+        loop {
+            // A clear medium (σ̄ = 0) flies straight to the surface.
+            let step = if majorant > 0.0 {
+                -(1.0 - rng.random::<f32>()).ln() / majorant
+            } else {
+                f32::INFINITY
+            };
             if step >= left {
                 break;
             }

@@ -5,9 +5,11 @@
 //! `bssrdf_spp` and by the volumetric walk at `reference_spp`. The per-pixel relative error of the
 //! luminance, (Y_bssrdf − Y_ref) / Y_ref, is drawn as a heat map (PNG) over the skin pixels lit above
 //! 15% of the reference's 95th percentile; the region's mean signed and mean absolute errors go to
-//! `render_cases.csv` with the reference's own noise (standard error of the region mean, from each
-//! pixel's variance pass), so a difference can be told from noise. A case *fails* when
-//! |mean signed error| exceeds 5% and three reference standard errors.
+//! `render_cases.csv` with the noise of the mean signed error (standard error from both renders'
+//! per-pixel variance passes), so a difference can be told from noise. A case *fails* when
+//! |mean signed error| exceeds 5% and three standard errors. Every skin has `surface = "smooth"`:
+//! then the BSSRDF's totals (adding-doubling under a Fresnel boundary) and the walk's boundary are
+//! the same physics, and what differs is geometry (docs/physics.md §15).
 //!
 //! The error-against-time chart renders one case (the sphere, light skin) with both integrators at
 //! increasing spp, each image's RMS relative error taken against a separate volumetric run at the
@@ -37,12 +39,12 @@ pub struct RenderStudy {
 }
 
 impl RenderStudy {
-    /// Modest counts: minutes on two cores.
+    /// Modest counts: a few CPU minutes.
     pub const QUICK: Self = Self {
-        side: 48,
-        bssrdf_spp: 64,
-        reference_spp: 64,
-        ladder: &[1, 4, 16],
+        side: 24,
+        bssrdf_spp: 16,
+        reference_spp: 16,
+        ladder: &[1, 4],
     };
     /// The counts of BENCHMARKS.md.
     pub const FULL: Self = Self {
@@ -71,7 +73,9 @@ fn analytic_cases(side: usize, dir: &Path) -> anyhow::Result<Vec<Case>> {
     std::fs::write(&slab, box_obj([100.0, 100.0, 20.0]))?;
     let mut cases = Vec::new();
     for tone in TONES {
-        let skin = format!("[materials.skin]\ntype = \"skin\"\npreset = \"{tone}\"\n");
+        let skin = format!(
+            "[materials.skin]\ntype = \"skin\"\npreset = \"{tone}\"\nsurface = \"smooth\"\n"
+        );
         // Flat slab seen from above: 20 mm of its top face fill the view.
         let slab_toml = format!(
             "[camera]\nposition_mm = [0, 0, 300]\nlook_at_mm = [0, 0, 0]\nfov_deg = 3.9\n\
@@ -100,7 +104,12 @@ fn analytic_cases(side: usize, dir: &Path) -> anyhow::Result<Vec<Case>> {
                  size_mm = [200, 200]\nintensity = 5\n",
                 file.display()
             );
-            cases.push(case(&format!("thin slab {mm} mm (backlit)"), tone, thin, side));
+            cases.push(case(
+                &format!("thin slab {mm} mm (backlit)"),
+                tone,
+                thin,
+                side,
+            ));
         }
     }
     Ok(cases)
@@ -140,10 +149,17 @@ fn builtin_cases(side: usize) -> Vec<Case> {
 }
 
 /// The scene without skin albedo textures (the volumetric walk has no texture modulation, so both
-/// integrators see the same skin).
+/// integrators see the same skin) and with the smooth surface on every skin.
 fn untextured(toml: &str) -> String {
     toml.lines()
         .filter(|l| !l.trim_start().starts_with("albedo_texture"))
+        .map(|l| {
+            if l.trim() == "type = \"skin\"" {
+                format!("{l}\nsurface = \"smooth\"")
+            } else {
+                l.to_string()
+            }
+        })
         .collect::<Vec<_>>()
         .join("\n")
 }
@@ -208,7 +224,8 @@ fn error_map(test: &Film, reference: &Film, pixels: &[usize]) -> Vec<f64> {
 struct CaseResult {
     mean_signed: f64,
     mean_abs: f64,
-    ref_noise: f64,
+    /// Standard error of `mean_signed` from both renders' noise.
+    noise: f64,
     pixels: usize,
 }
 
@@ -217,19 +234,20 @@ fn measure(test: &Film, reference: &Film, pixels: &[usize], map: &[f64]) -> Case
     let n = pixels.len().max(1) as f64;
     let mean_signed = pixels.iter().map(|&i| map[i]).sum::<f64>() / n;
     let mean_abs = pixels.iter().map(|&i| map[i].abs()).sum::<f64>() / n;
-    // Standard error of the region's mean relative value: √Σ var_i / Y_i² / n.
+    // Standard error of the region's mean relative difference, both renders' noise:
+    // √Σ (var_ref,i + var_test,i) / Y_i² / n.
     let var: f64 = pixels
         .iter()
         .map(|&i| {
-            let y = f64::from(reference.xyz(i % w, i / w)[1]);
-            reference.variance(i % w, i / w) / (y * y)
+            let (x, y) = (i % w, i / w);
+            let l = f64::from(reference.xyz(x, y)[1]);
+            (reference.variance(x, y) + test.variance(x, y)) / (l * l)
         })
         .sum();
-    let _ = test;
     CaseResult {
         mean_signed,
         mean_abs,
-        ref_noise: var.sqrt() / n,
+        noise: var.sqrt() / n,
         pixels: pixels.len(),
     }
 }
@@ -266,10 +284,10 @@ pub fn run_render(study: RenderStudy, out: &Path) -> anyhow::Result<()> {
     let mut cases = analytic_cases(study.side, meshes.path())?;
     cases.extend(builtin_cases(study.side));
     let mut csv = String::from(
-        "case,tone,pixels,mean_signed_error,mean_abs_error,reference_noise,fails,bssrdf_cpu_s,volumetric_cpu_s\n",
+        "case,tone,pixels,mean_signed_error,mean_abs_error,noise,fails,bssrdf_cpu_s,volumetric_cpu_s\n",
     );
     let mut table = String::from(
-        "| case | tone | pixels | mean error | mean abs error | reference noise | BSSRDF fails? | CPU s (BSSRDF / volumetric) |\n|---|---|---|---|---|---|---|---|\n",
+        "| case | tone | pixels | mean error | mean abs error | noise (1σ) | BSSRDF fails? | CPU s (BSSRDF / volumetric) |\n|---|---|---|---|---|---|---|---|\n",
     );
     for (k, c) in cases.iter().enumerate() {
         eprintln!("[{}/{}] {} ({})", k + 1, cases.len(), c.name, c.tone);
@@ -281,17 +299,22 @@ pub fn run_render(study: RenderStudy, out: &Path) -> anyhow::Result<()> {
         let pixels = compared_pixels(&reference, &skin);
         let map = error_map(&test, &reference, &pixels);
         let r = measure(&test, &reference, &pixels, &map);
-        let fails = r.mean_signed.abs() > 0.05 && r.mean_signed.abs() > 3.0 * r.ref_noise;
+        let fails = r.mean_signed.abs() > 0.05 && r.mean_signed.abs() > 3.0 * r.noise;
         let stem: String = format!("{}-{}", c.name, c.tone)
             .chars()
             .map(|ch| if ch.is_ascii_alphanumeric() { ch } else { '_' })
             .collect();
         let title = format!("{} ({}): BSSRDF vs volumetric", c.name, c.tone);
-        save_png(&out.join(format!("error_{stem}.png")), &[heat(&title, &reference, map)], 900, 700)?;
+        save_png(
+            &out.join(format!("error_{stem}.png")),
+            &[heat(&title, &reference, map)],
+            900,
+            700,
+        )?;
         let _ = writeln!(
             csv,
             "{},{},{},{:.5},{:.5},{:.5},{},{:.2},{:.2}",
-            c.name, c.tone, r.pixels, r.mean_signed, r.mean_abs, r.ref_noise, fails, t_b, t_v
+            c.name, c.tone, r.pixels, r.mean_signed, r.mean_abs, r.noise, fails, t_b, t_v
         );
         let _ = writeln!(
             table,
@@ -301,7 +324,7 @@ pub fn run_render(study: RenderStudy, out: &Path) -> anyhow::Result<()> {
             r.pixels,
             100.0 * r.mean_signed,
             100.0 * r.mean_abs,
-            100.0 * r.ref_noise,
+            100.0 * r.noise,
             if fails { "**yes**" } else { "no" },
             t_b,
             t_v
@@ -349,7 +372,11 @@ fn time_chart(study: RenderStudy, case: &Case, out: &Path) -> anyhow::Result<Str
             let e = rms_error(&film, &reference, &pixels);
             let paths = (case.width * case.height) as f64 * f64::from(spp) / t.max(1e-9);
             let _ = writeln!(csv, "{name},{spp},{t:.3},{e:.5},{paths:.0}");
-            let _ = writeln!(lines, "| {name} | {spp} | {t:.2} | {:.1}% | {paths:.0} |", 100.0 * e);
+            let _ = writeln!(
+                lines,
+                "| {name} | {spp} | {t:.2} | {:.1}% | {paths:.0} |",
+                100.0 * e
+            );
             pts.push((t, e));
         }
         series.push(Series::line(name, pts).with_style(SeriesStyle::LinePoints));
@@ -365,6 +392,11 @@ fn time_chart(study: RenderStudy, case: &Case, out: &Path) -> anyhow::Result<Str
     for s in series {
         chart = chart.with_series(s);
     }
-    save_png(&out.join("render_time.png"), &[Panel::Line(chart)], 900, 600)?;
+    save_png(
+        &out.join("render_time.png"),
+        &[Panel::Line(chart)],
+        900,
+        600,
+    )?;
     Ok(lines)
 }
