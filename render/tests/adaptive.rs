@@ -5,8 +5,8 @@ mod common;
 
 use common::SceneText;
 use render::film::Film;
-use render::noise::{luminance, relative_noise};
 use render::integrator::PathSettings;
+use render::noise::{luminance, relative_noise};
 use render::renderer::{RenderOptions, RenderStats, render};
 use render::sampler::SamplerKind;
 use render::scene::Scene;

@@ -146,7 +146,7 @@ mod tests {
         }
         assert!(inside > 1000, "the test must exercise both answers");
         // Closed form: a point above the square's interior is at its height.
-        assert!((distance_squared(Vec3::new(1.0, 2.0, 0.3), &tris[0]) - 0.09).abs() < 1e-6);
+        assert!((distance_squared(Vec3::new(2.0, 1.0, 0.3), &tris[0]) - 0.09).abs() < 1e-6);
         // Beyond a corner: the distance to the corner.
         let d2 = distance_squared(Vec3::new(6.0, -6.0, 0.0), &tris[0]);
         assert!((d2 - 2.0).abs() < 1e-5, "{d2}");

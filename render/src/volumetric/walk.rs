@@ -95,8 +95,13 @@ pub fn walk<R: RngCore>(
         };
         let mut left = hit.t;
         let mut scattered = false;
-        while majorant > 0.0 {
-            let step = -(1.0 - rng.random::<f32>()).ln() / majorant;
+        loop {
+            // A clear medium (σ̄ = 0) flies straight to the surface.
+            let step = if majorant > 0.0 {
+                -(1.0 - rng.random::<f32>()).ln() / majorant
+            } else {
+                f32::INFINITY
+            };
             if step >= left {
                 break;
             }
