@@ -236,10 +236,14 @@ fn measure(test: &Film, reference: &Film, pixels: &[usize], map: &[f64]) -> Case
     // Ratio of the region's sums, not the mean of per-pixel ratios: a noisy denominator biases
     // the latter upwards by about the reference's relative variance per pixel (Jensen).
     let y = |f: &Film, i: usize| f64::from(f.xyz(i % w, i / w)[1]);
-    let (sum_t, sum_r) = pixels
-        .iter()
-        .fold((0.0, 0.0), |(a, b), &i| (a + y(test, i), b + y(reference, i)));
-    let mean_signed = if sum_r > 0.0 { sum_t / sum_r - 1.0 } else { f64::NAN };
+    let (sum_t, sum_r) = pixels.iter().fold((0.0, 0.0), |(a, b), &i| {
+        (a + y(test, i), b + y(reference, i))
+    });
+    let mean_signed = if sum_r > 0.0 {
+        sum_t / sum_r - 1.0
+    } else {
+        f64::NAN
+    };
     let mean_abs = pixels.iter().map(|&i| map[i].abs()).sum::<f64>() / n;
     // Standard error of that ratio from both renders' noise (first order):
     // √(Σ var_test,i + Σ var_ref,i) / Σ Y_ref,i.
