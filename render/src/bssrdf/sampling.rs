@@ -52,7 +52,7 @@ impl ProbeAxes {
     /// Axes with the normal chosen with probability `p_normal` in (0, 1) (None outside).
     #[must_use]
     pub fn new(p_normal: f32) -> Option<Self> {
-        (p_normal > 0.0 && p_normal < 1.0).then(|| Self {
+        (p_normal > 0.0 && p_normal < 1.0).then_some(Self {
             probability: [p_normal, 0.5 * (1.0 - p_normal), 0.5 * (1.0 - p_normal)],
         })
     }
