@@ -1,4 +1,8 @@
 //! Typed errors of the layered-transport crate: every variant names the parameter, its value and its range.
+//!
+//! [`check_range`] mirrors `skin_optics`'s private helper of the same name on purpose: each returns
+//! its own crate's error type (skin-optics also separates non-finite from out-of-range values), and
+//! sharing one would make the leaf crate export an internal helper only this crate needs.
 
 use skin_optics::OpticsError;
 use thiserror::Error;

@@ -1,6 +1,9 @@
 //! Skin presets in scene files: seed and measured names resolve to the same skins as on the command
 //! line, overrides keep a measured preset's extended parameters, and the default scene's three
 //! skins are measured ones.
+//!
+//! The scene text is spelled out in TOML (not `common::SceneText`) so that the preset keys under
+//! test appear exactly as a user writes them.
 
 use render::material::Material;
 use render::scene::{Scene, SceneOptions};
