@@ -104,12 +104,19 @@ fn invalid_skin_parameter_is_named() {
 fn non_finite_transform_is_named() {
     let text = good().replace("translate_mm = [0, 0, 0]", "translate_mm = [nan, 0, 0]");
     let e = render_text("nan", &text).unwrap_err();
-    // Refused while parsing, on one line with its position.
-    assert_mentions(&e, &["scene.toml", "line 15, column 16", "finite"]);
+    // Refused while parsing, on one line with its position (1-based, at the bad value).
+    let at = |text: &str, key: &str, column: usize| {
+        let line = text.lines().position(|l| l.starts_with(key)).unwrap() + 1;
+        format!("line {line}, column {column}")
+    };
+    assert_mentions(
+        &e,
+        &["scene.toml", &at(&text, "translate_mm", 16), "finite"],
+    );
     assert!(!e.contains('\n'), "{e}");
     let text = good().replace("scale = 50", "scale = inf");
     let e = render_text("inf", &text).unwrap_err();
-    assert_mentions(&e, &["line 14, column 9", "finite"]);
+    assert_mentions(&e, &[&at(&text, "scale", 9), "finite"]);
 }
 
 #[test]
