@@ -21,57 +21,42 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     // The same kind of sweep as `skin-validate`'s knob study (validation/src/compare/knobs.rs), on
     // purpose wider and timed: that study charts error against time for the documented ranges,
     // this example finds where each knob stops paying. An example cannot call the validation crate.
-    let mut settings: Vec<(&str, String, ProfileOptions)> = Vec::new();
-    for n in [0usize, 1, 2, 5, 10, 20, 50] {
-        settings.push((
-            "poles",
-            n.to_string(),
-            ProfileOptions {
-                poles: Poles::Count(n),
-                ..d
-            },
-        ));
-    }
-    settings.push(("poles", "exact".into(), d));
-    for n in [16usize, 32, 64, 128, 256, 512, 1024] {
-        settings.push((
+    type Set = fn(&mut ProfileOptions, usize);
+    let counts: [(&str, &[usize], Set); 4] = [
+        ("poles", &[0, 1, 2, 5, 10, 20, 50], |o, n| {
+            o.poles = Poles::Count(n)
+        }),
+        (
             "radial_samples",
-            n.to_string(),
-            ProfileOptions {
-                radial_samples: n,
-                ..d
-            },
-        ));
-    }
-    for n in [2usize, 3, 4, 5, 6, 8, 12] {
-        settings.push((
-            "transform_nodes",
-            n.to_string(),
-            ProfileOptions {
-                transform_nodes: n,
-                ..d
-            },
-        ));
-    }
-    for n in [8usize, 12, 16, 24, 32, 48, 64, 96, 128] {
-        settings.push((
+            &[16, 32, 64, 128, 256, 512, 1024],
+            |o, n| o.radial_samples = n,
+        ),
+        ("transform_nodes", &[2, 3, 4, 5, 6, 8, 12], |o, n| {
+            o.transform_nodes = n
+        }),
+        (
             "transform_radii",
-            n.to_string(),
-            ProfileOptions {
-                transform_radii: n,
-                ..d
-            },
-        ));
+            &[8, 12, 16, 24, 32, 48, 64, 96, 128],
+            |o, n| o.transform_radii = n,
+        ),
+    ];
+    let mut settings: Vec<(&str, String, ProfileOptions)> = Vec::new();
+    for (knob, values, set) in counts {
+        for &n in values {
+            let mut o = d;
+            set(&mut o, n);
+            settings.push((knob, n.to_string(), o));
+        }
+        if knob == "poles" {
+            settings.push(("poles", "exact".into(), d));
+        }
     }
     for t in [1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-10, 1e-12] {
-        settings.push((
-            "transform_tolerance",
-            format!("{t:e}"),
-            ProfileOptions {
-                transform_tolerance: t,
-                ..d
-            },
-        ));
+        let o = ProfileOptions {
+            transform_tolerance: t,
+            ..d
+        };
+        settings.push(("transform_tolerance", format!("{t:e}"), o));
     }
     let mut csv = String::from(
         "preset,lambda_nm,knob,value,time_us,max_energy_density_error,total_relative_error,r99_relative_error\n",

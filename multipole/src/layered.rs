@@ -5,6 +5,10 @@
 //! [`LayeredMedium`]; [`LayeredMedium::skin`] builds the two-layer skin from its parameters
 //! (docs/physics.md §1, §6). The default anisotropy, the σs'→σs conversion and the valid ranges
 //! live here and nowhere else.
+//!
+//! `Layer::checked`'s arguments repeat the struct's fields one for one on purpose: it is the single
+//! constructor every public one funnels into, where the ranges are checked; its accessors are
+//! spelled out one per field so each carries its unit.
 
 use crate::error::{MultipoleError, check_range};
 use skin_optics::{SkinParams, Wavelength};
@@ -31,8 +35,6 @@ pub struct Layer {
 }
 
 impl Layer {
-    // The arguments repeat the fields one for one: this is the single constructor every public
-    // one funnels into, where the ranges are checked.
     fn checked(
         sigma_a: f64,
         sigma_s: f64,

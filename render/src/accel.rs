@@ -169,6 +169,22 @@ mod tests {
         }
     }
 
+    /// A 2000-triangle soup from `seed`, its BVH, and 10,000 random rays (origin, direction) from
+    /// a box a little larger than the soup's.
+    fn soup_and_rays(seed: u64) -> (Vec<[Vec3; 3]>, Accel, Vec<(Vec3, Vec3)>) {
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+        let tris = random_soup(2000, &mut rng);
+        let accel = Accel::build(&tris);
+        let rays = (0..10_000)
+            .map(|_| {
+                let o =
+                    Vec3::new(rng.random(), rng.random(), rng.random()) * 14.0 - Vec3::splat(2.0);
+                (o, random_dir(&mut rng))
+            })
+            .collect();
+        (tris, accel, rays)
+    }
+
     fn brute_force(tris: &[[Vec3; 3]], r: &Ray) -> Option<(f32, usize)> {
         tris.iter()
             .enumerate()
@@ -185,13 +201,10 @@ mod tests {
     /// Closest hits agree with testing every triangle, on 10,000 random rays.
     #[test]
     fn closest_hit_matches_brute_force() {
-        let mut rng = Xoshiro256PlusPlus::seed_from_u64(6);
-        let tris = random_soup(2000, &mut rng);
-        let accel = Accel::build(&tris);
+        let (tris, accel, rays) = soup_and_rays(6);
         let mut hits = 0;
-        for _ in 0..10_000 {
-            let o = Vec3::new(rng.random(), rng.random(), rng.random()) * 14.0 - Vec3::splat(2.0);
-            let r = ray(o, random_dir(&mut rng), 0.0, f32::INFINITY);
+        for (o, d) in rays {
+            let r = ray(o, d, 0.0, f32::INFINITY);
             let bvh = accel.closest(&r);
             let brute = brute_force(&tris, &r);
             match (bvh, brute) {
@@ -246,13 +259,9 @@ mod tests {
     /// A shadow ray is blocked exactly when its length exceeds the closest-hit distance.
     #[test]
     fn shadow_rays_agree_with_closest_hit() {
-        let mut rng = Xoshiro256PlusPlus::seed_from_u64(7);
-        let tris = random_soup(2000, &mut rng);
-        let accel = Accel::build(&tris);
+        let (_, accel, rays) = soup_and_rays(7);
         let mut checked = 0;
-        for _ in 0..10_000 {
-            let o = Vec3::new(rng.random(), rng.random(), rng.random()) * 14.0 - Vec3::splat(2.0);
-            let d = random_dir(&mut rng);
+        for (o, d) in rays {
             let inf = ray(o, d, 0.0, f32::INFINITY);
             let Some(h) = accel.closest(&inf) else {
                 assert!(!accel.occluded(&inf));

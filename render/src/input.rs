@@ -1,6 +1,9 @@
 //! The one way input files are read: the extension is checked first, then that the path is a
 //! regular file (not a device, FIFO or folder) no larger than its kind's cap, and only then are
 //! the bytes read (never more than the cap, even if the file grows meanwhile).
+//!
+//! The constants are alike by design: each is a row of the table of what may be read (what,
+//! extensions, size cap), kept as named constants so the loaders and the errors cite them.
 
 use crate::error::RenderError;
 use std::fs;
@@ -19,9 +22,6 @@ pub struct InputKind {
 }
 
 const MIB: u64 = 1 << 20;
-
-// One constant per kind of input, alike by design: each is a row of the table of what may be read
-// (what, extensions, size cap), kept as named constants so the loaders and the errors cite them.
 
 /// A scene description (TOML), at most 4 MiB.
 pub const SCENE: InputKind = InputKind {

@@ -1,16 +1,14 @@
 //! `skin brdf`: CSV shape and values (against brdf's quadrature and the smooth-surface limit),
 //! flag validation (one line naming the flag and range, exit code 2), and the PNG chart.
 
+mod common;
+
 use brdf::TorranceSparrow;
 use brdf::fresnel::dielectric_reflectance;
-use std::process::{Command, Output};
+use std::process::Output;
 
 fn skin(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_skin"))
-        .arg("brdf")
-        .args(args)
-        .output()
-        .expect("the skin binary runs")
+    common::skin_cli("brdf", args)
 }
 
 /// Parse the CSV, checking the header and the 0–89° rows.

@@ -1,22 +1,17 @@
 //! `skin fit` end to end: colour and spectrum fits, JSON output, out-of-gamut reporting, bad input.
 
+mod common;
+
+use common::stderr;
 use multipole::Method;
 use multipole::fit::{ColourModel, FitOptions};
 use skin_optics::Wavelength;
 use skin_optics::lab::Lab;
 use std::path::PathBuf;
-use std::process::{Command, Output};
+use std::process::Output;
 
 fn skin_fit(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_skin"))
-        .arg("fit")
-        .args(args)
-        .output()
-        .expect("run skin")
-}
-
-fn stderr(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stderr).into_owned()
+    common::skin_cli("fit", args)
 }
 
 /// A CSV file in the temp directory, unique per test.
@@ -251,10 +246,7 @@ fn bad_usage_exits_with_code_2() {
 
 #[test]
 fn skin_spectrum_reports_lab_and_ita_on_stderr() {
-    let out = Command::new(env!("CARGO_BIN_EXE_skin"))
-        .args(["spectrum", "--preset", "medium", "--method", "multipole"])
-        .output()
-        .expect("run skin");
+    let out = common::skin_cli("spectrum", &["--preset", "medium", "--method", "multipole"]);
     assert!(out.status.success(), "{}", stderr(&out));
     let err = stderr(&out);
     let line = err

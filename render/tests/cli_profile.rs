@@ -1,13 +1,9 @@
 //! `skin profile` end to end: CSV shape and values, flag validation, the plot file.
 
-use std::process::Command;
+mod common;
 
 fn skin(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_skin"))
-        .arg("profile")
-        .args(args)
-        .output()
-        .expect("run skin")
+    common::skin_cli("profile", args)
 }
 
 /// `skin profile` with the whitespace-separated `args`, which must succeed.

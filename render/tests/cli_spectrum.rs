@@ -1,22 +1,13 @@
 //! `skin spectrum` end to end: the built binary, its CSV, its errors and its chart.
 
+mod common;
+
+use common::{stderr, stdout};
 use std::path::PathBuf;
-use std::process::{Command, Output};
+use std::process::Output;
 
 fn skin(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_skin"))
-        .arg("spectrum")
-        .args(args)
-        .output()
-        .expect("run the skin binary")
-}
-
-fn stdout(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stdout).into_owned()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
+    common::skin_cli("spectrum", args)
 }
 
 const HEADER: &str = "lambda_nm,sigma_a_epidermis_per_mm,sigma_a_dermis_per_mm,sigma_s_reduced_per_mm,diffuse_reflectance";

@@ -110,6 +110,22 @@ fn slab_matches_adding_doubling_and_monte_carlo() {
     }
 }
 
+/// Give the scene's first mesh a skin body of constant [σa, σs] (mm⁻¹) per layer, epidermis then
+/// dermis: g 0.9, n 1.4, a 0.1-mm epidermis.
+fn set_constant_body(scene: &mut Scene, epidermis: [f32; 2], dermis: [f32; 2]) {
+    let body = SkinVolume::new(
+        LayerTables::constant(epidermis[0], epidermis[1]),
+        LayerTables::constant(dermis[0], dermis[1]),
+        0.9,
+        1.4,
+        0.1,
+        scene.geometry.triangles_of(0),
+    );
+    scene.volumetric = Some(Volumetric {
+        media: vec![Some(body)],
+    });
+}
+
 /// White furnace: a 2-mm sphere of non-absorbing skin (σa = 0) under a sky of radiance 1 is
 /// invisible — every walk leaves with weight 1 and surface + body reflect ρ(θ) + T(θ) = 1 — for the
 /// smooth and the oily surface; 3σ of the render's noise, plus 1e-4 for f32 rounding.
@@ -124,18 +140,7 @@ fn white_furnace_sphere_conserves_energy() {
         );
         let mut scene =
             Scene::from_toml(&text, "furnace.toml", None, &SceneOptions::default()).unwrap();
-        let tris = scene.geometry.triangles_of(0);
-        let white = SkinVolume::new(
-            LayerTables::constant(0.0, 20.0),
-            LayerTables::constant(0.0, 10.0),
-            0.9,
-            1.4,
-            0.1,
-            tris,
-        );
-        scene.volumetric = Some(Volumetric {
-            media: vec![Some(white)],
-        });
+        set_constant_body(&mut scene, [0.0, 20.0], [0.0, 10.0]);
         let film = render_mono(&scene, 6, 200, 5);
         let (l, sigma) = mean_and_sigma(&film);
         assert!(
@@ -166,18 +171,7 @@ fn smooth_surface_reflects_fresnel_over_a_clear_absorber() {
     for theta in [0.0f64, 45.0, 70.0] {
         let keys = "surface = \"smooth\"";
         let mut scene = box_scene(dir.path(), [400.0, 400.0, 20.0], theta as f32, keys);
-        let tris = scene.geometry.triangles_of(0);
-        let black = SkinVolume::new(
-            LayerTables::constant(50.0, 0.0),
-            LayerTables::constant(50.0, 0.0),
-            0.9,
-            1.4,
-            0.1,
-            tris,
-        );
-        scene.volumetric = Some(Volumetric {
-            media: vec![Some(black)],
-        });
+        set_constant_body(&mut scene, [50.0, 0.0], [50.0, 0.0]);
         let film = render_mono(&scene, 4, 4000, 3);
         let (l, sigma) = mean_and_sigma(&film);
         let (lo, hi) = fresnel_bounds(theta);

@@ -24,6 +24,7 @@
 mod eigen;
 mod layer;
 mod matrix;
+mod memo;
 mod modes;
 mod quadrature;
 mod split;

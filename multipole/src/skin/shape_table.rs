@@ -9,6 +9,9 @@
 //! Knobs ([`ShapeTableOptions`]): photons (noise), depths per octave (interpolation), radial and
 //! path bins per decade (binning); errors against the run-time Monte Carlo in BENCHMARKS.md
 //! (`## Exact profile table`).
+//!
+//! The `g` and `n` accessors read like `Layer`'s on purpose: a shape table is tabulated for one
+//! such layer's anisotropy and index, and callers compare the two.
 
 use super::shape::profile_from_shape;
 use crate::diffusion::profile::Profile;
@@ -205,8 +208,6 @@ impl ShapeTable {
         }
     }
 
-    // g and n read like `Layer`'s accessors on purpose: a shape table is tabulated for one such
-    // layer's anisotropy and index, and callers compare the two.
     /// HG anisotropy of the run.
     #[must_use]
     pub fn g(&self) -> f64 {

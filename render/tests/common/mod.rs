@@ -8,6 +8,7 @@ use render::film::Film;
 use render::renderer::{RenderOptions, render};
 use render::scene::{Scene, SceneOptions};
 use skin_optics::color::{cie_xyz_bar, cie_y_integral};
+use std::process::{Command, Output};
 
 /// The TOML of a test scene, assembled part by part so that no test spells out the same camera,
 /// material, mesh or light again. The camera looks at the origin with +Y up.
@@ -161,4 +162,23 @@ pub fn assert_close(got: [f64; 3], want: [f64; 3], rel: f64, what: &str) {
             "{what}: channel {c}: {got:?} vs {want:?}"
         );
     }
+}
+
+/// Run the `skin` binary's `subcommand` with `args` to completion.
+pub fn skin_cli(subcommand: &str, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_skin"))
+        .arg(subcommand)
+        .args(args)
+        .output()
+        .expect("run the skin binary")
+}
+
+/// A finished process's standard output, as text.
+pub fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+/// A finished process's standard error, as text.
+pub fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
 }

@@ -25,37 +25,30 @@ use std::time::Instant;
 /// (knob name, setting label, options) for every multipole setting measured.
 fn multipole_settings() -> Vec<(&'static str, String, ProfileOptions)> {
     let base = ProfileOptions::default();
-    let mut v = Vec::new();
-    for n in [0usize, 1, 2, 3, 5, 10] {
-        v.push((
-            "poles",
-            format!("{n}"),
-            ProfileOptions {
-                poles: Poles::Count(n),
-                ..base
-            },
-        ));
-    }
-    v.push(("poles", "exact".into(), base));
-    for s in [16usize, 32, 64, 128, 256, 512, 1024] {
-        v.push((
+    type Set = fn(&mut ProfileOptions, usize);
+    let knobs: [(&str, &[usize], Set); 3] = [
+        ("poles", &[0, 1, 2, 3, 5, 10], |o, n| {
+            o.poles = Poles::Count(n)
+        }),
+        (
             "radial samples",
-            format!("{s}"),
-            ProfileOptions {
-                radial_samples: s,
-                ..base
-            },
-        ));
-    }
-    for k in [1usize, 2, 3, 5, 8, 16] {
-        v.push((
-            "transform nodes",
-            format!("{k}"),
-            ProfileOptions {
-                transform_nodes: k,
-                ..base
-            },
-        ));
+            &[16, 32, 64, 128, 256, 512, 1024],
+            |o, n| o.radial_samples = n,
+        ),
+        ("transform nodes", &[1, 2, 3, 5, 8, 16], |o, n| {
+            o.transform_nodes = n
+        }),
+    ];
+    let mut v = Vec::new();
+    for (knob, values, set) in knobs {
+        for &n in values {
+            let mut o = base;
+            set(&mut o, n);
+            v.push((knob, format!("{n}"), o));
+        }
+        if knob == "poles" {
+            v.push(("poles", "exact".into(), base));
+        }
     }
     v
 }

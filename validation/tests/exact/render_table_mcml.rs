@@ -103,20 +103,18 @@ fn check(preset: Preset, nm: f64, case: &str) {
     );
 }
 
-#[test]
-#[cfg_attr(
-    debug_assertions,
-    ignore = "builds a renderer table: run with --release"
-)]
-fn render_table_light_550_nm_matches_mcml() {
-    check(Preset::Light, 550.0, "light-550");
+/// One `#[test]` per case: test name, preset, wavelength (nm), committed MCML case.
+macro_rules! table_cases {
+    ($($name:ident: $preset:expr, $nm:expr, $case:literal;)*) => {$(
+        #[test]
+        #[cfg_attr(debug_assertions, ignore = "builds a renderer table: run with --release")]
+        fn $name() {
+            check($preset, $nm, $case);
+        }
+    )*};
 }
 
-#[test]
-#[cfg_attr(
-    debug_assertions,
-    ignore = "builds a renderer table: run with --release"
-)]
-fn render_table_dark_450_nm_matches_mcml() {
-    check(Preset::Dark, 450.0, "dark-450");
+table_cases! {
+    render_table_light_550_nm_matches_mcml: Preset::Light, 550.0, "light-550";
+    render_table_dark_450_nm_matches_mcml: Preset::Dark, 450.0, "dark-450";
 }

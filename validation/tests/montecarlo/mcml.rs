@@ -105,38 +105,22 @@ fn check(name: &str, photons: u64, seed: u64) {
     );
 }
 
-#[test]
-#[cfg_attr(debug_assertions, ignore = "10⁵–10⁶ photons: run with --release")]
-fn light_skin_450_nm_matches_mcml() {
-    check("light-450", 160_000, 0x4D43_0450);
+/// One `#[test]` per committed MCML case: test name, case, our photon count, seed.
+macro_rules! mcml_cases {
+    ($($name:ident: $case:literal, $photons:expr, $seed:expr;)*) => {$(
+        #[test]
+        #[cfg_attr(debug_assertions, ignore = "10⁵–10⁶ photons: run with --release")]
+        fn $name() {
+            check($case, $photons, $seed);
+        }
+    )*};
 }
 
-#[test]
-#[cfg_attr(debug_assertions, ignore = "10⁵–10⁶ photons: run with --release")]
-fn light_skin_550_nm_matches_mcml() {
-    check("light-550", 160_000, 0x4D43_0550);
-}
-
-#[test]
-#[cfg_attr(debug_assertions, ignore = "10⁵–10⁶ photons: run with --release")]
-fn light_skin_650_nm_matches_mcml() {
-    check("light-650", 120_000, 0x4D43_0650);
-}
-
-#[test]
-#[cfg_attr(debug_assertions, ignore = "10⁵–10⁶ photons: run with --release")]
-fn dark_skin_450_nm_matches_mcml() {
-    check("dark-450", 4_000_000, 0x4D44_0450);
-}
-
-#[test]
-#[cfg_attr(debug_assertions, ignore = "10⁵–10⁶ photons: run with --release")]
-fn dark_skin_650_nm_matches_mcml() {
-    check("dark-650", 800_000, 0x4D44_0650);
-}
-
-#[test]
-#[cfg_attr(debug_assertions, ignore = "10⁵–10⁶ photons: run with --release")]
-fn half_space_matches_mcml() {
-    check("half-space", 80_000, 0x4D48_0001);
+mcml_cases! {
+    light_skin_450_nm_matches_mcml: "light-450", 160_000, 0x4D43_0450;
+    light_skin_550_nm_matches_mcml: "light-550", 160_000, 0x4D43_0550;
+    light_skin_650_nm_matches_mcml: "light-650", 120_000, 0x4D43_0650;
+    dark_skin_450_nm_matches_mcml: "dark-450", 4_000_000, 0x4D44_0450;
+    dark_skin_650_nm_matches_mcml: "dark-650", 800_000, 0x4D44_0650;
+    half_space_matches_mcml: "half-space", 80_000, 0x4D48_0001;
 }

@@ -9,8 +9,8 @@
 
 use super::matrix::{Mat, Singular};
 use super::quadrature::legendre_with_derivative;
-use std::collections::HashMap;
-use std::sync::{Arc, Mutex, OnceLock};
+use super::memo::{Memo, memoized};
+use std::sync::{Arc, OnceLock};
 
 /// Quadrature directions inside the slab, shared by every layer of a stack.
 #[derive(Debug, Clone)]
@@ -139,9 +139,7 @@ pub(crate) fn redistribution(angles: &Angles, g: f64) -> (Mat, Mat) {
 /// neither of which changes with λ, and costs about n³ operations to build. Keyed by (n, first node,
 /// last weight, g) bits, which identify a grid of this module; a few entries per process.
 fn redistribution_cached(angles: &Angles, g: f64) -> Arc<(Mat, Mat)> {
-    type Key = (usize, u64, u64, u64);
-    type Cache = Mutex<HashMap<Key, Arc<(Mat, Mat)>>>;
-    static CACHE: OnceLock<Cache> = OnceLock::new();
+    static MEMO: Memo<(usize, u64, u64, u64), (Mat, Mat)> = OnceLock::new();
     let n = angles.n();
     let key = (
         n,
@@ -149,15 +147,7 @@ fn redistribution_cached(angles: &Angles, g: f64) -> Arc<(Mat, Mat)> {
         angles.w[n - 1].to_bits(),
         g.to_bits(),
     );
-    let cache = CACHE.get_or_init(|| Mutex::new(HashMap::new()));
-    // A poisoned lock only means another thread panicked mid-insert of an independent entry: the map
-    // is still valid, so recover it rather than fail.
-    if let Some(hit) = cache.lock().unwrap_or_else(|e| e.into_inner()).get(&key) {
-        return Arc::clone(hit);
-    }
-    let built = Arc::new(redistribution(angles, g));
-    let mut map = cache.lock().unwrap_or_else(|e| e.into_inner());
-    Arc::clone(map.entry(key).or_insert(built))
+    memoized(&MEMO, key, || redistribution(angles, g))
 }
 
 /// δ-M rescaling: (albedo, optical thickness) → (a*, τ*) with f = g^M ([Prahl95] §3.5):

@@ -3,6 +3,8 @@
 
 pub(crate) use brdf::quadrature::{Rule, gauss, legendre_with_derivative, radau};
 
+use super::memo::{Memo, memoized};
+
 /// The angular grid inside the slab: `n` nodes in (0, 1], the last one μ = 1.
 ///
 /// With no critical angle (`mu_critical` = 0) it is one Radau rule on [0, 1]. Otherwise, as Prahl does,
@@ -28,19 +30,8 @@ pub(crate) fn slab_rule(n: usize, mu_critical: f64) -> Rule {
 /// [`slab_rule`] built once per (n, μc) and shared: every wavelength of a spectrum uses the same
 /// grid, and the Newton iterations for the nodes cost as much as a small layer solve.
 pub(crate) fn slab_rule_cached(n: usize, mu_critical: f64) -> std::sync::Arc<Rule> {
-    use std::collections::HashMap;
-    use std::sync::{Arc, Mutex, OnceLock};
-    type Cache = Mutex<HashMap<(usize, u64), Arc<Rule>>>;
-    static CACHE: OnceLock<Cache> = OnceLock::new();
-    let key = (n, mu_critical.to_bits());
-    let cache = CACHE.get_or_init(|| Mutex::new(HashMap::new()));
-    // A poisoned lock only means another thread panicked mid-insert of an independent entry.
-    if let Some(hit) = cache.lock().unwrap_or_else(|e| e.into_inner()).get(&key) {
-        return Arc::clone(hit);
-    }
-    let built = Arc::new(slab_rule(n, mu_critical));
-    let mut map = cache.lock().unwrap_or_else(|e| e.into_inner());
-    Arc::clone(map.entry(key).or_insert(built))
+    static MEMO: Memo<(usize, u64), Rule> = std::sync::OnceLock::new();
+    memoized(&MEMO, (n, mu_critical.to_bits()), || slab_rule(n, mu_critical))
 }
 
 #[cfg(test)]
