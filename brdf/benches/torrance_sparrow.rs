@@ -18,6 +18,15 @@ fn random_dir(rng: &mut Xoshiro256PlusPlus) -> Vec3 {
     Vec3::new(s * phi.cos(), s * phi.sin(), c)
 }
 
+/// One batch: the sum of `f` over the (opaque to the optimiser) direction pairs.
+fn over_pairs(pairs: &[(Vec3, Vec3)], f: impl Fn(Vec3, Vec3) -> f32) -> f32 {
+    let mut acc = 0.0f32;
+    for &(wo, wi) in black_box(pairs) {
+        acc += f(wo, wi);
+    }
+    acc
+}
+
 fn bench(c: &mut Criterion) {
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(1);
     let pairs: Vec<(Vec3, Vec3)> = (0..BATCH)
@@ -31,13 +40,7 @@ fn bench(c: &mut Criterion) {
     for m in [0.1f32, 0.3] {
         let ts = TorranceSparrow::new(m, 0.25, 1.4).expect("valid parameters");
         group.bench_function(BenchmarkId::new("eval", format!("m{m}")), |b| {
-            b.iter(|| {
-                let mut acc = 0.0f32;
-                for &(wo, wi) in black_box(&pairs) {
-                    acc += ts.eval(wo, wi);
-                }
-                black_box(acc)
-            });
+            b.iter(|| black_box(over_pairs(&pairs, |wo, wi| ts.eval(wo, wi))));
         });
         group.bench_function(BenchmarkId::new("sample", format!("m{m}")), |b| {
             b.iter(|| {
@@ -51,13 +54,7 @@ fn bench(c: &mut Criterion) {
             });
         });
         group.bench_function(BenchmarkId::new("pdf", format!("m{m}")), |b| {
-            b.iter(|| {
-                let mut acc = 0.0f32;
-                for &(wo, wi) in black_box(&pairs) {
-                    acc += ts.pdf(wo, wi);
-                }
-                black_box(acc)
-            });
+            b.iter(|| black_box(over_pairs(&pairs, |wo, wi| ts.pdf(wo, wi))));
         });
     }
     let ts = TorranceSparrow::new(0.3, 0.25, 1.4).expect("valid parameters");

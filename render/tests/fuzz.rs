@@ -9,6 +9,8 @@
 //! FUZZ_CASES=5000 FUZZ_SEED=1 cargo test -p render --release --test fuzz -- --nocapture --include-ignored
 //! ```
 
+mod common;
+
 use proptest::prelude::*;
 use proptest::strategy::ValueTree;
 use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
@@ -219,15 +221,7 @@ fn glb_bytes() -> impl Strategy<Value = Vec<u8>> {
 
 /// A valid 2×2 EXR written by the `exr` crate with bytes of its header overwritten.
 fn exr_bytes() -> impl Strategy<Value = Vec<u8>> {
-    use exr::prelude::*;
-    let mut base = Vec::new();
-    Image::from_channels(
-        (2, 2),
-        SpecificChannels::rgb(|_: Vec2<usize>| (0.5f32, 0.5f32, 0.5f32)),
-    )
-    .write()
-    .to_buffered(std::io::Cursor::new(&mut base))
-    .unwrap();
+    let base = common::grey_exr_2x2();
     let header_len = base.len().min(400);
     prop::collection::vec((0..header_len, any::<u8>()), 1..6).prop_map(move |edits| {
         let mut b = base.clone();

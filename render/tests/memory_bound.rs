@@ -2,6 +2,8 @@
 //! 2 GiB: every one must end in a clean error (exit 1 or 2), never an abort, a crash or a kill
 //! for memory.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -99,16 +101,8 @@ fn glb_node_dag_with_2_pow_40_paths_is_refused_within_2_gib() {
 
 #[test]
 fn exr_declaring_100000_by_100000_is_refused_within_2_gib() {
-    use exr::prelude::*;
     let d = dir("exr");
-    let mut bytes = Vec::new();
-    Image::from_channels(
-        (2, 2),
-        SpecificChannels::rgb(|_: Vec2<usize>| (0.5f32, 0.5f32, 0.5f32)),
-    )
-    .write()
-    .to_buffered(std::io::Cursor::new(&mut bytes))
-    .unwrap();
+    let mut bytes = common::grey_exr_2x2();
     let key = b"dataWindow\0box2i\0";
     let at = bytes.windows(key.len()).position(|w| w == key).unwrap() + key.len() + 4;
     bytes[at + 8..at + 12].copy_from_slice(&99_999i32.to_le_bytes());

@@ -184,16 +184,8 @@ impl SkinParams {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::test_util::{rel, wl};
     use proptest::prelude::*;
-
-    fn wl(nm: f64) -> Wavelength {
-        Wavelength::new(nm).unwrap()
-    }
-
-    /// Relative difference, for the 1e-9 hand-computed checks.
-    fn rel(a: f64, b: f64) -> f64 {
-        (a - b).abs() / b.abs()
-    }
 
     // Hand-computed from the printed formulas (double precision, independent of this code):
     // e.g. eq. 2 at 400 nm: 6.6e10 · 400^−3.33 = 6.6e10 · e^(−3.33 · ln 400) = 142.78551898613...

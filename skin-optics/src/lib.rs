@@ -13,6 +13,8 @@ pub mod params;
 pub mod physiology;
 pub mod spectrum;
 mod table;
+#[cfg(test)]
+mod test_util;
 pub mod units;
 
 pub use chromophores::{LayerCoefficients, SkinCoefficients};

@@ -284,12 +284,8 @@ pub fn run(
             .collect();
         chart = chart.with_series(Series::line(v.name, pts).with_style(SeriesStyle::LinePoints));
     }
-    save_png(
-        &out.join("noise_vs_time.png"),
-        &[Panel::Line(chart)],
-        900,
-        600,
-    )?;
+    let png = out.join("noise_vs_time.png");
+    save_png(&png, &[Panel::Line(chart)], 900, 600)?;
     Ok(rows)
 }
 

@@ -171,23 +171,20 @@ mod tests {
     #[test]
     fn light_skin_diffusion_is_close_and_dark_skin_is_not() {
         let lambda = Wavelength::new(550.0).unwrap();
-        let light = explain(
-            &SkinParams::preset(Preset::Light),
-            lambda,
-            Method::Exact,
-            Some(ExactShape::default()),
-        )
-        .unwrap();
+        let at = |preset, method| {
+            explain(
+                &SkinParams::preset(preset),
+                lambda,
+                method,
+                Some(ExactShape::default()),
+            )
+            .unwrap()
+        };
+        let light = at(Preset::Light, Method::Exact);
         // BENCHMARKS.md `## Exact method`: light skin within −2.2% to +3.1% over 400–700 nm.
         assert!(light.diffusion_error().abs() < 0.035, "{light}");
         assert!(light.epidermis_albedo_prime > 0.9, "{light}");
-        let dark = explain(
-            &SkinParams::preset(Preset::Dark),
-            lambda,
-            Method::Multipole,
-            Some(ExactShape::default()),
-        )
-        .unwrap();
+        let dark = at(Preset::Dark, Method::Multipole);
         // Dark skin: diffusion at least 60% too bright, low-albedo epidermis; no profile factors asked.
         assert!(dark.diffusion_error() > 0.6, "{dark}");
         assert!(dark.epidermis_albedo_prime < light.epidermis_albedo_prime);

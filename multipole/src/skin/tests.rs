@@ -13,22 +13,11 @@ fn exact_method_gives_adding_doubling_totals_and_rescaled_profiles() {
     let obs = diffuse_reflectance(&light, lambda, Method::Exact).unwrap();
     assert!((obs - 0.4370).abs() < 0.005 * 0.4370, "{obs}");
     let total = total_reflectance(&light, lambda, Method::Exact).unwrap();
-    let p = profile(&light, lambda, Method::Exact, &ProfileOptions::default()).unwrap();
+    let opts = ProfileOptions::default();
+    let p = profile(&light, lambda, Method::Exact, &opts).unwrap();
     assert!((p.total() - total).abs() < 1e-12);
-    let m = profile(
-        &light,
-        lambda,
-        Method::Multipole,
-        &ProfileOptions::default(),
-    )
-    .unwrap();
-    let r = exact_profile(
-        &light,
-        lambda,
-        ExactShape::RescaledTotal,
-        &ProfileOptions::default(),
-    )
-    .unwrap();
+    let m = profile(&light, lambda, Method::Multipole, &opts).unwrap();
+    let r = exact_profile(&light, lambda, ExactShape::RescaledTotal, &opts).unwrap();
     assert!((r.total() - total).abs() < 1e-12);
     let ratio = r.eval(0.5) / m.eval(0.5);
     assert!((ratio - total / m.total()).abs() < 1e-9, "same shape");

@@ -182,3 +182,17 @@ pub fn stdout(o: &Output) -> String {
 pub fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
+
+/// A valid 2×2 grey (0.5) RGB OpenEXR file written by the `exr` crate, for tests that corrupt it.
+pub fn grey_exr_2x2() -> Vec<u8> {
+    use exr::prelude::*;
+    let mut bytes = Vec::new();
+    Image::from_channels(
+        (2, 2),
+        SpecificChannels::rgb(|_: Vec2<usize>| (0.5f32, 0.5f32, 0.5f32)),
+    )
+    .write()
+    .to_buffered(std::io::Cursor::new(&mut bytes))
+    .unwrap();
+    bytes
+}

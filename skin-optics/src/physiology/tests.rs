@@ -1,13 +1,6 @@
 use super::*;
+use crate::test_util::{rel, wl};
 use crate::{Preset, SkinParams};
-
-fn wl(nm: f64) -> Wavelength {
-    Wavelength::new(nm).unwrap()
-}
-
-fn rel(a: f64, b: f64) -> f64 {
-    (a - b).abs() / b.abs()
-}
 
 #[test]
 fn bilirubin_peaks_at_the_scaled_55000_near_451nm() {

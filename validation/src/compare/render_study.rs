@@ -399,11 +399,7 @@ fn time_chart(study: RenderStudy, case: &Case, out: &Path) -> anyhow::Result<Str
     for s in series {
         chart = chart.with_series(s);
     }
-    save_png(
-        &out.join("render_time.png"),
-        &[Panel::Line(chart)],
-        900,
-        600,
-    )?;
+    let png = out.join("render_time.png");
+    save_png(&png, &[Panel::Line(chart)], 900, 600)?;
     Ok(lines)
 }

@@ -103,18 +103,9 @@ fn check(preset: Preset, nm: f64, case: &str) {
     );
 }
 
-/// One `#[test]` per case: test name, preset, wavelength (nm), committed MCML case.
-macro_rules! table_cases {
-    ($($name:ident: $preset:expr, $nm:expr, $case:literal;)*) => {$(
-        #[test]
-        #[cfg_attr(debug_assertions, ignore = "builds a renderer table: run with --release")]
-        fn $name() {
-            check($preset, $nm, $case);
-        }
-    )*};
-}
-
-table_cases! {
+// One test per case: test name, preset, wavelength (nm), committed MCML case.
+release_cases! {
+    check, "builds a renderer table: run with --release";
     render_table_light_550_nm_matches_mcml: Preset::Light, 550.0, "light-550";
     render_table_dark_450_nm_matches_mcml: Preset::Dark, 450.0, "dark-450";
 }

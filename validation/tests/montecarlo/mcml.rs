@@ -105,18 +105,9 @@ fn check(name: &str, photons: u64, seed: u64) {
     );
 }
 
-/// One `#[test]` per committed MCML case: test name, case, our photon count, seed.
-macro_rules! mcml_cases {
-    ($($name:ident: $case:literal, $photons:expr, $seed:expr;)*) => {$(
-        #[test]
-        #[cfg_attr(debug_assertions, ignore = "10⁵–10⁶ photons: run with --release")]
-        fn $name() {
-            check($case, $photons, $seed);
-        }
-    )*};
-}
-
-mcml_cases! {
+// One test per committed MCML case: test name, case, our photon count, seed.
+release_cases! {
+    check, "10⁵–10⁶ photons: run with --release";
     light_skin_450_nm_matches_mcml: "light-450", 160_000, 0x4D43_0450;
     light_skin_550_nm_matches_mcml: "light-550", 160_000, 0x4D43_0550;
     light_skin_650_nm_matches_mcml: "light-650", 120_000, 0x4D43_0650;
