@@ -6,7 +6,7 @@
 use render::bssrdf::{Directional, EnergySplit};
 mod common;
 
-use common::{SceneText, mean_xyz, run, xyz_of};
+use common::{SceneText, assert_finite_non_negative, mean_xyz, run, xyz_of};
 use glam::Vec3;
 use skin_optics::color::d65;
 use skin_optics::{Preset, SkinParams, Wavelength};
@@ -152,16 +152,7 @@ fn skin_sphere_in_a_white_furnace_never_exceeds_the_environment() {
                 );
             }
         }
-        let (w, h) = film.size();
-        for py in 0..h {
-            for px in 0..w {
-                let v = film.xyz(px, py);
-                assert!(
-                    v.iter().all(|x| x.is_finite() && *x >= 0.0),
-                    "pixel {px},{py}: {v:?}"
-                );
-            }
-        }
+        assert_finite_non_negative(&film, "image");
     }
 }
 
@@ -179,18 +170,8 @@ fn edge_parameters_render_finite_non_negative_images() {
             .sphere_light([150.0; 3], 20.0, 30.0)
             .load();
         let film = run(&s, 16, 16, 4, SEED);
-        let (w, h) = film.size();
-        let mut total = 0.0;
-        for py in 0..h {
-            for px in 0..w {
-                let v = film.xyz(px, py);
-                assert!(
-                    v.iter().all(|x| x.is_finite() && *x >= 0.0),
-                    "C_m {melanin} C_h {hemoglobin}: {v:?}"
-                );
-                total += v[1];
-            }
-        }
-        assert!(total > 0.0, "C_m {melanin} C_h {hemoglobin}: black image");
+        let what = format!("C_m {melanin} C_h {hemoglobin}");
+        assert_finite_non_negative(&film, &what);
+        assert!(mean_xyz(&film)[1] > 0.0, "{what}: black image");
     }
 }

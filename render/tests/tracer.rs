@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{SceneText, assert_close, mean_xyz, plane, run, white_furnace, xyz_of};
+use common::{SceneText, assert_close, film_mean, mean_xyz, plane, run, white_furnace, xyz_of};
 use render::renderer::{RenderOptions, TILE, render};
 use render::scene::{Scene, SceneOptions};
 
@@ -47,16 +47,7 @@ fn d65_white_plane_is_srgb_white() {
         .diffuse("white", 1.0)
         .load();
     let film = run(&s, 32, 32, 8, SEED);
-    let (w, h) = film.size();
-    let mut rgb = [0.0f64; 3];
-    for y in 0..h {
-        for x in 0..w {
-            let v = film.linear_srgb(x, y);
-            for c in 0..3 {
-                rgb[c] += f64::from(v[c]) / (w * h) as f64;
-            }
-        }
-    }
+    let rgb = film_mean(&film, |x, y| film.linear_srgb(x, y));
     assert_close(rgb, [1.0; 3], 0.01, "linear sRGB");
     // One stop down: 0.5 through the tone curve, equal in all channels.
     let png = film.to_srgb8(-1.0);

@@ -2,7 +2,7 @@
 //! the distant light.
 
 use super::{LightSample, facing, selection};
-use crate::spectrum::{SampledWavelengths, SpectrumTable};
+use crate::spectrum::{SampledSpectrum, SampledWavelengths, SpectrumTable};
 use glam::Vec3;
 
 /// Isotropic point light.
@@ -18,15 +18,8 @@ impl PointLight {
     /// The light arriving at `p`: intensity / d².
     #[must_use]
     pub fn sample(&self, p: Vec3, wl: &SampledWavelengths) -> Option<LightSample> {
-        let d = self.position_mm - p;
-        let r2 = d.length_squared();
-        Some(LightSample {
-            wi: d / r2.sqrt(),
-            distance_mm: r2.sqrt(),
-            li: self.intensity.eval(wl) / r2,
-            pdf: 1.0,
-            is_delta: true,
-        })
+        let (wi, r2) = towards(self.position_mm, p);
+        Some(delta(wi, r2.sqrt(), self.intensity.eval(wl) / r2))
     }
 
     /// Selection proxy at `p` with normal `n`: intensity / d² times the cosine.
@@ -55,26 +48,36 @@ impl SpotLight {
     /// The light arriving at `p`: intensity / d² times the smoothstep falloff (None outside the cone).
     #[must_use]
     pub fn sample(&self, p: Vec3, wl: &SampledWavelengths) -> Option<LightSample> {
-        let d = self.position_mm - p;
-        let r2 = d.length_squared();
-        let wi = d / r2.sqrt();
+        let (wi, r2) = towards(self.position_mm, p);
         let cos = (-wi).dot(self.direction);
         let x =
             ((cos - self.cos_outer) / (self.cos_inner - self.cos_outer).max(1e-6)).clamp(0.0, 1.0);
         let falloff = x * x * (3.0 - 2.0 * x);
-        (falloff > 0.0).then(|| LightSample {
-            wi,
-            distance_mm: r2.sqrt(),
-            li: self.intensity.eval(wl) * (falloff / r2),
-            pdf: 1.0,
-            is_delta: true,
-        })
+        (falloff > 0.0).then(|| delta(wi, r2.sqrt(), self.intensity.eval(wl) * (falloff / r2)))
     }
 
     /// Selection proxy at `p` with normal `n`: as a point light (the cone is ignored).
     #[must_use]
     pub fn selection_weight(&self, p: Vec3, n: Vec3) -> f32 {
         inverse_square_weight(self.position_mm, &self.intensity, p, n)
+    }
+}
+
+/// Unit direction from `p` to `position_mm`, and the squared distance, mm².
+fn towards(position_mm: Vec3, p: Vec3) -> (Vec3, f32) {
+    let d = position_mm - p;
+    let r2 = d.length_squared();
+    (d / r2.sqrt(), r2)
+}
+
+/// A delta light's sample: `li` arriving from `wi`, emitted `distance_mm` away (pdf 1).
+fn delta(wi: Vec3, distance_mm: f32, li: SampledSpectrum) -> LightSample {
+    LightSample {
+        wi,
+        distance_mm,
+        li,
+        pdf: 1.0,
+        is_delta: true,
     }
 }
 
@@ -98,13 +101,11 @@ impl DistantLight {
     /// The irradiance from the light's direction.
     #[must_use]
     pub fn sample(&self, wl: &SampledWavelengths) -> Option<LightSample> {
-        Some(LightSample {
-            wi: self.to_light,
-            distance_mm: f32::INFINITY,
-            li: self.irradiance.eval(wl),
-            pdf: 1.0,
-            is_delta: true,
-        })
+        Some(delta(
+            self.to_light,
+            f32::INFINITY,
+            self.irradiance.eval(wl),
+        ))
     }
 
     /// Selection proxy with normal `n`: E times the cosine.

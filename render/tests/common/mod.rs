@@ -128,17 +128,36 @@ pub fn run(scene: &Scene, w: usize, h: usize, spp: u32, seed: u64) -> Film {
 
 /// Mean XYZ over the whole film.
 pub fn mean_xyz(film: &Film) -> [f64; 3] {
+    film_mean(film, |x, y| film.xyz(x, y))
+}
+
+/// Mean over the whole film of a per-pixel triple `value(x, y)` (XYZ, linear sRGB, ...).
+pub fn film_mean(film: &Film, value: impl Fn(usize, usize) -> [f32; 3]) -> [f64; 3] {
     let (w, h) = film.size();
     let mut s = [0.0f64; 3];
     for y in 0..h {
         for x in 0..w {
-            let v = film.xyz(x, y);
+            let v = value(x, y);
             for c in 0..3 {
                 s[c] += f64::from(v[c]);
             }
         }
     }
     s.map(|v| v / (w * h) as f64)
+}
+
+/// Fail, naming `what` and the pixel, unless every XYZ value of `film` is finite and ≥ 0.
+pub fn assert_finite_non_negative(film: &Film, what: &str) {
+    let (w, h) = film.size();
+    for y in 0..h {
+        for x in 0..w {
+            let v = film.xyz(x, y);
+            assert!(
+                v.iter().all(|c| c.is_finite() && *c >= 0.0),
+                "{what}: pixel {x},{y}: {v:?}"
+            );
+        }
+    }
 }
 
 /// XYZ of a spectrum s(λ) over the rendered range 380–780 nm, normalised like the film
