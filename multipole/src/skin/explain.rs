@@ -189,20 +189,16 @@ mod tests {
         assert!(dark.diffusion_error() > 0.6, "{dark}");
         assert!(dark.epidermis_albedo_prime < light.epidermis_albedo_prime);
         assert!(dark.profile_scales.is_none());
-        let text = dark.to_string();
-        assert!(
-            text.contains("550 nm")
-                && text.contains("wrong here")
-                && text.contains("--method exact"),
-            "{text}"
-        );
-        let text = light.to_string();
-        assert!(
-            text.contains("adding-doubling")
-                && text.contains("dermis R ×")
-                && text.contains("white Monte Carlo table"),
-            "{text}"
-        );
+        for (e, words) in [
+            (&dark, ["550 nm", "wrong here", "--method exact"]),
+            (
+                &light,
+                ["adding-doubling", "dermis R ×", "white Monte Carlo table"],
+            ),
+        ] {
+            let text = e.to_string();
+            assert!(words.iter().all(|w| text.contains(w)), "{text}");
+        }
         // The final correction of the per-layer profile is small (the scalars ignore angles only).
         let (_, corr) = light.profile_scales.unwrap();
         assert!((corr - 1.0).abs() < 0.02, "{corr}");

@@ -140,9 +140,7 @@ pub fn run(args: &ProfileArgs) -> anyhow::Result<()> {
     let stdout = std::io::stdout();
     let mut out = BufWriter::new(stdout.lock());
     writeln!(out, "r_mm,reflectance_per_mm2")?;
-    for (r, v) in prof.radii_mm().iter().zip(prof.reflectance_per_mm2()) {
-        writeln!(out, "{r:.6e},{v:.6e}")?;
-    }
+    write_rows(&mut out, "", &prof)?;
     out.flush()?;
     eprintln!(
         "R_d = {:.5} (model, per unit flux entering), r99 = {:.4} mm, r_max = {:.4} mm, method {}",
@@ -152,6 +150,14 @@ pub fn run(args: &ProfileArgs) -> anyhow::Result<()> {
         args.method
     );
     plot(args, &skin, &opts)
+}
+
+/// One CSV row `{prefix}r,R(r)` per radius of `p`.
+fn write_rows(out: &mut impl Write, prefix: &str, p: &Profile) -> std::io::Result<()> {
+    for (r, v) in p.radii_mm().iter().zip(p.reflectance_per_mm2()) {
+        writeln!(out, "{prefix}{r:.6e},{v:.6e}")?;
+    }
+    Ok(())
 }
 
 /// The spectral set `--from`..`--to` every `--step` nm: one CSV row per (λ, r).
@@ -171,9 +177,7 @@ fn run_spectral(
     for (i, p) in set.profiles().iter().enumerate() {
         let p = on_requested_radii(p.clone(), opts)?;
         let nm = grid.wavelength(i).nm();
-        for (r, v) in p.radii_mm().iter().zip(p.reflectance_per_mm2()) {
-            writeln!(out, "{nm},{r:.6e},{v:.6e}")?;
-        }
+        write_rows(&mut out, &format!("{nm},"), &p)?;
     }
     out.flush()?;
     eprintln!(
