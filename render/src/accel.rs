@@ -4,6 +4,10 @@
 //! The triangles are kept as `RtTriangle`s in the BVH's leaf order, so the traversal closure
 //! indexes them directly; barycentrics come from `RtTriangle::compute_barycentric`
 //! (obvhs 0.4's `Triangle::compute_barycentric` is scaled wrongly, see docs/crates.md §3).
+//!
+//! The tests spell out their triangles and queries in full (the random-ray tests share their setup
+//! through `soup_and_rays` and differ in what they check) so that each states the whole case it
+//! checks.
 
 use glam::{Vec2, Vec3, Vec3A};
 use obvhs::{

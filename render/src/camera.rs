@@ -133,17 +133,10 @@ mod tests {
 
     #[test]
     fn centre_ray_looks_at_target_and_corners_match_fov() {
-        let c = Camera::new(
-            Vec3::new(0.0, 0.0, 100.0),
-            Vec3::ZERO,
-            Vec3::Y,
-            90.0,
-            0.0,
-            None,
-        )
-        .unwrap();
+        let eye = Vec3::new(0.0, 0.0, 100.0);
+        let c = Camera::new(eye, Vec3::ZERO, Vec3::Y, 90.0, 0.0, None).unwrap();
         let (o, d) = c.generate_ray(Vec2::splat(0.5), 1.0, Vec2::ZERO);
-        assert_eq!(o, Vec3::new(0.0, 0.0, 100.0));
+        assert_eq!(o, eye);
         assert!((d - Vec3::NEG_Z).length() < 1e-6);
         // Top edge of a 90° vertical fov is 45° up.
         let (_, d) = c.generate_ray(Vec2::new(0.5, 0.0), 1.0, Vec2::ZERO);
@@ -159,14 +152,8 @@ mod tests {
 
     #[test]
     fn camera_position_that_overflows_is_blamed_on_the_position_not_up() {
-        let r = Camera::new(
-            Vec3::new(3e38, 0.0, 0.0),
-            Vec3::ZERO,
-            Vec3::Y,
-            40.0,
-            0.0,
-            None,
-        );
+        let far = Vec3::new(3e38, 0.0, 0.0);
+        let r = Camera::new(far, Vec3::ZERO, Vec3::Y, 40.0, 0.0, None);
         assert_eq!(error_key(r), "camera.position_mm");
         let r = Camera::new(Vec3::Z, Vec3::splat(-3e38), Vec3::Y, 40.0, 0.0, None);
         assert_eq!(error_key(r), "camera.look_at_mm");

@@ -38,6 +38,9 @@
 //! temperature_k = 5500
 //! intensity = 20
 //! ```
+//!
+//! The light variants repeat the same field shape (a documented key with its serde checker) because
+//! each kind of light has its own keys; the checkers are shared.
 
 use serde::Deserialize;
 use serde::de::{Deserializer, Error as _};

@@ -1,6 +1,9 @@
 //! `skin render` run as a binary: flag errors (exit code 2, one line naming the flag, nothing
 //! written), and tiny end-to-end renders with `--method multipole` and `--no-subsurface` whose
 //! outputs are a valid EXR and PNG of the requested size.
+//!
+//! Each flag error is its own one-line test so that a failure names the flag; the scene texts are
+//! spelled out in TOML where the test is about exactly what a user writes.
 
 mod common;
 

@@ -1,6 +1,9 @@
 //! Absorption and reduced scattering of skin's chromophores, mm⁻¹ ([DJ06] eqs 1–6).
 //!
 //! The only home of these laws in the workspace: everyone else calls them.
+//!
+//! Each equation's hand-computed check is its own test, spelled out with its printed constants, so
+//! that a failure names the equation and a reader can redo the arithmetic.
 
 use crate::params::SkinParams;
 use crate::physiology;

@@ -9,6 +9,9 @@
 //! - **Spectral** (pbrt-v4, Mitsuba 3, MCML, MCX): the layers' σa, σs, g, n and thickness per
 //!   wavelength ([`spectral::SpectralSkin`]), exact by construction where the program takes two layers;
 //!   pbrt's `subsurface` takes one, so it gets the single layer that returns our total.
+//!
+//! [`Format`]'s `Display`/`FromStr` pair follows the same pattern as `ColourSpace`'s (canonical
+//! name out, names in, case-insensitive); the names and the error type are each type's own.
 
 pub mod burley;
 pub mod colour;

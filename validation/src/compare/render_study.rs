@@ -15,6 +15,10 @@
 //! The error-against-time chart renders one case (the sphere, light skin) with both integrators at
 //! increasing spp, each image's RMS relative error taken against a separate volumetric run at the
 //! largest count, CPU seconds of the process on the x axis.
+//!
+//! `timed` builds its `RenderOptions` like `render`'s test helper `tests/common::run` does: a
+//! library crate cannot use another crate's test scaffolding, and here the CPU time is measured
+//! around the render.
 
 use anyhow::Context;
 use render::film::Film;

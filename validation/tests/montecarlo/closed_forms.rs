@@ -1,4 +1,7 @@
 //! Cases with exact answers: clear slabs, Fresnel multiple reflection, no-absorption slabs.
+//!
+//! Each case builds its layers and calls the transport in full (as the Monte Carlo's own unit tests
+//! do), so that a reader sees the whole physical setup beside the closed form it must meet.
 
 use super::photons;
 use brdf::fresnel::normal_incidence_reflectance;
