@@ -3,6 +3,7 @@
 
 use super::{ShapeTable, ShapeTableOptions};
 use crate::error::MultipoleError;
+use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, PoisonError};
 
@@ -86,20 +87,40 @@ fn read(path: &Path, g: f64, n: f64, opts: &ShapeTableOptions) -> Option<ShapeTa
     Some(table)
 }
 
-/// Write `table` to `path` through a temporary file in the same directory and a rename, so a
-/// reader never sees a half-written table.
+/// Write `table` to `path` through a uniquely named temporary file in the same directory
+/// (`tempfile`), persisted onto the path: a reader never sees a half-written table, and two
+/// writers never share a temporary.
 fn write(path: &Path, table: &ShapeTable) -> std::io::Result<()> {
-    if let Some(dir) = path.parent() {
-        std::fs::create_dir_all(dir)?;
-    }
+    let dir = path.parent().unwrap_or(Path::new("."));
+    std::fs::create_dir_all(dir)?;
     let mut bytes = Vec::with_capacity(MAGIC.len() + 4 * table.counts.len());
     bytes.extend_from_slice(MAGIC);
     for c in &table.counts {
         bytes.extend_from_slice(&c.to_le_bytes());
     }
-    let tmp = path.with_extension(format!("tmp{}", std::process::id()));
-    std::fs::write(&tmp, &bytes)?;
-    std::fs::rename(&tmp, path).inspect_err(|_| {
-        let _ = std::fs::remove_file(&tmp);
-    })
+    let mut tmp = tempfile::NamedTempFile::new_in(dir)?;
+    tmp.write_all(&bytes)?;
+    tmp.persist(path).map_err(|e| e.error)?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_written_table_reads_back_whole_and_leaves_no_temporary() {
+        let dir = tempfile::tempdir().unwrap();
+        let opts = ShapeTableOptions::default();
+        let mut table = ShapeTable::empty(0.9, 1.4, opts);
+        for (i, c) in table.counts.iter_mut().enumerate() {
+            *c = i as f32;
+        }
+        let path = dir.path().join("new").join(file_name(0.9, 1.4, &opts));
+        write(&path, &table).unwrap();
+        let back = read(&path, 0.9, 1.4, &opts).expect("a complete table");
+        assert_eq!(back.counts, table.counts);
+        let files = std::fs::read_dir(path.parent().unwrap()).unwrap().count();
+        assert_eq!(files, 1, "only the table itself is left");
+    }
 }
