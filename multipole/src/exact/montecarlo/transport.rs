@@ -5,6 +5,8 @@
 //! (σt = 0) is crossed in one move to its boundary. Interfaces reflect all-or-none with the exact
 //! unpolarised Fresnel probability (MCML's default, [`brdf::fresnel::dielectric_reflectance`]).
 
+mod free_path;
+mod lanes;
 mod sampling;
 #[cfg(test)]
 mod tests;
@@ -13,10 +15,12 @@ pub(crate) mod white;
 use super::tally::{BatchTally, RadialGrid};
 use crate::layered::LayeredMedium;
 use brdf::fresnel::dielectric_reflectance;
+use rand::RngCore;
+#[cfg(test)]
 use rand_distr::{Distribution, Exp1};
 use rand_xoshiro::Xoshiro256StarStar;
 pub use sampling::{HgSampler, scatter_direction};
-use sampling::{scatter, uniform};
+use sampling::{turn, uniform};
 
 /// Russian roulette starts below this weight ([WJZ95] §3.7: 1e-4).
 pub const ROULETTE_THRESHOLD: f64 = 1.0e-4;
@@ -81,13 +85,8 @@ impl Medium {
     }
 }
 
-/// Photons traced side by side in one batch. Each history is a long chain of dependent square
-/// roots and divisions; interleaving independent histories lets the out-of-order core overlap
-/// their chains. Measured on the half-space case (BENCHMARKS.md, "Monte Carlo (validation)"):
-/// 19.9 ns per scattering with 1 lane, 16.8 with 2, 17.0 with 3, 16.9 with 4.
-pub(crate) const LANES: usize = 2;
-
 /// The photon state: position (mm), direction cosines, weight, current layer.
+#[derive(Debug, Clone, Copy)]
 pub(super) struct Photon {
     pub(super) x: f64,
     pub(super) y: f64,
@@ -113,9 +112,31 @@ impl Photon {
             layer: 0,
         }
     }
+
+    /// An interaction `step` mm ahead ([WJZ95] §3.3, §3.6, §3.5): move there, deposit the
+    /// fraction `absorb` = σa/σt of the weight (implicit capture), turn by the drawn polar cosine
+    /// and azimuth. The one home of the interaction: the scalar and the lane paths both call it.
+    #[inline(always)]
+    fn interact(&mut self, step: f64, absorb: f64, cos_t: f64, cos_p: f64, sin_p: f64) {
+        self.x += step * self.ux;
+        self.y += step * self.uy;
+        self.z += step * self.uz;
+        self.w -= self.w * absorb;
+        [self.ux, self.uy, self.uz] = turn([self.ux, self.uy, self.uz], cos_t, cos_p, sin_p);
+    }
+}
+
+/// Does a step from depth `z` along direction cosine `uz` to depth `z_new` reach the face of the
+/// layer [`z_top`, `z_bottom`] the photon heads for? (No division unless it does.) The sign of u_z
+/// is a coin toss after each scattering, so both tests are evaluated and combined without
+/// short-circuit: a branch on it would be mispredicted half the time.
+#[inline(always)]
+fn reaches_face(uz: f64, z_new: f64, z_top: f64, z_bottom: f64) -> bool {
+    (uz > 0.0) & (z_new >= z_bottom) | (uz < 0.0) & (z_new <= z_top)
 }
 
 /// One history in flight.
+#[derive(Debug, Clone, Copy)]
 struct Lane {
     p: Photon,
     /// Remaining dimensionless step (optical depth) carried over a boundary ([WJZ95] §3.4).
@@ -128,14 +149,17 @@ struct Lane {
 
 impl Lane {
     /// A collimated photon of weight `w0` entering at the origin along +z.
-    fn launch(&mut self, w0: f64) {
-        self.p = Photon::launched(w0);
-        self.s_left = 0.0;
-        self.w_entry = w0;
+    fn launched(w0: f64) -> Self {
+        Self {
+            p: Photon::launched(w0),
+            s_left: 0.0,
+            w_entry: w0,
+        }
     }
 
-    /// One event: an interaction inside the layer or a meeting with a face. Returns true when the
-    /// history has ended (escaped or lost to roulette), its weight tallied.
+    /// One event of the scalar path: an interaction inside the layer or a meeting with a face.
+    /// Returns true when the history has ended (escaped or lost to roulette), its weight tallied.
+    #[cfg(test)]
     #[inline(always)]
     fn step(
         &mut self,
@@ -144,8 +168,7 @@ impl Lane {
         rng: &mut Xoshiro256StarStar,
         tally: &mut BatchTally,
     ) -> bool {
-        let p = &mut self.p;
-        let slab = &slabs[p.layer];
+        let slab = &slabs[self.p.layer];
         let step = if slab.mu_t == 0.0 {
             f64::INFINITY
         } else {
@@ -156,36 +179,52 @@ impl Lane {
             }
             self.s_left * slab.inv_mu_t
         };
-        // Does the step reach the face the photon heads for? (No division unless it does.) The
-        // sign of u_z is a coin toss after each scattering, so both tests are evaluated and
-        // combined without short-circuit: a branch on it would be mispredicted half the time.
-        let z_new = p.z + step * p.uz;
-        let crosses =
-            (p.uz > 0.0) & (z_new >= slab.z_bottom) | (p.uz < 0.0) & (z_new <= slab.z_top);
-        if !crosses {
-            // Interaction inside the layer: move, deposit σa/σt of the weight, scatter.
-            p.x += step * p.ux;
-            p.y += step * p.uy;
-            p.z = z_new;
-            self.s_left = 0.0;
-            p.w -= p.w * slab.absorb_fraction;
-            tally.interactions += 1;
-            scatter(p, &slab.hg, rng);
-            if p.w >= ROULETTE_THRESHOLD {
-                return false;
-            }
-            if uniform(rng) < ROULETTE_SURVIVAL {
-                let gained = p.w * (1.0 / ROULETTE_SURVIVAL - 1.0);
-                tally.roulette_balance -= gained;
-                p.w += gained;
-                self.w_entry += gained;
-                return false;
-            }
-            tally.absorbed_by_layer[p.layer] += self.w_entry - p.w;
-            tally.roulette_balance += p.w;
-            return true;
+        let z_new = self.p.z + step * self.p.uz;
+        if reaches_face(self.p.uz, z_new, slab.z_top, slab.z_bottom) {
+            return self.face(step, slabs, grid, rng, tally);
         }
-        // Hit the face: move there, keep the unused optical depth, cross or reflect.
+        let cos_t = slab.hg.cos_theta(uniform(rng));
+        let (cos_p, sin_p) = sampling::sample_azimuth(rng);
+        self.p.interact(step, slab.absorb_fraction, cos_t, cos_p, sin_p);
+        self.s_left = 0.0;
+        tally.interactions += 1;
+        self.roulette(rng, tally)
+    }
+
+    /// Russian roulette after an interaction ([WJZ95] §3.7): below [`ROULETTE_THRESHOLD`] the
+    /// photon survives with chance [`ROULETTE_SURVIVAL`], its weight raised to keep the
+    /// expectation. Returns true when it died, its deposit tallied.
+    #[inline(always)]
+    fn roulette(&mut self, rng: &mut impl RngCore, tally: &mut BatchTally) -> bool {
+        let p = &mut self.p;
+        if p.w >= ROULETTE_THRESHOLD {
+            return false;
+        }
+        if uniform(rng) < ROULETTE_SURVIVAL {
+            let gained = p.w * (1.0 / ROULETTE_SURVIVAL - 1.0);
+            tally.roulette_balance -= gained;
+            p.w += gained;
+            self.w_entry += gained;
+            return false;
+        }
+        tally.absorbed_by_layer[p.layer] += self.w_entry - p.w;
+        tally.roulette_balance += p.w;
+        true
+    }
+
+    /// The photon meets the face it heads for within `step` mm ([WJZ95] §3.4, §3.8–3.9): move
+    /// there, keep the unused optical depth, reflect or cross (escaping from the stack when it is
+    /// the outer face). Returns true when the history has ended, its weight tallied.
+    fn face(
+        &mut self,
+        step: f64,
+        slabs: &[SlabOptics],
+        grid: RadialGrid,
+        rng: &mut impl RngCore,
+        tally: &mut BatchTally,
+    ) -> bool {
+        let p = &mut self.p;
+        let slab = &slabs[p.layer];
         let up = p.uz < 0.0;
         let d_face = (if up { slab.z_top } else { slab.z_bottom } - p.z) / p.uz;
         p.x += d_face * p.ux;
@@ -244,10 +283,9 @@ impl Lane {
 
 /// Trace `photons` histories into `tally` ([WJZ95] §3–4). `w0` = 1 − R_spec is the launch weight.
 ///
-/// [`LANES`] histories are in flight at once; a lane whose photon ends starts the batch's next one
-/// until `photons` have been launched. The lanes take turns, one event each, drawing from the
-/// batch's one stream, so the result depends only on the batch's generator, never on the thread
-/// count.
+/// The photons run in SIMD lanes ([`lanes`]), each lane with its own generator stream seeded from
+/// the batch's generator, so the result depends only on the batch's generator, never on the
+/// thread count or the instruction set.
 pub(crate) fn trace_batch(
     medium: &Medium,
     grid: RadialGrid,
@@ -256,12 +294,12 @@ pub(crate) fn trace_batch(
     rng: &mut Xoshiro256StarStar,
     tally: &mut BatchTally,
 ) {
-    trace_lanes::<LANES>(medium, grid, w0, photons, rng, tally);
+    lanes::trace(&medium.slabs, grid, w0, photons, rng, tally);
 }
 
-/// [`trace_batch`] with `K` lanes. Its signature repeats `trace_batch`'s on purpose: the wrapper
-/// fixes the lane count for callers, tests run this one at other counts.
-fn trace_lanes<const K: usize>(
+/// The scalar path, one photon at a time: the reference the lanes are tested against.
+#[cfg(test)]
+fn trace_scalar(
     medium: &Medium,
     grid: RadialGrid,
     w0: f64,
@@ -269,39 +307,9 @@ fn trace_lanes<const K: usize>(
     rng: &mut Xoshiro256StarStar,
     tally: &mut BatchTally,
 ) {
-    let slabs = &medium.slabs[..];
-    // A local copy the optimiser can keep in registers; the batch's generator is not reused.
-    let mut rng = rng.clone();
-    let mut lanes: [Lane; K] = std::array::from_fn(|_| {
-        let mut lane = Lane {
-            p: Photon::launched(0.0),
-            s_left: 0.0,
-            w_entry: 0.0,
-        };
-        lane.launch(w0);
-        lane
-    });
-    let mut live = [false; K];
-    let mut launched = 0u64;
-    for l in &mut live {
-        if launched < photons {
-            *l = true;
-            launched += 1;
-        }
-    }
-    let mut n_live = live.iter().filter(|&&l| l).count();
-    while n_live > 0 {
-        for (lane, l) in lanes.iter_mut().zip(live.iter_mut()) {
-            if *l && lane.step(slabs, grid, &mut rng, tally) {
-                if launched < photons {
-                    lane.launch(w0);
-                    launched += 1;
-                } else {
-                    *l = false;
-                    n_live -= 1;
-                }
-            }
-        }
+    for _ in 0..photons {
+        let mut lane = Lane::launched(w0);
+        while !lane.step(&medium.slabs, grid, rng, tally) {}
     }
     tally.photons += photons;
 }
