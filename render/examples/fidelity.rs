@@ -1,67 +1,97 @@
 //! Render time and error of the automatic fidelity against `--fidelity full`, on the far view
-//! (`builtin:three-heads-far`, fifteen heads about 40 px tall) and the close-up (`builtin:ear`):
-//! each scene at a fixed sample count with full fidelity (seed 1: the reference; seed 2: the
-//! noise floor, what a second reference differs by), auto, and auto with a narrower level-of-detail
-//! band. Error: relative RMS over the image's cells (5 × 3 for the far view, one head each; the
-//! whole frame for the ear) of the mean skin luminance, and the per-pixel relative RMS over skin
-//! pixels. Time: process CPU time of the render (`cpu-time`), so it holds on a loaded machine.
-//! Writes OUT/fidelity.csv, OUT/fidelity.png (error against render time) and each render's PNG.
+//! (`builtin:three-heads-far`, fifteen heads about 40 px tall) and the close-up (`builtin:ear`).
 //!
-//! Each configuration has its own seed, so no two renders share their noise; the full-fidelity
-//! render with seed 2 gives the noise floor of the error.
+//! Three questions, one table (OUT/fidelity.csv, chart OUT/fidelity.png, each render's PNG):
+//! - **Where the time goes** at a fixed sample count: full fidelity, auto, auto with a narrower
+//!   level-of-detail band, the level of detail forced on at every skin hit (`collapsed`), and no
+//!   subsurface at all (`--no-subsurface`, the Lambertian stand-in: the floor the level of detail
+//!   cannot go below).
+//! - **Time to the same noise**, what a default render (a per-pixel noise target) costs: full,
+//!   auto, narrow and collapsed rendered to the same noise target, their CPU time compared.
+//! - **Error** of each against a full-fidelity reference at four times the samples (seed 1):
+//!   relative RMS over the image's cells (5 × 3 for the far view, one head each; the whole frame
+//!   for the ear) of the mean skin luminance Y; the per-pixel relative RMS over skin pixels; and
+//!   χ² per skin pixel, (a − b)² / (σa² + σb²) from each render's own variance of the mean: 1 when
+//!   the two differ by noise alone, above 1 by the share of a bias (shadow-edge bleeding the
+//!   stand-in does not have would show here, where the cell mean averages it out).
 //!
-//! `cargo run --release -p render --example fidelity -- [OUT] [SPP_FAR] [SPP_EAR]` (default
-//! out/fidelity, 96, 16)
+//! Time: process CPU time of the render (`cpu-time`), so it holds on a loaded machine. Each
+//! configuration has its own seed, so no two renders share their noise.
+//!
+//! OUT/lod_ratios.csv: for each skin of the far view, the 99% energy radius at 450, 550 and 650 nm
+//! (blue, green, red) and the largest over the table's rows (what the level of detail uses), and the
+//! ratio of the pixel footprint at the skin's mean camera distance to each.
+//!
+//! `cargo run --release -p render --example fidelity -- [OUT] [SPP_FAR] [SPP_EAR] [NOISE]`
+//! (default out/fidelity, 64, 16, 0.1)
 
 use render::fidelity::{Fidelity, FidelityKnobs, LodBand, LodSetting};
+use render::film::Film;
 use render::integrator::PathSettings;
+use render::material::Material;
 use render::passes::Passes;
 use render::plot::{LineChart, Panel, Series, save_png};
 use render::renderer::{RenderOptions, render};
 use render::scene::{Scene, SceneOptions};
 use std::fmt::Write as _;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 const WIDTH: usize = 768;
 const HEIGHT: usize = 384;
+/// Most samples a pixel takes under the noise target.
+const MAX_SPP: u32 = 4096;
+
+/// One configuration to render.
+struct Config {
+    label: &'static str,
+    opts: SceneOptions,
+    seed: u64,
+    spp: u32,
+    noise: Option<f64>,
+}
 
 /// One rendered configuration.
 struct Run {
     label: &'static str,
+    spp: u32,
+    noise: Option<f64>,
+    mean_spp: f64,
     luminance: Vec<f64>,
+    variance: Vec<f64>,
     cpu_s: f64,
     load_s: f64,
 }
 
-fn knobs(fidelity: Fidelity, lod: LodSetting) -> SceneOptions {
+fn knobs(fidelity: Fidelity, lod: LodSetting, no_subsurface: bool) -> SceneOptions {
     SceneOptions {
         fidelity: FidelityKnobs {
             fidelity: Some(fidelity),
             lod,
             ..FidelityKnobs::default()
         },
+        no_subsurface,
         ..SceneOptions::default()
     }
 }
 
-fn render_one(
-    spec: &str,
-    label: &'static str,
-    opts: &SceneOptions,
-    seed: u64,
-    spp: u32,
-    out: &std::path::Path,
-) -> Run {
+fn band(full_below: f32, diffuse_above: f32) -> LodSetting {
+    LodSetting::Band(LodBand {
+        full_below,
+        diffuse_above,
+    })
+}
+
+fn render_one(spec: &str, c: &Config, out: &Path) -> Run {
     let t0 = Instant::now();
-    let scene = Scene::load(spec, opts).expect("built-in scenes load");
+    let scene = Scene::load(spec, &c.opts).expect("built-in scenes load");
     let load_s = t0.elapsed().as_secs_f64();
     let settings = RenderOptions {
         width: WIDTH,
         height: HEIGHT,
-        spp,
-        seed,
-        noise: None,
+        spp: c.noise.map_or(c.spp, |_| MAX_SPP),
+        seed: c.seed,
+        noise: c.noise,
         time_limit: None,
         path: PathSettings {
             pixel_angle_rad: scene.camera.pixel_angle_rad(HEIGHT),
@@ -73,43 +103,67 @@ fn render_one(
     .validate()
     .expect("valid settings");
     let cpu = cpu_time::ProcessTime::now();
-    let (film, _) = render(&scene, &settings).expect("render");
+    let (film, stats) = render(&scene, &settings).expect("render");
     let cpu_s = cpu.elapsed().as_secs_f64();
     let name = spec.trim_start_matches("builtin:");
     film.write_png(
-        &out.join(format!("{name}-{label}.png")),
+        &out.join(format!("{name}-{}.png", c.label)),
         scene.exposure_stops,
     )
     .expect("write png");
-    let luminance = (0..HEIGHT)
-        .flat_map(|y| (0..WIDTH).map(move |x| (x, y)))
-        .map(|(x, y)| f64::from(film.xyz(x, y)[1]))
-        .collect();
-    eprintln!("{spec} {label}: load {load_s:.2} s, render {cpu_s:.1} CPU-s");
+    eprintln!(
+        "{spec} {}: load {load_s:.2} s, render {cpu_s:.1} CPU-s, mean {:.1} spp",
+        c.label, stats.mean_spp
+    );
     Run {
-        label,
-        luminance,
+        label: c.label,
+        spp: c.spp,
+        noise: c.noise,
+        mean_spp: stats.mean_spp,
+        luminance: per_pixel(&film, |f, x, y| f64::from(f.xyz(x, y)[1])),
+        variance: per_pixel(&film, Film::variance),
         cpu_s,
         load_s,
     }
 }
 
-/// (cell relative RMS of the mean skin luminance, per-pixel relative RMS over skin) of `run`
-/// against `reference`, cells `nx` × `ny`.
-fn errors(run: &Run, reference: &Run, skin: &[bool], nx: usize, ny: usize) -> (f64, f64) {
+fn per_pixel(film: &Film, f: impl Fn(&Film, usize, usize) -> f64) -> Vec<f64> {
+    (0..HEIGHT)
+        .flat_map(|y| (0..WIDTH).map(move |x| (x, y)))
+        .map(|(x, y)| f(film, x, y))
+        .collect()
+}
+
+/// How `run` differs from `reference` over the skin pixels.
+struct Errors {
+    /// Relative RMS over the cells of the mean skin luminance.
+    cell: f64,
+    /// Per-pixel relative RMS.
+    pixel: f64,
+    /// Mean of (a − b)² / (σa² + σb²).
+    chi2: f64,
+    /// RMS relative noise of the run's own skin pixels (σ of the mean / mean).
+    noise: f64,
+}
+
+fn errors(run: &Run, reference: &Run, skin: &[bool], nx: usize, ny: usize) -> Errors {
     let mut cells = vec![(0.0, 0.0, 0usize); nx * ny];
-    let (mut sq, mut sum_ref, mut n) = (0.0, 0.0, 0usize);
-    for (i, &is_skin) in skin.iter().enumerate() {
-        if !is_skin {
-            continue;
-        }
-        let (x, y) = (i % WIDTH, i / WIDTH);
-        let c = &mut cells[(y * ny / HEIGHT) * nx + x * nx / WIDTH];
-        c.0 += run.luminance[i];
-        c.1 += reference.luminance[i];
+    let (mut sq, mut sum_ref, mut chi2, mut noise2, mut n) = (0.0, 0.0, 0.0, 0.0, 0usize);
+    for (i, _) in skin.iter().enumerate().filter(|(_, s)| **s) {
+        let (a, b) = (run.luminance[i], reference.luminance[i]);
+        let c = &mut cells[((i / WIDTH) * ny / HEIGHT) * nx + (i % WIDTH) * nx / WIDTH];
+        c.0 += a;
+        c.1 += b;
         c.2 += 1;
-        sq += (run.luminance[i] - reference.luminance[i]).powi(2);
-        sum_ref += reference.luminance[i];
+        sq += (a - b).powi(2);
+        sum_ref += b;
+        let var = run.variance[i] + reference.variance[i];
+        if var > 0.0 {
+            chi2 += (a - b).powi(2) / var;
+        }
+        if a > 0.0 {
+            noise2 += run.variance[i] / (a * a);
+        }
         n += 1;
     }
     let rel: Vec<f64> = cells
@@ -117,26 +171,132 @@ fn errors(run: &Run, reference: &Run, skin: &[bool], nx: usize, ny: usize) -> (f
         .filter(|c| c.2 > 0 && c.1 > 0.0)
         .map(|c| c.0 / c.1 - 1.0)
         .collect();
-    let cell_rms = (rel.iter().map(|r| r * r).sum::<f64>() / rel.len().max(1) as f64).sqrt();
-    let pixel_rms = (sq / n.max(1) as f64).sqrt() / (sum_ref / n.max(1) as f64);
-    (cell_rms, pixel_rms)
+    let n = n.max(1) as f64;
+    Errors {
+        cell: (rel.iter().map(|r| r * r).sum::<f64>() / rel.len().max(1) as f64).sqrt(),
+        pixel: (sq / n).sqrt() / (sum_ref / n),
+        chi2: chi2 / n,
+        noise: (noise2 / n).sqrt(),
+    }
+}
+
+/// The far view's configurations: the reference, where the time goes at `spp`, and time to the
+/// noise target `noise`.
+fn far_configs(spp: u32, noise: f64) -> Vec<Config> {
+    let full = || knobs(Fidelity::Full, LodSetting::ByFidelity, false);
+    let auto = || knobs(Fidelity::Auto, LodSetting::ByFidelity, false);
+    let narrow = || knobs(Fidelity::Auto, band(0.25, 1.0), false);
+    // A band far below any footprint: every skin hit takes the diffuse body.
+    let collapsed = || knobs(Fidelity::Auto, band(1e-4, 2e-4), false);
+    let fixed = |label, opts, seed| Config {
+        label,
+        opts,
+        seed,
+        spp,
+        noise: None,
+    };
+    let target = |label, opts, seed| Config {
+        label,
+        opts,
+        seed,
+        spp,
+        noise: Some(noise),
+    };
+    vec![
+        Config {
+            spp: 4 * spp,
+            ..fixed("full-reference", full(), 1)
+        },
+        fixed("full", full(), 2),
+        fixed("auto", auto(), 3),
+        fixed("auto-band-0.25-1", narrow(), 4),
+        fixed("collapsed", collapsed(), 5),
+        fixed(
+            "no-subsurface",
+            knobs(Fidelity::Auto, LodSetting::Off, true),
+            6,
+        ),
+        target("full-to-noise", full(), 7),
+        target("auto-to-noise", auto(), 8),
+        target("auto-band-0.25-1-to-noise", narrow(), 9),
+        target("collapsed-to-noise", collapsed(), 10),
+    ]
+}
+
+/// The close-up's configurations (all at `spp`, the reference at four times as many).
+fn ear_configs(spp: u32) -> Vec<Config> {
+    let full = knobs(Fidelity::Full, LodSetting::ByFidelity, false);
+    let config = |label, opts, seed, spp| Config {
+        label,
+        opts,
+        seed,
+        spp,
+        noise: None,
+    };
+    vec![
+        config("full-reference", full, 1, 4 * spp),
+        config("full", full, 2, spp),
+        config("auto", SceneOptions::default(), 3, spp),
+        config(
+            "auto-band-0.25-1",
+            knobs(Fidelity::Auto, band(0.25, 1.0), false),
+            4,
+            spp,
+        ),
+    ]
+}
+
+/// OUT/lod_ratios.csv: per skin of `spec`, the 99% radius per colour and the pixel footprint over it.
+fn lod_ratios(spec: &str, out: &Path) -> String {
+    let full = knobs(Fidelity::Full, LodSetting::ByFidelity, false);
+    let scene = Scene::load(spec, &full).expect("built-in scenes load");
+    // The mean camera distance of the skin the camera sees.
+    let passes = Passes::first_hit(&scene, WIDTH, HEIGHT);
+    let depths: Vec<f32> = (passes.skin.iter().zip(&passes.depth))
+        .filter(|(s, _)| **s > 0.5)
+        .map(|(_, d)| *d)
+        .collect();
+    let distance_mm = depths.iter().sum::<f32>() / depths.len().max(1) as f32;
+    let footprint_mm = scene.camera.pixel_angle_rad(HEIGHT) * distance_mm;
+    let mut csv = String::from(
+        "material,footprint_mm,r99_450_mm,r99_550_mm,r99_650_mm,r99_largest_mm,\
+         ratio_450,ratio_550,ratio_650,ratio_largest\n",
+    );
+    for (name, m) in scene.material_names.iter().zip(&scene.materials) {
+        let Material::Skin(skin) = m else { continue };
+        let Some(ss) = &skin.subsurface else { continue };
+        // The inverse CDF at 0.99 of a row is its 99% energy radius.
+        let r: Vec<f32> = [450.0, 550.0, 650.0]
+            .iter()
+            .map(|&nm| ss.table.sample_radius(nm, 0.99))
+            .chain(std::iter::once(ss.table.largest_radius_for_energy_mm(0.99)))
+            .collect();
+        let _ = write!(csv, "{name},{footprint_mm:.3}");
+        for x in &r {
+            let _ = write!(csv, ",{x:.3}");
+        }
+        for x in &r {
+            let _ = write!(csv, ",{:.2}", footprint_mm / x);
+        }
+        csv.push('\n');
+    }
+    render::atomic::write_bytes(&out.join("lod_ratios.csv"), csv.as_bytes()).expect("write csv");
+    csv
 }
 
 fn main() {
     let mut args = std::env::args().skip(1);
     let out = PathBuf::from(args.next().unwrap_or_else(|| "out/fidelity".into()));
-    let mut spp = |default: u32| {
+    let mut next = |default: f64| {
         args.next()
-            .map_or(default, |s| s.parse().expect("SPP is a number"))
+            .map_or(default, |s| s.parse().expect("a number"))
     };
-    let (spp_far, spp_ear) = (spp(96), spp(16));
+    let (spp_far, spp_ear, noise) = (next(64.0) as u32, next(16.0) as u32, next(0.1));
     std::fs::create_dir_all(&out).expect("create OUT");
-    let narrow = LodSetting::Band(LodBand {
-        full_below: 0.25,
-        diffuse_above: 1.0,
-    });
+    print!("{}", lod_ratios("builtin:three-heads-far", &out));
     let mut csv = String::from(
-        "scene,config,spp,load_s,render_cpu_s,speedup,cell_rel_rms,pixel_rel_rms,skin_pixels\n",
+        "scene,config,spp,noise_target,mean_spp,load_s,render_cpu_s,speedup,cell_rel_rms,\
+         pixel_rel_rms,chi2,skin_noise,skin_pixels\n",
     );
     let mut chart = LineChart::new(
         "Automatic fidelity against --fidelity full",
@@ -144,48 +304,56 @@ fn main() {
         "relative RMS of mean skin luminance per cell",
     );
     let mut worst: f64 = 0.0;
-    for (spec, nx, ny, spp) in [
-        ("builtin:three-heads-far", 5, 3, spp_far),
-        ("builtin:ear", 1, 1, spp_ear),
+    for (spec, nx, ny, configs) in [
+        ("builtin:three-heads-far", 5, 3, far_configs(spp_far, noise)),
+        ("builtin:ear", 1, 1, ear_configs(spp_ear)),
     ] {
-        let full = knobs(Fidelity::Full, LodSetting::ByFidelity);
-        let runs = [
-            render_one(spec, "full", &full, 1, spp, &out),
-            render_one(spec, "full-seed2", &full, 2, spp, &out),
-            render_one(spec, "auto", &SceneOptions::default(), 3, spp, &out),
-            render_one(
-                spec,
-                "auto-band-0.25-1",
-                &knobs(Fidelity::Auto, narrow),
-                4,
-                spp,
-                &out,
-            ),
-        ];
-        let scene = Scene::load(spec, &full).expect("built-in scenes load");
+        let runs: Vec<Run> = configs.iter().map(|c| render_one(spec, c, &out)).collect();
+        let scene = Scene::load(spec, &configs[0].opts).expect("built-in scenes load");
         let skin: Vec<bool> = Passes::first_hit(&scene, WIDTH, HEIGHT)
             .skin
             .iter()
             .map(|&s| s > 0.5)
             .collect();
         let skin_pixels = skin.iter().filter(|&&s| s).count();
-        let mut points = Vec::new();
-        for run in &runs {
-            let (cell, pixel) = errors(run, &runs[0], &skin, nx, ny);
+        let (mut fixed, mut targeted) = (Vec::new(), Vec::new());
+        for run in &runs[1..] {
+            let e = errors(run, &runs[0], &skin, nx, ny);
+            // Speed-up against full fidelity under the same stop rule.
+            let base = runs[1..]
+                .iter()
+                .find(|r| r.label.starts_with("full") && r.noise == run.noise)
+                .map_or(run.cpu_s, |r| r.cpu_s);
             let _ = writeln!(
                 csv,
-                "{spec},{},{spp},{:.3},{:.2},{:.3},{cell:.5},{pixel:.5},{skin_pixels}",
+                "{spec},{},{},{},{:.1},{:.3},{:.2},{:.3},{:.5},{:.5},{:.3},{:.5},{skin_pixels}",
                 run.label,
+                run.spp,
+                run.noise.map_or("none".into(), |n| n.to_string()),
+                run.mean_spp,
                 run.load_s,
                 run.cpu_s,
-                runs[0].cpu_s / run.cpu_s
+                base / run.cpu_s,
+                e.cell,
+                e.pixel,
+                e.chi2,
+                e.noise
             );
-            if run.label != "full" {
-                points.push((run.cpu_s, cell));
-                worst = worst.max(cell);
+            if run.label != "no-subsurface" {
+                let points = if run.noise.is_some() {
+                    &mut targeted
+                } else {
+                    &mut fixed
+                };
+                points.push((run.cpu_s, e.cell));
+                worst = worst.max(e.cell);
             }
         }
-        chart = chart.with_series(Series::scatter(spec, points));
+        let name = spec.trim_start_matches("builtin:");
+        chart = chart.with_series(Series::scatter(format!("{name}, fixed spp"), fixed));
+        if !targeted.is_empty() {
+            chart = chart.with_series(Series::scatter(format!("{name}, to noise"), targeted));
+        }
     }
     // From 0, with headroom, so no point sits on the frame.
     chart = chart.with_y_range(0.0, 1.2 * worst.max(1e-3));

@@ -334,11 +334,14 @@ pub fn radiance(
         let q_sss = bsdf.subsurface_probability(wo);
         sampler.seek(dims::SUBSURFACE_CHOICE);
         let take_sss = q_sss > 0.0 && sampler.get_1d() < q_sss;
-        let volume = scene
-            .volumetric
-            .as_ref()
-            .and_then(|v| v.medium(si.material));
-        // A skin rendered by the volumetric reference takes no BSSRDF exit: its body is walked.
+        // The volumetric reference walks every skin hit; otherwise a thin part of skin is walked
+        // (crate::fidelity::transport) and the rest takes the BSSRDF.
+        let volume = match (&scene.volumetric, &scene.thin_parts) {
+            (Some(v), _) => v.medium(si.material),
+            (None, Some(thin)) if q_sss > 0.0 => thin.walk_at(scene, &si, ng, rays),
+            _ => None,
+        };
+        // A skin rendered by the volumetric walk takes no BSSRDF exit: its body is walked.
         if take_sss
             && let (Some(vol), Material::Skin(skin)) = (volume, material)
             && let Some(ss) = &skin.subsurface

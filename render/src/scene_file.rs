@@ -189,6 +189,8 @@ pub struct FidelityDesc {
     pub wavelength_step_nm: Option<f64>,
     /// Level of detail: "off", or the band [LO, HI] in pixel footprints per r99.
     pub lod: Option<LodDesc>,
+    /// Local thickness, in r99, below which a hit takes the volumetric walk, in [0, 10] (0: never).
+    pub thin_walk: Option<f64>,
 }
 
 /// `fidelity.lod`: "off" or [LO, HI].

@@ -97,6 +97,10 @@ pub struct RenderArgs {
     /// radius: BSSRDF below LO, diffuse above HI, blended between; auto: 1,4).
     #[arg(long, value_name = "off|LO,HI", value_parser = Checked(parse_lod))]
     pub lod: Option<LodSetting>,
+    /// Volumetric walk instead of the BSSRDF where the body under a skin hit is thinner than this
+    /// many of the skin's largest 99% energy radii, in [0, 10] (0: never; auto: 1, full: 0).
+    #[arg(long, value_name = "R99S", value_parser = Checked(parse_thin_walk), allow_hyphen_values = true)]
+    pub thin_walk: Option<f64>,
     /// Neither read nor write the disk cache of skin tables.
     #[arg(long)]
     pub no_cache: bool,
@@ -163,6 +167,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         radial_error: args.radial_error,
         wavelength_step_nm: args.wavelength_step,
         lod: args.lod.unwrap_or_default(),
+        thin_walk_r99: args.thin_walk,
         cache: !args.no_cache,
     };
     fidelity
@@ -237,6 +242,11 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         settings.width * settings.height,
         100.0 * passes.skin.iter().sum::<f32>() / passes.skin.len().max(1) as f32
     );
+    if args.explain
+        && let Some(report) = crate::fidelity::explain::thin_walk_report(&scene)
+    {
+        print!("{report}");
+    }
     println!(
         "total {:.1} s; wrote {} and {}",
         t0.elapsed().as_secs_f64(),
@@ -314,6 +324,14 @@ fn parse_step(s: &str) -> Result<f64, String> {
             "{} nm is not one of 5, 8, 10, 16, 20, 25, 40, 50, 80, 100",
             Num(v)
         ));
+    }
+    Ok(v)
+}
+
+fn parse_thin_walk(s: &str) -> Result<f64, String> {
+    let v = parse_number(s, "[0, 10] r99")?;
+    if !(0.0..=10.0).contains(&v) {
+        return Err(format!("{} outside [0, 10] r99", Num(v)));
     }
     Ok(v)
 }

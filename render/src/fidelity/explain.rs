@@ -11,21 +11,33 @@ use std::fmt::Write;
 /// How a skin's body is shaded.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum TransportChoice {
-    /// The separable BSSRDF everywhere; `transport_mfp_mm` is the dermis' largest transport mean
-    /// free path 1/(σa + σs') over 380–780 nm, the length the thickness criterion for the
-    /// volumetric walk is counted in.
+    /// The separable BSSRDF, and the volumetric walk where the body under a hit is thinner than
+    /// `walk_below_mm` (`super::transport`); `transport_mfp_mm` is the dermis' largest transport
+    /// mean free path 1/(σa + σs') over 380–780 nm, for scale.
     Bssrdf {
         /// Largest transport mean free path, mm.
         transport_mfp_mm: f64,
+        /// Local thickness below which a hit takes the walk, mm (`None`: never).
+        walk_below_mm: Option<f32>,
     },
     /// The Lambertian stand-in (`--no-subsurface`).
     Lambertian,
 }
 
 impl TransportChoice {
-    /// The BSSRDF with the dermis' largest transport mean free path of `params` (every 10 nm).
+    /// The local thickness below which a hit takes the walk, mm, if it ever does.
     #[must_use]
-    pub fn bssrdf(params: &SkinParams) -> Self {
+    pub fn walk_below_mm(&self) -> Option<f32> {
+        match self {
+            TransportChoice::Bssrdf { walk_below_mm, .. } => *walk_below_mm,
+            TransportChoice::Lambertian => None,
+        }
+    }
+
+    /// The BSSRDF with the dermis' largest transport mean free path of `params` (every 10 nm), and
+    /// the walk below `walk_below_mm`.
+    #[must_use]
+    pub fn bssrdf(params: &SkinParams, walk_below_mm: Option<f32>) -> Self {
         let transport_mfp_mm = (0..=40)
             .filter_map(|i| Wavelength::new(380.0 + 10.0 * f64::from(i)).ok())
             .filter_map(|l| LayeredMedium::skin(params, l, DEFAULT_G).ok())
@@ -35,7 +47,10 @@ impl TransportChoice {
                     .map(|d| 1.0 / (d.sigma_a() + d.sigma_s_prime()))
             })
             .fold(0.0, f64::max);
-        Self::Bssrdf { transport_mfp_mm }
+        Self::Bssrdf {
+            transport_mfp_mm,
+            walk_below_mm,
+        }
     }
 }
 
@@ -148,9 +163,10 @@ pub fn explain_table(skins: &[(&str, &SkinChoices)]) -> String {
     let mut s = String::new();
     for (name, c) in skins {
         let w = &c.wavelengths;
-        let de = w.delta_e.map_or("fixed step".to_string(), |d| {
-            format!("ΔE2000 {d:.2} vs 1 nm")
-        });
+        let de = match (w.delta_e, w.luminance_error) {
+            (Some(d), Some(y)) => format!("ΔE2000 {d:.2}, luminance {:.3}% vs 1 nm", 100.0 * y),
+            _ => "fixed step".to_string(),
+        };
         let extent = match c.energy_tolerance {
             Some(t) => format!("rows end where {:.2}% of the energy is left", 100.0 * t),
             None => "each profile's own 99.9% radius".into(),
@@ -167,9 +183,21 @@ pub fn explain_table(skins: &[(&str, &SkinChoices)]) -> String {
             None => "off (BSSRDF at every hit)".into(),
         };
         let transport = match c.transport {
-            TransportChoice::Bssrdf { transport_mfp_mm } => format!(
-                "BSSRDF everywhere (no volumetric integrator in this build; thickness criterion \
-                 counted in the dermis' largest transport mean free path, {transport_mfp_mm:.3} mm)"
+            TransportChoice::Bssrdf {
+                transport_mfp_mm,
+                walk_below_mm: Some(t),
+            } => format!(
+                "BSSRDF; the volumetric walk where the body under a hit is thinner than {t:.2} mm \
+                 along the inward normal ({:.1} × r99; dermis transport mean free path \
+                 {transport_mfp_mm:.3} mm); share of hits walked printed after the render",
+                t / c.r99_mm.max(f32::MIN_POSITIVE)
+            ),
+            TransportChoice::Bssrdf {
+                transport_mfp_mm,
+                walk_below_mm: None,
+            } => format!(
+                "BSSRDF everywhere (thin-part walk off; dermis transport mean free path \
+                 {transport_mfp_mm:.3} mm)"
             ),
             TransportChoice::Lambertian => "Lambertian stand-in (--no-subsurface)".into(),
         };
@@ -259,6 +287,28 @@ pub fn report(scene: &crate::scene::Scene, explain: bool) {
             failing.join("; ")
         );
     }
+}
+
+/// After a render: per skin material with a thin-part walk, the share of its subsurface hits
+/// that took the walk (`super::transport`); `None` when no material has one.
+#[must_use]
+pub fn thin_walk_report(scene: &crate::scene::Scene) -> Option<String> {
+    let parts = scene.thin_parts.as_ref()?;
+    let mut s = String::new();
+    for (index, name) in scene.material_names.iter().enumerate() {
+        let Some(part) = parts.part(index as u32) else {
+            continue;
+        };
+        let (tested, walked) = part.counts();
+        let _ = writeln!(
+            s,
+            "skin '{name}': volumetric walk at {:.2}% of {tested} subsurface hits (thinner than \
+             {:.2} mm), the BSSRDF at the rest",
+            100.0 * walked as f64 / tested.max(1) as f64,
+            part.walk_below_mm
+        );
+    }
+    Some(s)
 }
 
 #[cfg(test)]

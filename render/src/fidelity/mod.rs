@@ -5,12 +5,14 @@
 //! - [`extent`]: where a profile row ends (energy left beyond it below a tolerance) and how many
 //!   radii the table needs for an interpolation error target.
 //! - [`wavelengths`]: the widest wavelength step whose interpolated reflectance keeps the skin's
-//!   colour within a CIEDE2000 target of a 1-nm grid.
+//!   colour within a CIEDE2000 target and its luminance within a relative target of a 1-nm grid.
 //! - [`lod`]: subsurface scattering blended into a Fresnel-weighted diffuse surface where a pixel
 //!   covers much more than the profile's 99% radius.
 //! - [`cache`]: the tables on disk, keyed by everything they depend on, verified before use.
 //! - [`explain`]: what was chosen for each skin material and why; the diffusion warning.
 //! - [`tables`]: a skin's tables with the choices applied, through the cache.
+//! - [`transport`]: the volumetric walk instead of the BSSRDF where the body under a hit is
+//!   thinner than the profile's reach.
 //!
 //! `Fidelity::Full` keeps every table knob at its fixed default (10-nm rows, 128 radii, each
 //! profile's own 99.9% extent) and shades every skin hit with the full BSSRDF: the reference the
@@ -22,6 +24,7 @@ pub mod explain;
 pub mod extent;
 pub mod lod;
 pub mod tables;
+pub mod transport;
 pub mod wavelengths;
 
 pub use explain::{SkinChoices, TransportChoice};
@@ -38,6 +41,10 @@ pub const DEFAULT_ENERGY_TOLERANCE: f64 = 1e-3;
 pub const DEFAULT_RADIAL_ERROR: f64 = 2e-3;
 /// CIEDE2000 target of the wavelength choice in `Fidelity::Auto` (against a 1-nm grid).
 pub const DEFAULT_MAX_DELTA_E: f64 = 0.5;
+/// Relative luminance (CIE Y under D65) target of the wavelength choice in `Fidelity::Auto`
+/// (against a 1-nm grid): below the 0.13% noise floor of the close-up's mean skin luminance
+/// (BENCHMARKS.md, "Fidelity").
+pub const DEFAULT_MAX_LUMINANCE_ERROR: f64 = 1e-3;
 
 /// All automatic choices on (`Auto`, the default) or every knob at its fixed reference value
 /// (`Full`).
@@ -100,6 +107,9 @@ pub struct FidelityKnobs {
     pub wavelength_step_nm: Option<f64>,
     /// Level of detail by pixel footprint.
     pub lod: LodSetting,
+    /// Local thickness, in units of the skin's largest r₉₉, below which a hit takes the
+    /// volumetric walk, in [0, 10] (0: never).
+    pub thin_walk_r99: Option<f64>,
     /// Read and write the disk cache of skin tables (default true; `--no-cache` clears it).
     pub cache: bool,
 }
@@ -112,6 +122,7 @@ impl Default for FidelityKnobs {
             radial_error: None,
             wavelength_step_nm: None,
             lod: LodSetting::ByFidelity,
+            thin_walk_r99: None,
             cache: true,
         }
     }
@@ -122,10 +133,12 @@ impl Default for FidelityKnobs {
 pub enum StepChoice {
     /// This step, nm.
     Fixed(f64),
-    /// The widest step within this CIEDE2000 of a 1-nm grid.
+    /// The widest step within this CIEDE2000 and this relative luminance error of a 1-nm grid.
     Colour {
         /// ΔE2000 target.
         max_delta_e: f64,
+        /// |Y / Y₁ₙₘ − 1| target.
+        max_luminance_error: f64,
     },
 }
 
@@ -140,6 +153,8 @@ pub struct Resolved {
     pub step: StepChoice,
     /// The level-of-detail band, if on.
     pub lod: Option<LodBand>,
+    /// The thin-part walk's threshold in r₉₉, if on.
+    pub thin_walk_r99: Option<f64>,
 }
 
 /// A fidelity knob outside its range.
@@ -167,6 +182,7 @@ impl FidelityKnobs {
                 LodSetting::ByFidelity => under.lod,
                 set => set,
             },
+            thin_walk_r99: self.thin_walk_r99.or(under.thin_walk_r99),
             cache: self.cache,
         }
     }
@@ -197,6 +213,7 @@ impl FidelityKnobs {
             }
             None if auto => StepChoice::Colour {
                 max_delta_e: DEFAULT_MAX_DELTA_E,
+                max_luminance_error: DEFAULT_MAX_LUMINANCE_ERROR,
             },
             None => StepChoice::Fixed(crate::material::SKIN_TABLE_STEP_NM),
         };
@@ -205,11 +222,23 @@ impl FidelityKnobs {
             LodSetting::Off => None,
             LodSetting::Band(b) => Some(b.checked()?),
         };
+        let thin_walk_r99 = match self.thin_walk_r99 {
+            Some(k) if !(0.0..=10.0).contains(&k) => {
+                return Err(FidelityError {
+                    name: "fidelity.thin_walk",
+                    value: k,
+                    range: "[0, 10] (r99; 0: never)",
+                });
+            }
+            Some(k) => (k > 0.0).then_some(k),
+            None => auto.then_some(transport::DEFAULT_THIN_WALK_R99),
+        };
         Ok(Resolved {
             energy_tolerance,
             radial_error,
             step,
             lod,
+            thin_walk_r99,
         })
     }
 }
@@ -232,10 +261,17 @@ mod tests {
         assert_eq!(full.radial_error, None);
         assert_eq!(full.step, StepChoice::Fixed(10.0));
         assert_eq!(full.lod, None);
+        assert_eq!(full.thin_walk_r99, None);
         let auto = FidelityKnobs::default().resolve().unwrap();
         assert_eq!(auto.energy_tolerance, Some(DEFAULT_ENERGY_TOLERANCE));
         assert!(matches!(auto.step, StepChoice::Colour { .. }));
         assert_eq!(auto.lod, Some(LodBand::default()));
+        assert_eq!(auto.thin_walk_r99, Some(transport::DEFAULT_THIN_WALK_R99));
+        let never = FidelityKnobs {
+            thin_walk_r99: Some(0.0),
+            ..FidelityKnobs::default()
+        };
+        assert_eq!(never.resolve().unwrap().thin_walk_r99, None);
         let over = FidelityKnobs {
             wavelength_step_nm: Some(20.0),
             lod: LodSetting::Off,

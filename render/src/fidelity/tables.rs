@@ -73,16 +73,16 @@ pub fn skin_table(
         .flatten()
         .map(|d| d.join("tables"));
     let (stored, outcome): (Stored, CacheOutcome) =
-        cache::load_or_build(dir.as_deref(), &key, || {
+        cache::load_or_build(dir.as_deref(), cache::max_bytes()?, &key, || {
             let wavelengths = match resolved.step {
-                StepChoice::Fixed(step_nm) => WavelengthChoice {
-                    step_nm,
-                    nodes: ((wavelengths::TO_NM - wavelengths::FROM_NM) / step_nm) as usize + 1,
-                    delta_e: None,
-                },
-                StepChoice::Colour { max_delta_e } => wavelengths::choose_step(
+                StepChoice::Fixed(step_nm) => WavelengthChoice::fixed(step_nm),
+                StepChoice::Colour {
+                    max_delta_e,
+                    max_luminance_error,
+                } => wavelengths::choose_step(
                     &wavelengths::totals_1nm(params, method, phase_g)?,
                     max_delta_e,
+                    max_luminance_error,
                 ),
             };
             let opts = table_options(&resolved, shape_escapes, phase_g, wavelengths.step_nm);
@@ -101,7 +101,10 @@ pub fn skin_table(
         radii: table.radii_mm().len(),
         shape: shape_source(method, &probe),
         lod: resolved.lod.map(|band| Lod { r99_mm, band }),
-        transport: TransportChoice::bssrdf(params),
+        transport: TransportChoice::bssrdf(
+            params,
+            resolved.thin_walk_r99.map(|k| k as f32 * r99_mm),
+        ),
         cache: outcome,
         build_ms: 1e3 * t0.elapsed().as_secs_f64(),
         diffusion_failures: (method == Method::Multipole)
@@ -168,9 +171,9 @@ mod tests {
             })
         };
         let fresh = build().unwrap();
-        let (first, o) = cache::load_or_build(Some(dir), &k, build).unwrap();
+        let (first, o) = cache::load_or_build(Some(dir), cache::DEFAULT_MAX_BYTES, &k, build).unwrap();
         assert!(matches!(o, CacheOutcome::Built(_)));
-        let (hit, o) = cache::load_or_build(Some(dir), &k, build).unwrap();
+        let (hit, o) = cache::load_or_build(Some(dir), cache::DEFAULT_MAX_BYTES, &k, build).unwrap();
         assert!(matches!(o, CacheOutcome::Hit(_)), "{o:?}");
         assert_eq!(bits(&hit.table), bits(&fresh.table));
         assert_eq!(bits(&first.table), bits(&fresh.table));
@@ -182,7 +185,7 @@ mod tests {
         corrupt[mid] = if corrupt[mid] == b'1' { b'2' } else { b'1' };
         for bad in [corrupt, good[..good.len() / 3].to_vec()] {
             std::fs::write(&path, bad).unwrap();
-            let (again, o) = cache::load_or_build(Some(dir), &k, build).unwrap();
+            let (again, o) = cache::load_or_build(Some(dir), cache::DEFAULT_MAX_BYTES, &k, build).unwrap();
             assert!(matches!(o, CacheOutcome::Rebuilt(..)), "{o:?}");
             assert_eq!(bits(&again.table), bits(&fresh.table));
         }

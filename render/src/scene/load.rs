@@ -268,7 +268,7 @@ impl Loader<'_> {
             .map(|e| self.environment(e))
             .transpose()?;
 
-        Ok(Scene {
+        let mut scene = Scene {
             name: self.file.to_string(),
             camera,
             lights,
@@ -279,7 +279,11 @@ impl Loader<'_> {
             geometry: Geometry::new(meshes),
             exposure_stops: desc.film.exposure_stops,
             volumetric: None,
-        })
+            thin_parts: None,
+        };
+        scene.thin_parts = crate::fidelity::transport::ThinParts::build(&scene)
+            .map_err(|e| self.err("fidelity.thin_walk", e.to_string()))?;
+        Ok(scene)
     }
 
     fn mesh(

@@ -160,6 +160,7 @@ impl Loader<'_> {
             radial_error: d.radial_error,
             wavelength_step_nm: d.wavelength_step_nm,
             lod,
+            thin_walk_r99: d.thin_walk,
             cache: true,
         };
         knobs

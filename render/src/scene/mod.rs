@@ -59,6 +59,8 @@ pub struct Scene {
     pub exposure_stops: f32,
     /// The skin media of the volumetric reference integrator (None = skin by its BSSRDF).
     pub volumetric: Option<crate::volumetric::Volumetric>,
+    /// The volumetric walk at thin parts of skin (`crate::fidelity::transport`; None = off).
+    pub thin_parts: Option<crate::fidelity::transport::ThinParts>,
 }
 
 impl Scene {

@@ -152,7 +152,7 @@ pub fn hero_only(beta: SampledSpectrum) -> SampledSpectrum {
 
 /// σa and σs of the skin's two layers on the 5-nm grid of [`SpectrumTable`], from
 /// `LayeredMedium::skin` at anisotropy `g`; an error carries its wavelength.
-fn layer_tables(
+pub(crate) fn layer_tables(
     params: &skin_optics::SkinParams,
     g: f64,
 ) -> Result<(LayerTables, LayerTables), (f64, MultipoleError)> {
