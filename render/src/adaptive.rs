@@ -1,9 +1,15 @@
 //! Noise-targeted adaptive sampling: per-pixel sums of XYZ and of squared luminance, the noise of
 //! each pixel's mean estimated from its own samples, and the set of pixels still sampled.
 //!
-//! The error of pixel p's mean after n samples is σ̂/√n, with σ̂² the unbiased sample variance of
-//! the samples' luminance Y (n − 1 degrees of freedom; a half-buffer difference |A − B|/2 has one).
-//! It is divided by max(Ȳ_p, T), T the lit threshold of [`crate::noise`], so the figure is the same
+//! Two estimates of the error of pixel p's mean ([`ErrorEstimate`]). From the sample variance:
+//! σ̂/√n, σ̂² the unbiased sample variance of the n samples' luminance Y (n − 1 degrees of
+//! freedom); right for independent samples, an overstatement for the points of one Sobol sequence,
+//! whose mean converges faster than 1/√n. From two independent halves (the even and the odd
+//! samples of [`crate::sampler::SamplerKind::SobolPair`]): |Ȳ_A − Ȳ_B|/2, unbiased in square
+//! for any sampler whose halves are independent (E[(Ȳ_A − Ȳ_B)²]/4 = Var((Ȳ_A + Ȳ_B)/2)), with
+//! one degree of freedom per pixel; the image-wide figure averages it over many pixels, and the
+//! stopping rule over nine. The error is divided by max(Ȳ_p, T), T the lit threshold of
+//! [`crate::noise`], so the figure is the same
 //! relative noise as the two-seed metric on lit pixels and an absolute one, relative to T, in the
 //! dark. A pixel stops when the mean squared relative error over its 3×3 neighbourhood is below the
 //! target²: pooling nine pixels keeps a pixel whose own few samples happened to agree (no firefly
@@ -15,35 +21,51 @@ use crate::noise::lit_threshold;
 /// Fewest samples per pixel before a pixel may stop (a variance from fewer is unreliable).
 pub const MIN_SPP: u32 = 16;
 
+/// How the error of a pixel's mean is estimated from its samples.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ErrorEstimate {
+    /// σ̂²/n from the sample variance (samples independent).
+    SampleVariance,
+    /// (Ȳ_A − Ȳ_B)²/4 from the means of the even (A) and the odd (B) samples (halves independent).
+    HalfDifference,
+}
+
 /// Per-pixel sample sums of an adaptive render.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Accumulator {
     width: usize,
     height: usize,
+    estimate: ErrorEstimate,
     sum_xyz: Vec<[f64; 3]>,
     sum_y2: Vec<f64>,
     count: Vec<u32>,
+    /// Luminance sums and sample counts of the even and the odd samples.
+    sum_y_half: Vec<[f64; 2]>,
+    count_half: Vec<[u32; 2]>,
     /// Non-finite samples dropped (not in `count` or the sums).
     dropped: u64,
 }
 
 impl Accumulator {
-    /// Empty sums for `width × height` pixels.
+    /// Empty sums for `width × height` pixels whose error is estimated by `estimate`.
     #[must_use]
-    pub fn new(width: usize, height: usize) -> Self {
+    pub fn new(width: usize, height: usize, estimate: ErrorEstimate) -> Self {
         let n = width * height;
         Self {
             width,
             height,
+            estimate,
             sum_xyz: vec![[0.0; 3]; n],
             sum_y2: vec![0.0; n],
             count: vec![0; n],
+            sum_y_half: vec![[0.0; 2]; n],
+            count_half: vec![[0; 2]; n],
             dropped: 0,
         }
     }
 
-    /// Add one XYZ sample to pixel `i` (row-major).
-    pub fn add(&mut self, i: usize, xyz: [f32; 3]) {
+    /// Add pixel `i`'s (row-major) sample number `sample` (its parity picks the half), in XYZ.
+    pub fn add(&mut self, i: usize, sample: u32, xyz: [f32; 3]) {
         // A non-finite sample is dropped and counted, as the film does, so no NaN or infinity
         // reaches the image or the stopping rule; the pixel averages the samples it kept.
         if !xyz.iter().all(|c| c.is_finite()) {
@@ -55,6 +77,9 @@ impl Accumulator {
         }
         self.sum_y2[i] += f64::from(xyz[1]).powi(2);
         self.count[i] += 1;
+        let half = (sample % 2) as usize;
+        self.sum_y_half[i][half] += f64::from(xyz[1]);
+        self.count_half[i][half] += 1;
     }
 
     /// Non-finite samples dropped so far, over all pixels.
@@ -101,11 +126,33 @@ impl Accumulator {
             .collect()
     }
 
-    /// Squared relative error of every pixel, σ̂²/(n · max(Ȳ, T)²), and the lit threshold T.
+    /// Estimated variance of every pixel's mean luminance by the accumulator's [`ErrorEstimate`]
+    /// (∞ where it cannot be formed yet).
+    #[must_use]
+    pub fn error2(&self) -> Vec<f64> {
+        match self.estimate {
+            ErrorEstimate::SampleVariance => self.variance_of_mean(),
+            ErrorEstimate::HalfDifference => self
+                .sum_y_half
+                .iter()
+                .zip(&self.count_half)
+                .map(|(s, n)| {
+                    if n[0] == 0 || n[1] == 0 {
+                        return f64::INFINITY;
+                    }
+                    let d = s[0] / f64::from(n[0]) - s[1] / f64::from(n[1]);
+                    0.25 * d * d
+                })
+                .collect(),
+        }
+    }
+
+    /// Squared relative error of every pixel, [`Accumulator::error2`]/max(Ȳ, T)², and the lit
+    /// threshold T.
     fn relative_error2(&self) -> (Vec<f64>, f64) {
         let mean = self.mean_luminance();
         let t = lit_threshold(&mean);
-        let var = self.variance_of_mean();
+        let var = self.error2();
         let e2 = var
             .iter()
             .zip(&mean)
@@ -187,9 +234,9 @@ mod tests {
     /// Samples alternating 1 and 3: variance 4/3 (n/(n−1) · 1 with n = 4), mean 2.
     #[test]
     fn variance_of_known_samples() {
-        let mut acc = Accumulator::new(1, 1);
-        for y in [1.0, 3.0, 1.0, 3.0] {
-            acc.add(0, [0.0, y, 0.0]);
+        let mut acc = Accumulator::new(1, 1, ErrorEstimate::SampleVariance);
+        for (k, y) in [1.0, 3.0, 1.0, 3.0].into_iter().enumerate() {
+            acc.add(0, k as u32, [0.0, y, 0.0]);
         }
         assert_eq!(acc.mean_luminance(), vec![2.0]);
         let v = acc.variance_of_mean()[0];
@@ -198,15 +245,29 @@ mod tests {
         assert!((acc.noise_estimate() - (1.0f64 / 3.0).sqrt() / 2.0).abs() < 1e-12);
     }
 
+    /// Even samples 1, 1 and odd samples 3, 3: the half-means differ by 2, so the error of the
+    /// mean 2 is estimated as 2²/4 = 1 (relative 1/2), while the sample variance says 4/3/4.
+    #[test]
+    fn half_difference_of_known_samples() {
+        let mut acc = Accumulator::new(1, 1, ErrorEstimate::HalfDifference);
+        assert_eq!(acc.error2(), vec![f64::INFINITY]);
+        for (k, y) in [1.0, 3.0, 1.0, 3.0].into_iter().enumerate() {
+            acc.add(0, k as u32, [0.0, y, 0.0]);
+        }
+        assert_eq!(acc.error2(), vec![1.0]);
+        assert!((acc.noise_estimate() - 0.5).abs() < 1e-12);
+        assert!((acc.variance_of_mean()[0] - 1.0 / 3.0).abs() < 1e-12);
+    }
+
     /// A non-finite sample is left out of the pixel's mean and variance and counted, and the
     /// film reports it.
     #[test]
     fn non_finite_samples_are_dropped_and_counted() {
-        let mut acc = Accumulator::new(1, 1);
-        for y in [1.0, f32::NAN, 3.0, f32::INFINITY] {
-            acc.add(0, [0.0, y, 0.0]);
+        let mut acc = Accumulator::new(1, 1, ErrorEstimate::SampleVariance);
+        for (k, y) in [1.0, f32::NAN, 3.0, f32::INFINITY].into_iter().enumerate() {
+            acc.add(0, k as u32, [0.0, y, 0.0]);
         }
-        acc.add(0, [f32::NEG_INFINITY, 1.0, 0.0]);
+        acc.add(0, 4, [f32::NEG_INFINITY, 1.0, 0.0]);
         assert_eq!((acc.count(0), acc.dropped()), (2, 3));
         assert_eq!(acc.mean_luminance(), vec![2.0]);
         let film = acc.to_film();
@@ -217,11 +278,11 @@ mod tests {
     /// A constant pixel has zero error and stops at `min_spp`, not before.
     #[test]
     fn constant_pixels_stop_at_min_spp() {
-        let mut acc = Accumulator::new(2, 2);
+        let mut acc = Accumulator::new(2, 2, ErrorEstimate::HalfDifference);
         let mut active = vec![true; 4];
         for k in 0..MIN_SPP {
             for i in 0..4 {
-                acc.add(i, [0.5; 3]);
+                acc.add(i, k, [0.5; 3]);
             }
             let stopped = acc.update_active(&mut active, 0.01, MIN_SPP);
             assert_eq!(stopped, if k + 1 < MIN_SPP { 0 } else { 4 });

@@ -9,11 +9,11 @@
 //! to the film in order, so the image for a given seed and sample count does not depend on the
 //! number of threads or on the tile schedule.
 
-use crate::adaptive::{Accumulator, MIN_SPP};
+use crate::adaptive::{Accumulator, ErrorEstimate, MIN_SPP};
 use crate::error::RenderError;
 use crate::film::Film;
 use crate::integrator::{PathSettings, radiance};
-use crate::sampler::PathSampler;
+use crate::sampler::{PathSampler, SamplerKind};
 use crate::scene::Scene;
 use crate::spectrum::{LAMBDA_MAX_NM, LAMBDA_MIN_NM, SampledWavelengths};
 use glam::Vec2;
@@ -209,7 +209,12 @@ pub fn render(
 
 fn render_passes(scene: &Scene, s: &RenderSettings) -> Result<(Film, RenderStats), RenderError> {
     let (w, h) = (s.width, s.height);
-    let mut acc = Accumulator::new(w, h);
+    let estimate = if s.path.sampler == SamplerKind::SobolPair {
+        ErrorEstimate::HalfDifference
+    } else {
+        ErrorEstimate::SampleVariance
+    };
+    let mut acc = Accumulator::new(w, h, estimate);
     let mut active = vec![true; w * h];
     let mut converged = 0usize;
     let tiles: Vec<(usize, usize)> = (0..h.div_ceil(TILE))
@@ -272,11 +277,13 @@ fn render_passes(scene: &Scene, s: &RenderSettings) -> Result<(Film, RenderStats
             })
             .collect();
         for (i, v) in results.into_iter().flatten() {
-            acc.add(i, v);
+            acc.add(i, sample, v);
         }
         let done = sample + 1;
+        // Pixels stop after an even pass only, so both halves of a pixel hold equally many samples.
         if let Some(target) = s.noise
             && done >= s.min_spp
+            && done % 2 == 0
         {
             converged = acc.update_active(&mut active, target, s.min_spp);
         }

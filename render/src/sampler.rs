@@ -23,9 +23,13 @@ pub enum SamplerKind {
     /// Independent uniforms (xoshiro256++ per pixel sample).
     Independent,
     /// Owen-scrambled Sobol points per pixel, padded in sets of four dimensions.
-    #[default]
     Sobol,
+    /// Two independently scrambled Sobol sequences per pixel, the even samples from one and the
+    /// odd ones from the other, so the two half-means are independent estimates.
+    #[default]
+    SobolPair,
 }
+
 
 /// Dimensions reserved for the camera: wavelength, film x, y, lens u, v (and three spare).
 pub const CAMERA_DIMENSIONS: u32 = 8;
@@ -72,14 +76,20 @@ impl PathSampler {
     /// The sampler of pixel `pixel`'s sample `sample` for image seed `seed`.
     #[must_use]
     pub fn new(kind: SamplerKind, seed: u64, pixel: u64, sample: u32) -> Self {
+        // SobolPair: point sample/2 of the sequence of half sample % 2 (the half enters the seed).
+        let (point, half) = match kind {
+            SamplerKind::SobolPair => (sample / 2, u64::from(sample % 2)),
+            _ => (sample, 0),
+        };
         Self {
             kind,
             rng: Xoshiro256PlusPlus::seed_from_u64(sample_seed(seed, pixel, sample)),
-            index: sample % SEQUENCE_LENGTH,
+            index: point % SEQUENCE_LENGTH,
             sequence_seed: mix64(
                 seed.wrapping_add(0x2545_F491_4F6C_DD1D)
                     ^ pixel.wrapping_mul(0xD1B5_4A32_D192_ED03)
-                    ^ u64::from(sample / SEQUENCE_LENGTH).wrapping_mul(0x9E37_79B9_7F4A_7C15),
+                    ^ u64::from(point / SEQUENCE_LENGTH).wrapping_mul(0x9E37_79B9_7F4A_7C15)
+                    ^ half.wrapping_mul(0x5851_F42D_4C95_7F2D),
             ),
             dim: 0,
             start: 0,
@@ -113,7 +123,7 @@ impl PathSampler {
     pub fn get_1d(&mut self) -> f32 {
         match self.kind {
             SamplerKind::Independent => self.rng.random(),
-            SamplerKind::Sobol if self.dim < self.end => {
+            SamplerKind::Sobol | SamplerKind::SobolPair if self.dim < self.end => {
                 let d = self.dim;
                 self.dim += 1;
                 let set = d / 4;
@@ -126,7 +136,7 @@ impl PathSampler {
                 }
                 self.cache[(d % 4) as usize]
             }
-            SamplerKind::Sobol => self.rng.random(),
+            SamplerKind::Sobol | SamplerKind::SobolPair => self.rng.random(),
         }
     }
 
@@ -155,41 +165,71 @@ mod tests {
     /// The first 2^k points of one pixel's Sobol sequence put exactly one point in each of 2^k
     /// equal intervals of every dimension (a (0, m, 1)-net per dimension, kept by Owen
     /// scrambling), and 2D pairs of a set are stratified in 2^k elementary boxes of both shapes
-    /// 2^a × 2^(k−a) for dimensions 0 and 1 of a set (the (0, 2)-sequence property).
+    /// 2^a × 2^(k−a) for dimensions 0 and 1 of a set (the (0, 2)-sequence property). With
+    /// [`SamplerKind::SobolPair`] the even samples and the odd samples each have the property.
     #[test]
     fn sobol_points_are_stratified() {
         let n = 64u32;
+        let cases = [
+            (SamplerKind::Sobol, 1, 0),
+            (SamplerKind::SobolPair, 2, 0),
+            (SamplerKind::SobolPair, 2, 1),
+        ];
         for pixel in [0u64, 7, 12345] {
-            let pts: Vec<Vec<f32>> = (0..n)
-                .map(|i| {
-                    let mut s = PathSampler::new(SamplerKind::Sobol, 3, pixel, i);
-                    s.start_bounce(2);
-                    (0..BOUNCE_DIMENSIONS).map(|_| s.get_1d()).collect()
-                })
-                .collect();
-            for d in 0..BOUNCE_DIMENSIONS as usize {
-                let mut seen = vec![false; n as usize];
-                for p in &pts {
-                    seen[(p[d] * n as f32) as usize] = true;
-                }
-                assert!(seen.iter().all(|&s| s), "dimension {d} of pixel {pixel}");
+            for (kind, step, first) in cases {
+                let pts: Vec<Vec<f32>> = (0..n)
+                    .map(|j| {
+                        let mut s = PathSampler::new(kind, 3, pixel, j * step + first);
+                        s.start_bounce(2);
+                        (0..BOUNCE_DIMENSIONS).map(|_| s.get_1d()).collect()
+                    })
+                    .collect();
+                assert_stratified(&pts, n, &format!("{kind:?} {first} of pixel {pixel}"));
             }
-            for a in 0..=6u32 {
-                let (bx, by) = (1u32 << a, n >> a);
-                let mut seen = vec![false; n as usize];
-                for p in &pts {
-                    let cell = (p[0] * bx as f32) as u32 * by + (p[1] * by as f32) as u32;
-                    seen[cell as usize] = true;
-                }
-                assert!(seen.iter().all(|&s| s), "{bx}×{by} boxes, pixel {pixel}");
+        }
+    }
+
+    fn assert_stratified(pts: &[Vec<f32>], n: u32, what: &str) {
+        for d in 0..BOUNCE_DIMENSIONS as usize {
+            let mut seen = vec![false; n as usize];
+            for p in pts {
+                seen[(p[d] * n as f32) as usize] = true;
             }
+            assert!(seen.iter().all(|&s| s), "dimension {d}, {what}");
+        }
+        for a in 0..=6u32 {
+            let (bx, by) = (1u32 << a, n >> a);
+            let mut seen = vec![false; n as usize];
+            for p in pts {
+                let cell = (p[0] * bx as f32) as u32 * by + (p[1] * by as f32) as u32;
+                seen[cell as usize] = true;
+            }
+            assert!(seen.iter().all(|&s| s), "{bx}×{by} boxes, {what}");
+        }
+    }
+
+    /// The two halves of a [`SamplerKind::SobolPair`] pixel are scrambled apart: point j of A
+    /// and point j of B differ (one shared scramble would make them equal).
+    #[test]
+    fn pair_halves_are_scrambled_apart() {
+        for j in 0..8 {
+            let draw = |sample| {
+                let mut s = PathSampler::new(SamplerKind::SobolPair, 4, 11, sample);
+                s.start_camera();
+                [s.get_1d(), s.get_1d()]
+            };
+            assert_ne!(draw(2 * j), draw(2 * j + 1), "point {j}");
         }
     }
 
     /// The same (seed, pixel, sample) gives the same numbers; another pixel other numbers.
     #[test]
     fn sampler_is_a_function_of_its_seed() {
-        for kind in [SamplerKind::Independent, SamplerKind::Sobol] {
+        for kind in [
+            SamplerKind::Independent,
+            SamplerKind::Sobol,
+            SamplerKind::SobolPair,
+        ] {
             let draw = |pixel| {
                 let mut s = PathSampler::new(kind, 9, pixel, 5);
                 s.start_camera();

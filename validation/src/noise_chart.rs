@@ -11,7 +11,7 @@
 use cpu_time::ProcessTime;
 use render::bssrdf::ProbeAxes;
 use render::integrator::PathSettings;
-use render::noise::lit_threshold;
+use render::noise::relative_noise_where;
 use render::passes::Passes;
 use render::plot::{LineChart, Panel, Series, SeriesStyle, save_png};
 use render::renderer::{RenderOptions, render};
@@ -116,20 +116,8 @@ impl Point {
 }
 
 /// The two-seed metric over the lit pixels where `keep` holds (NaN when none).
-fn masked_noise(a: &[f64], b: &[f64], threshold: f64, keep: impl Fn(usize) -> bool) -> f64 {
-    let (mut s, mut n) = (0.0, 0usize);
-    for (i, (x, y)) in a.iter().zip(b).enumerate() {
-        let m = 0.5 * (x + y);
-        if m > 0.0 && m >= threshold && m.is_finite() && keep(i) {
-            s += (x - y).powi(2) / (2.0 * m * m);
-            n += 1;
-        }
-    }
-    if n == 0 {
-        f64::NAN
-    } else {
-        (s / n as f64).sqrt()
-    }
+fn masked_noise(a: &[f64], b: &[f64], keep: impl Fn(usize) -> bool) -> f64 {
+    relative_noise_where(a, b, keep).map_or(f64::NAN, |r| r.relative_noise)
 }
 
 /// Render `scene` at `spp` with seeds 1 and 2 and measure the noise; `skin` is the skin mask.
@@ -164,19 +152,13 @@ pub fn measure(
                 .collect::<Vec<f64>>(),
         );
     }
-    let mean: Vec<f64> = lum[0]
-        .iter()
-        .zip(&lum[1])
-        .map(|(x, y)| 0.5 * (x + y))
-        .collect();
-    let t = lit_threshold(&mean);
     Ok(Point {
         spp,
         cpu_s: 0.5 * cpu,
         wall_s: 0.5 * wall,
-        noise: masked_noise(&lum[0], &lum[1], t, |_| true),
-        noise_skin: masked_noise(&lum[0], &lum[1], t, |i| skin[i] > 0.5),
-        noise_other: masked_noise(&lum[0], &lum[1], t, |i| skin[i] <= 0.5),
+        noise: masked_noise(&lum[0], &lum[1], |_| true),
+        noise_skin: masked_noise(&lum[0], &lum[1], |i| skin[i] > 0.5),
+        noise_other: masked_noise(&lum[0], &lum[1], |i| skin[i] <= 0.5),
     })
 }
 

@@ -82,6 +82,10 @@ struct NoiseArgs {
     a: PathBuf,
     /// Second render of the same scene with another seed (RGB OpenEXR).
     b: PathBuf,
+    /// Also the metric over the lit pixels that see skin, by the `mask.skin` pass of the first
+    /// render (an EXR written by `skin render`): prints both lines.
+    #[arg(long)]
+    skin: bool,
 }
 
 #[derive(Args, Debug)]
@@ -353,15 +357,23 @@ fn run_mc(args: &McArgs) -> anyhow::Result<()> {
 }
 
 fn run_noise(args: &NoiseArgs) -> anyhow::Result<()> {
-    let r = render::noise::compare_exr(&args.a, &args.b)?;
-    println!(
-        "relative noise {:.4} ({:.2}%) over {} of {} pixels (lit: luminance ≥ {:.4e})",
-        r.relative_noise,
-        100.0 * r.relative_noise,
-        r.lit_pixels,
-        r.pixels,
-        r.threshold
-    );
+    let print = |what: &str, r: &render::noise::NoiseReport| {
+        println!(
+            "relative noise {:.4} ({:.2}%) over {} of {} pixels ({what}: luminance ≥ {:.4e})",
+            r.relative_noise,
+            100.0 * r.relative_noise,
+            r.lit_pixels,
+            r.pixels,
+            r.threshold
+        );
+    };
+    if args.skin {
+        let (lit, skin) = render::noise::compare_exr_with_skin(&args.a, &args.b)?;
+        print("lit", &lit);
+        print("lit skin", &skin);
+    } else {
+        print("lit", &render::noise::compare_exr(&args.a, &args.b)?);
+    }
     Ok(())
 }
 
