@@ -218,11 +218,7 @@ pub(super) fn turn(u: [f64; 3], cos_t: f64, cos_p: f64, sin_p: f64) -> [f64; 3] 
     let q = (sin2_t * one_minus_uz2).sqrt();
     if along_normal {
         // Not copysign: the sampled cosine keeps its own sign, relative to the current direction.
-        return [
-            q * cos_p,
-            q * sin_p,
-            if uz > 0.0 { cos_t } else { -cos_t },
-        ];
+        return [q * cos_p, q * sin_p, if uz > 0.0 { cos_t } else { -cos_t }];
     }
     let q_over = q / one_minus_uz2;
     [
