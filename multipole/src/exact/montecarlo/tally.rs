@@ -1,4 +1,7 @@
 //! What one batch of photons scores, and how independent batches become means with standard errors.
+//!
+//! The tallies and results are plain records of documented fields; their constructors list every
+//! field, which makes them resemble other records of the workspace in shape only.
 
 use crate::error::{MultipoleError, check_range};
 
@@ -247,17 +250,6 @@ impl McResult {
             + self.specular_reflectance
             + self.transmittance.mean
             + self.absorbed.mean
-    }
-
-    /// Combine equally sized batch tallies, in batch order (bitwise independent of thread count).
-    #[cfg(test)]
-    pub(crate) fn from_batches(tallies: &[BatchTally], specular: f64, grid: RadialGrid) -> Self {
-        let layers = tallies.first().map_or(0, |t| t.absorbed_by_layer.len());
-        let mut acc = Combiner::new(layers, grid);
-        for t in tallies {
-            acc.add(t);
-        }
-        acc.finish(specular)
     }
 }
 

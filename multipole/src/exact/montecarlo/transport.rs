@@ -4,6 +4,12 @@
 //! The geometry is z downwards from the lit face (z = 0). A layer that neither absorbs nor scatters
 //! (σt = 0) is crossed in one move to its boundary. Interfaces reflect all-or-none with the exact
 //! unpolarised Fresnel probability (MCML's default, [`brdf::fresnel::dielectric_reflectance`]).
+//!
+//! The photons run in SIMD lanes ([`lanes`]); the scalar path, one photon at a time, is kept as
+//! their reference in the tests. Both share one interaction ([`Photon::interact`]), one face test
+//! ([`reaches_face`]), one face crossing ([`Lane::face`]) and one roulette ([`Lane::roulette`]);
+//! `trace_batch` and the scalar `trace_scalar` repeat one signature on purpose, so that a test
+//! can run either.
 
 mod free_path;
 mod lanes;
@@ -185,7 +191,8 @@ impl Lane {
         }
         let cos_t = slab.hg.cos_theta(uniform(rng));
         let (cos_p, sin_p) = sampling::sample_azimuth(rng);
-        self.p.interact(step, slab.absorb_fraction, cos_t, cos_p, sin_p);
+        self.p
+            .interact(step, slab.absorb_fraction, cos_t, cos_p, sin_p);
         self.s_left = 0.0;
         tally.interactions += 1;
         self.roulette(rng, tally)

@@ -14,6 +14,10 @@
 //! - The loop is compiled for AVX-512, AVX2 and plain x86-64 (or any target) and picked at run
 //!   time (`pulp`'s dispatch). Rust never fuses a multiply and an add on its own, so the three
 //!   give the same bits.
+//!
+//! The lane state is held field by field (one array per quantity, as `HgLanes` holds the phase
+//! constants), so moving a photon in or out of a lane lists its fields one by one; `trace` and
+//! `Trace` list the same arguments because `pulp` hands them over as one value.
 
 use super::free_path::free_path_from_bits;
 use super::sampling::{HgLanes, azimuth_from_bits, uniform_from_bits};
@@ -160,19 +164,25 @@ impl Pack {
         (self.z_top[k], self.z_bottom[k]) = (-1.0, 1.0);
     }
 
-    /// Lane `k`'s photon, for the scalar code.
+    /// Lane `k`'s photon.
+    #[inline(always)]
+    fn photon(&self, k: usize) -> Photon {
+        Photon {
+            x: self.x[k],
+            y: self.y[k],
+            z: self.z[k],
+            ux: self.ux[k],
+            uy: self.uy[k],
+            uz: self.uz[k],
+            w: self.w[k],
+            layer: self.layer[k],
+        }
+    }
+
+    /// Lane `k`'s history, for the scalar code.
     fn get(&self, k: usize) -> Lane {
         Lane {
-            p: Photon {
-                x: self.x[k],
-                y: self.y[k],
-                z: self.z[k],
-                ux: self.ux[k],
-                uy: self.uy[k],
-                uz: self.uz[k],
-                w: self.w[k],
-                layer: self.layer[k],
-            },
+            p: self.photon(k),
             s_left: self.s_left[k],
             w_entry: self.w_entry[k],
         }
@@ -219,16 +229,7 @@ impl Pack {
             let face = reaches_face(self.uz[i], z_new, self.z_top[i], self.z_bottom[i]);
             let cos_t = self.hg.cos_theta(i, uniform_from_bits(r_cos[i]));
             let (cos_p, sin_p) = azimuth_from_bits(r_az[i]);
-            let mut p = Photon {
-                x: self.x[i],
-                y: self.y[i],
-                z: self.z[i],
-                ux: self.ux[i],
-                uy: self.uy[i],
-                uz: self.uz[i],
-                w: self.w[i],
-                layer: 0,
-            };
+            let mut p = self.photon(i);
             p.interact(step, self.absorb[i], cos_t, cos_p, sin_p);
             let pick = |old: f64, new: f64| if face { old } else { new };
             self.x[i] = pick(self.x[i], p.x);
@@ -358,12 +359,22 @@ mod tests {
             }
             let mut reference = Xoshiro256StarStar::from_seed(seed);
             for _ in 0..5 {
-                assert_eq!(LaneRng { streams: &mut streams, lane: k }.next_u64(), reference.next_u64());
+                assert_eq!(
+                    LaneRng {
+                        streams: &mut streams,
+                        lane: k
+                    }
+                    .next_u64(),
+                    reference.next_u64()
+                );
             }
         }
         // Lane states are the batch generator's next 4 W draws.
         let first = batch.next_u64();
-        assert_eq!(Streams::seeded(&mut Xoshiro256StarStar::seed_from_u64(7)).s[0][0], first);
+        assert_eq!(
+            Streams::seeded(&mut Xoshiro256StarStar::seed_from_u64(7)).s[0][0],
+            first
+        );
     }
 
     #[test]

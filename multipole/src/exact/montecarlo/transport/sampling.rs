@@ -204,29 +204,28 @@ pub(super) fn scatter(p: &mut Photon, hg: &HgSampler, rng: &mut impl RngCore) {
 ///
 /// Eq 3.20 needs sin θ / √(1 − u_z²) and sin θ · √(1 − u_z²); both come from one square root,
 /// q = √((1 − cos²θ)(1 − u_z²)), as q / (1 − u_z²) and q: one square root and one division
-/// fewer than taking sin θ and √(1 − u_z²) apart. Both cases are evaluated and one selected (the
-/// unused one may divide by zero, harmlessly), so a loop over photon lanes vectorises.
+/// fewer than taking sin θ and √(1 − u_z²) apart. Along the normal the same square root, of
+/// 1 − cos²θ alone, gives sin θ. Both cases are evaluated and one selected, so a loop over photon
+/// lanes vectorises.
 #[inline(always)]
 pub(super) fn turn(u: [f64; 3], cos_t: f64, cos_p: f64, sin_p: f64) -> [f64; 3] {
     let [ux, uy, uz] = u;
+    let along_normal = uz.abs() > COS_ZERO;
     // |cos θ| ≤ 1 (clamped), so its rounded square is ≤ 1 and this is never negative.
     let sin2_t = 1.0 - cos_t * cos_t;
-    let sin_t = sin2_t.sqrt();
-    // Not copysign: the sampled cosine keeps its own sign, relative to the current direction.
-    let normal = [
-        sin_t * cos_p,
-        sin_t * sin_p,
-        if uz > 0.0 { cos_t } else { -cos_t },
-    ];
-    let one_minus_uz2 = 1.0 - uz * uz;
+    let one_minus_uz2 = if along_normal { 1.0 } else { 1.0 - uz * uz };
+    // q, or sin θ along the normal (where 1 − u_z² is replaced by 1).
     let q = (sin2_t * one_minus_uz2).sqrt();
+    if along_normal {
+        // Not copysign: the sampled cosine keeps its own sign, relative to the current direction.
+        return [q * cos_p, q * sin_p, if uz > 0.0 { cos_t } else { -cos_t }];
+    }
     let q_over = q / one_minus_uz2;
-    let general = [
+    [
         q_over * (ux * uz * cos_p - uy * sin_p) + ux * cos_t,
         q_over * (uy * uz * cos_p + ux * sin_p) + uy * cos_t,
         uz * cos_t - q * cos_p,
-    ];
-    if uz.abs() > COS_ZERO { normal } else { general }
+    ]
 }
 
 #[cfg(test)]

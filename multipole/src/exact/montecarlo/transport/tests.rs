@@ -1,5 +1,6 @@
 //! The SIMD lanes change the order and the source of the draws, never the statistics: they agree
-//! with the scalar path, one photon at a time, on the reference cases.
+//! with the scalar path, one photon at a time, on the reference cases. The stacks are spelled out
+//! layer by layer, as in the cross-crate tests, so a reader sees each case whole.
 
 use super::*;
 use crate::exact::montecarlo::tally::Estimate;
