@@ -1,13 +1,15 @@
 //! End-to-end checks of subsurface scattering in the tracer: the flat slab renders to the
 //! model's total diffuse reflectance with the documented energy split plus the specular term, a
-//! closed sphere of skin in a white furnace never outshines the environment, and skin parameters
-//! at the edges of their ranges render finite, non-negative images.
+//! closed sphere of skin in a white furnace renders to the separable BSSRDF's closed form there,
+//! and skin parameters at the edges of their ranges render finite, non-negative images.
 
 use render::bssrdf::{Directional, EnergySplit};
 mod common;
 
 use common::{SceneText, assert_finite_non_negative, mean_xyz, run, xyz_of};
-use glam::Vec3;
+use glam::{Vec2, Vec3};
+use render::material::Material;
+use render::scene::Hit;
 use skin_optics::color::d65;
 use skin_optics::{Preset, SkinParams, Wavelength};
 
@@ -98,61 +100,154 @@ fn flat_slab_at_oblique_incidence_and_view_matches_the_closed_form() {
     }
 }
 
-/// A closed sphere of skin inside a uniform white environment of radiance 1: the rendered
-/// radiance never exceeds the environment's (mean over the sphere within 1% MC noise, every
-/// pixel within a loose per-pixel bound), for a large sphere and one smaller than the profiles'
-/// reach (where the local fallback for missing surface is exercised).
+/// A bloodless, melanin-free light-skin sphere of `radius_mm` inside a uniform white environment
+/// of luminance 1, seen from 8 radii with a 10° field of view (the image lies inside the sphere's
+/// disc: exit angles from 0° at the centre to 79° at the corners), at full fidelity.
+fn furnace(radius_mm: f32) -> render::scene::Scene {
+    SceneText::camera([0.0, 0.0, radius_mm * 8.0], 10.0)
+        .environment("constant", 1.0)
+        .skin(
+            "skin",
+            "preset = \"light\"\nhemoglobin = 0.0\nmelanin = 0.0",
+        )
+        .mesh("sphere", "skin", radius_mm)
+        .with("[fidelity]\nfidelity = \"full\"")
+        .load()
+}
+
+/// Image means of the surface lobe's albedo ρ_dr(θ_o) and of T(θ_o) = 1 − ρ_dr(θ_o) over the
+/// film: 4×4 points per pixel, each a camera ray against the scene's own mesh, θ_o from its
+/// shading normal.
+fn image_mean_albedo(scene: &render::scene::Scene, w: usize, h: usize) -> (f64, f64) {
+    let Material::Skin(skin) = &scene.materials[0] else {
+        unreachable!("the furnace holds one skin")
+    };
+    let k = 4;
+    let (mut rho, mut t) = (0.0, 0.0);
+    for (py, px, j, i) in film_points(w, h, k) {
+        let ndc = Vec2::new(
+            (px as f32 + (i as f32 + 0.5) / k as f32) / w as f32,
+            (py as f32 + (j as f32 + 0.5) / k as f32) / h as f32,
+        );
+        let (o, d) = scene
+            .camera
+            .generate_ray(ndc, w as f32 / h as f32, Vec2::ZERO);
+        let Some(Hit::Surface(si)) = scene.intersect(o, d, 0.0, f32::INFINITY) else {
+            panic!("pixel {px},{py} misses the sphere")
+        };
+        let mu = (-d).dot(si.ns).clamp(0.0, 1.0);
+        rho += f64::from(skin.surface.directional_albedo(mu));
+        t += f64::from(skin.surface.transmitted_fraction(mu));
+    }
+    let n = (w * h * k * k) as f64;
+    (rho / n, t / n)
+}
+
+/// Every (row, column, sub-row, sub-column) of a `w`×`h` film with `k`×`k` points per pixel.
+fn film_points(w: usize, h: usize, k: usize) -> impl Iterator<Item = (usize, usize, usize, usize)> {
+    (0..h).flat_map(move |py| {
+        (0..w).flat_map(move |px| (0..k).flat_map(move |j| (0..k).map(move |i| (py, px, j, i))))
+    })
+}
+
+/// Standard error of the film's mean XYZ from the spread of its pixels, sd / √pixels. It
+/// overstates the noise (the pixels also differ by their exit angle), so a bound built on it is
+/// conservative.
+fn pixel_standard_error(film: &render::film::Film, mean: [f64; 3]) -> [f64; 3] {
+    let (w, h) = film.size();
+    let n = (w * h) as f64;
+    std::array::from_fn(|c| {
+        let ss: f64 = (0..h)
+            .flat_map(|py| (0..w).map(move |px| (px, py)))
+            .map(|(px, py)| (f64::from(film.xyz(px, py)[c]) - mean[c]).powi(2))
+            .sum();
+        (ss / (n - 1.0) / n).sqrt()
+    })
+}
+
+/// A closed sphere of skin in a white furnace renders to what the separable BSSRDF gives there,
+/// two-sided, and never outshines the environment.
+///
+/// Each pixel sees ρ_dr(θ_o) of the environment off the surface lobe plus T(θ_o) R_tot through the
+/// skin: light leaving the sphere anywhere sees the whole uniform environment (the sphere is
+/// convex) and S_ω integrates to 1. So the image mean is ρ̄ E + T̄ R_tot (ρ̄, T̄ the image means of
+/// ρ_dr and T from the film's own rays, `image_mean_albedo`; E the environment):
+/// - radius 100 mm, far larger than the profiles' 99% radius (5 mm), where the probes find the
+///   sphere as they find a plane: R_tot = `multipole::skin::total_reflectance`;
+/// - radius 2 mm, smaller than the profiles: the probes find the sphere's points at chord
+///   distance d ≤ 2R, and over a sphere dA = 2πd dd (Archimedes' hat-box theorem), so they return
+///   R_tot F(2R), F the profile's energy fraction within a radius; a normal probe misses where the
+///   planar radius exceeds R (the sphere's shadow on its tangent plane) and the local fallback
+///   (`render::bssrdf`) returns the planar energy there, R_tot (1 − F(R)). Together
+///   R_tot (1 + F(2R) − F(R)): the band R < r < 2R is counted twice, 5–6% of R_tot in X and Y
+///   here (measured, with F from the material's table).
+///
+/// Tolerance per channel: 4 standard errors of the image mean (`pixel_standard_error`,
+/// conservative; 0.15–0.3% at radius 100, 0.45–0.6% at radius 2) plus 0.2% for the model side:
+/// the table holds the model's totals to 1e-4 (full fidelity, 10-nm rows), the f32 tables and
+/// the 16-point pixel quadrature of ρ̄ (ρ̄ ≈ 0.009) add less. Measured (24×24 pixels × 32 paths,
+/// seeds 7 and 8): radius 100 within 0.3%, radius 2 within 0.55%.
+///
+/// (An earlier reading of 1.1–1.9% below R_tot, apparently independent of the radius, was one
+/// seed's noise: the scene is scale-free, so the same seed traces the same paths at every radius;
+/// seeds 8 and 9 gave 0.3–1.1% above. docs/tests.md.)
 #[test]
-fn skin_sphere_in_a_white_furnace_never_exceeds_the_environment() {
-    for radius in [100.0, 2.0] {
-        let s = SceneText::camera([0.0, 0.0, radius * 8.0], 10.0)
-            .environment("constant", 1.0)
-            .skin(
-                "skin",
-                "preset = \"light\"\nhemoglobin = 0.0\nmelanin = 0.0",
+fn skin_sphere_in_a_white_furnace_renders_the_separable_closed_form() {
+    let light = SkinParams::preset(Preset::Light);
+    let bloodless = SkinParams::new(0.0, light.eumelanin_blend(), 0.0, light.oiliness()).unwrap();
+    let y = xyz_of(|_| 1.0)[1];
+    let env = xyz_of(|_| 1.0 / y);
+    for radius in [100.0f32, 2.0] {
+        let s = furnace(radius);
+        let (w, h) = (24, 24);
+        let (rho, t) = image_mean_albedo(&s, w, h);
+        let Material::Skin(skin) = &s.materials[0] else {
+            unreachable!("the furnace holds one skin")
+        };
+        let table = &skin.subsurface.as_ref().expect("BSSRDF on").table;
+        // F(r): the row's energy within r, by a 2,000-point midpoint rule of 2πr R(r).
+        let within = |nm: f32, r_mm: f32| -> f64 {
+            let n = 2000;
+            let dr = r_mm / n as f32;
+            let e: f64 = (0..n)
+                .map(|i| {
+                    let r = (i as f32 + 0.5) * dr;
+                    f64::from(2.0 * std::f32::consts::PI * r * table.eval(nm, r) * dr)
+                })
+                .sum();
+            e / f64::from(table.total(nm))
+        };
+        let found = |nm: f64| {
+            let rd = multipole::skin::total_reflectance(
+                &bloodless,
+                Wavelength::new(nm).unwrap(),
+                multipole::Method::default(),
             )
-            .mesh("sphere", "skin", radius)
-            .load();
-        let film = run(&s, 24, 24, 32, SEED);
-        let y = xyz_of(|_| 1.0)[1];
-        let env = xyz_of(|_| 1.0 / y);
+            .unwrap();
+            if radius > 50.0 {
+                rd
+            } else {
+                let nm = nm as f32;
+                rd * (1.0 + within(nm, 2.0 * radius) - within(nm, radius))
+            }
+        };
+        let body = xyz_of(|nm| found(nm) / y);
+        let film = run(&s, w, h, 32, SEED);
         let got = mean_xyz(&film);
+        let se = pixel_standard_error(&film, got);
         for c in 0..3 {
+            let want = rho * env[c] + t * body[c];
             assert!(
-                got[c] <= env[c] * 1.01,
-                "radius {radius}: channel {c}: {got:?} vs environment {env:?}"
+                (got[c] - want).abs() <= 4.0 * se[c] + 2e-3 * want,
+                "radius {radius}: channel {c}: {got:?} vs {want} (± {})",
+                se[c]
+            );
+            assert!(
+                got[c] <= env[c],
+                "radius {radius}: channel {c}: {got:?} above the environment {env:?}"
             );
         }
-        if radius > 50.0 {
-            // Far larger than the profiles' reach, each point of the sphere reflects the uniform
-            // environment like a flat slab: ρ_dr(θ_o) + T(θ_o) R_tot = R_tot + ρ_dr (1 − R_tot) ≥ R_tot.
-            // Measured: the render falls 1.1% (Y) to 1.9% (Z) below R_tot alone, about 3% short of
-            // the flat-slab value, and by the same amount at radius 100, 400 and 1600 mm
-            // (docs/tests.md): not curvature or probe rays missing the surface, which would shrink
-            // as the radius grows past the profiles' reach. The loss is still unexplained (the
-            // closed-form slab checks cover 0° and 45°/30° only; the furnace also integrates
-            // grazing angles). The floor is R_tot − 3%, so that known deficit passes and any
-            // larger loss fails.
-            let light = SkinParams::preset(Preset::Light);
-            let bloodless =
-                SkinParams::new(0.0, light.eumelanin_blend(), 0.0, light.oiliness()).unwrap();
-            let floor = xyz_of(|nm| {
-                multipole::skin::total_reflectance(
-                    &bloodless,
-                    Wavelength::new(nm).unwrap(),
-                    multipole::Method::default(),
-                )
-                .unwrap()
-                    / y
-            });
-            for c in 0..3 {
-                assert!(
-                    got[c] >= floor[c] * 0.97,
-                    "channel {c}: {got:?} below the R_tot floor {floor:?}"
-                );
-            }
-        }
-        assert_finite_non_negative(&film, "image");
+        assert_finite_non_negative(&film, &format!("radius {radius}"));
     }
 }
 
