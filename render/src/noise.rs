@@ -138,10 +138,11 @@ pub fn read_exr_luminance(path: &Path) -> Result<(Vec<f64>, (usize, usize)), Noi
 /// The `mask.skin` pass of an OpenEXR written by `skin render` (1 where the pixel centre sees
 /// skin), or `None` when the file has no such channel.
 pub fn read_exr_skin_mask(path: &Path) -> Result<Option<Vec<f32>>, NoiseError> {
-    let img = exr::prelude::read_first_flat_layer_from_file(path).map_err(|e| NoiseError::Read {
-        path: path.to_path_buf(),
-        message: e.to_string(),
-    })?;
+    let img =
+        exr::prelude::read_first_flat_layer_from_file(path).map_err(|e| NoiseError::Read {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        })?;
     let channels = &img.layer_data.channel_data.list;
     Ok(channels
         .iter()
@@ -167,10 +168,7 @@ pub fn compare_exr(a: &Path, b: &Path) -> Result<NoiseReport, NoiseError> {
 
 /// The metric on two renders over all lit pixels and over the lit skin pixels (by the
 /// `mask.skin` pass of `a`), in that order.
-pub fn compare_exr_with_skin(
-    a: &Path,
-    b: &Path,
-) -> Result<(NoiseReport, NoiseReport), NoiseError> {
+pub fn compare_exr_with_skin(a: &Path, b: &Path) -> Result<(NoiseReport, NoiseReport), NoiseError> {
     let (la, lb) = read_pair(a, b)?;
     let mask = read_exr_skin_mask(a)?.ok_or_else(|| NoiseError::NoSkinMask {
         path: a.to_path_buf(),
@@ -235,9 +233,15 @@ mod tests {
         let quiet = relative_noise_where(&a, &b, |i| i < 50).unwrap();
         assert_eq!((quiet.relative_noise, quiet.lit_pixels), (0.0, 50));
         let noisy = relative_noise_where(&a, &b, |i| i >= 50).unwrap();
-        assert!((noisy.relative_noise - 0.02f64.sqrt()).abs() < 1e-12, "{noisy:?}");
+        assert!(
+            (noisy.relative_noise - 0.02f64.sqrt()).abs() < 1e-12,
+            "{noisy:?}"
+        );
         let all = relative_noise(&a, &b).unwrap();
-        assert!((all.relative_noise - 0.01f64.sqrt()).abs() < 1e-12, "{all:?}");
+        assert!(
+            (all.relative_noise - 0.01f64.sqrt()).abs() < 1e-12,
+            "{all:?}"
+        );
         assert_eq!(quiet.threshold, all.threshold);
         assert!(matches!(
             relative_noise_where(&a, &b, |_| false),

@@ -30,7 +30,6 @@ pub enum SamplerKind {
     SobolPair,
 }
 
-
 /// Dimensions reserved for the camera: wavelength, film x, y, lens u, v (and three spare).
 pub const CAMERA_DIMENSIONS: u32 = 8;
 /// Dimensions reserved for each bounce (light choice and position, subsurface probe, exit

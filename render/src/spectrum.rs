@@ -33,10 +33,14 @@ const VISIBLE_A_PER_NM: f32 = 0.0072;
 /// Centre of the visible-wavelength density, nm ([pbrt] 4th ed. §4.6.5).
 const VISIBLE_CENTRE_NM: f32 = 538.0;
 
-/// tanh(A (λ − 538)) at the two ends of the rendered range: the unnormalised CDF's bounds.
+/// tanh(A (λ − 538)) at the two ends of the rendered range: the unnormalised CDF's bounds
+/// (computed once: two tanh per wavelength were a few % of a path's time).
 fn visible_cdf_bounds() -> (f32, f32) {
-    let t = |nm: f32| (VISIBLE_A_PER_NM * (nm - VISIBLE_CENTRE_NM)).tanh();
-    (t(LAMBDA_MIN_NM), t(LAMBDA_MAX_NM))
+    static BOUNDS: std::sync::LazyLock<(f32, f32)> = std::sync::LazyLock::new(|| {
+        let t = |nm: f32| (VISIBLE_A_PER_NM * (nm - VISIBLE_CENTRE_NM)).tanh();
+        (t(LAMBDA_MIN_NM), t(LAMBDA_MAX_NM))
+    });
+    *BOUNDS
 }
 
 /// Density of [`WavelengthSampling::Visible`] at `nm`, nm⁻¹ (integrates to 1 over 380–780 nm).

@@ -23,6 +23,9 @@ pub struct Texture {
     width: usize,
     height: usize,
     texels: Vec<[f32; 3]>,
+    /// The luminance of every texel: a third of the texels' memory, so the skin's per-probe
+    /// modulation lookups (luminance only) miss the cache less.
+    luminance: Vec<f32>,
 }
 
 fn image_err(path: &Path, message: impl Into<String>) -> RenderError {
@@ -65,11 +68,7 @@ impl Texture {
             .chunks_exact(3)
             .map(|p| [lut[p[0] as usize], lut[p[1] as usize], lut[p[2] as usize]])
             .collect();
-        Ok(Self {
-            width,
-            height,
-            texels,
-        })
+        Ok(Self::from_texels(width, height, texels))
     }
 
     /// Decode a linear RGB(A) OpenEXR image (alpha ignored). The headers are read and the sizes
@@ -91,23 +90,19 @@ impl Texture {
             .no_deep_data()
             .largest_resolution_level()
             .rgba_channels(
-                |size, _| Texture {
-                    width: size.0,
-                    height: size.1,
-                    texels: vec![[0.0; 3]; size.0 * size.1],
-                },
-                |t: &mut Texture, pos, (r, g, b, _a): (f32, f32, f32, f32)| {
-                    let w = t.width;
-                    t.texels[pos.1 * w + pos.0] = [r, g, b];
+                |size, _| (size.0, size.1, vec![[0.0f32; 3]; size.0 * size.1]),
+                |t: &mut (usize, usize, Vec<[f32; 3]>),
+                 pos,
+                 (r, g, b, _a): (f32, f32, f32, f32)| {
+                    t.2[pos.1 * t.0 + pos.0] = [r, g, b];
                 },
             )
             .first_valid_layer()
             .all_attributes()
             .from_buffered(std::io::Cursor::new(bytes))
             .map_err(|e| image_err(path, e.to_string()))?;
-        let tex = img.layer_data.channel_data.pixels;
-        if let Some(v) = tex
-            .texels
+        let (width, height, texels) = img.layer_data.channel_data.pixels;
+        if let Some(v) = texels
             .iter()
             .flatten()
             .find(|v| !(v.is_finite() && (0.0..=MAX_TEXEL).contains(*v)))
@@ -120,17 +115,19 @@ impl Texture {
                 ),
             ));
         }
-        Ok(tex)
+        Ok(Self::from_texels(width, height, texels))
     }
 
     /// A texture from raw linear texels (row-major, `width × height`).
     #[must_use]
     pub fn from_texels(width: usize, height: usize, texels: Vec<[f32; 3]>) -> Self {
         assert_eq!(texels.len(), width * height, "texel count");
+        let luminance = texels.iter().map(|&t| luminance(t)).collect();
         Self {
             width,
             height,
             texels,
+            luminance,
         }
     }
 
@@ -140,27 +137,54 @@ impl Texture {
         (self.width, self.height)
     }
 
-    fn texel(&self, x: i64, y: i64) -> [f32; 3] {
-        let x = x.rem_euclid(self.width as i64) as usize;
-        let y = y.clamp(0, self.height as i64 - 1) as usize;
-        self.texels[y * self.width + x]
+    /// Row-major index of texel (x, y), x wrapped, y clamped.
+    fn index(&self, x: i64, y: i64) -> usize {
+        let (w, h) = (self.width as i64, self.height as i64);
+        // Inside the image (nearly always) no division is needed.
+        let x = if (0..w).contains(&x) {
+            x
+        } else {
+            x.rem_euclid(w)
+        };
+        (y.clamp(0, h - 1) * w + x) as usize
     }
 
-    /// Bilinear lookup at `uv` (u right, v down the rows, both in [0, 1], u wraps).
-    #[must_use]
-    pub fn lookup(&self, uv: Vec2) -> [f32; 3] {
+    /// The four texels around `uv` (row-major indices) and their bilinear weights.
+    fn footprint(&self, uv: Vec2) -> ([usize; 4], [f32; 4]) {
         let x = uv.x * self.width as f32 - 0.5;
         let y = uv.y * self.height as f32 - 0.5;
         let (x0, y0) = (x.floor(), y.floor());
         let (fx, fy) = (x - x0, y - y0);
         let (x0, y0) = (x0 as i64, y0 as i64);
-        let a = self.texel(x0, y0);
-        let b = self.texel(x0 + 1, y0);
-        let c = self.texel(x0, y0 + 1);
-        let d = self.texel(x0 + 1, y0 + 1);
-        std::array::from_fn(|i| {
-            (a[i] * (1.0 - fx) + b[i] * fx) * (1.0 - fy) + (c[i] * (1.0 - fx) + d[i] * fx) * fy
-        })
+        (
+            [
+                self.index(x0, y0),
+                self.index(x0 + 1, y0),
+                self.index(x0, y0 + 1),
+                self.index(x0 + 1, y0 + 1),
+            ],
+            [
+                (1.0 - fx) * (1.0 - fy),
+                fx * (1.0 - fy),
+                (1.0 - fx) * fy,
+                fx * fy,
+            ],
+        )
+    }
+
+    /// Bilinear lookup at `uv` (u right, v down the rows, both in [0, 1], u wraps).
+    #[must_use]
+    pub fn lookup(&self, uv: Vec2) -> [f32; 3] {
+        let (idx, wt) = self.footprint(uv);
+        std::array::from_fn(|c| (0..4).map(|k| self.texels[idx[k]][c] * wt[k]).sum())
+    }
+
+    /// Bilinear lookup of the luminance ([`luminance`]) at `uv`: the luminance of
+    /// [`Texture::lookup`] (both are linear in the texels), from a third of the memory.
+    #[must_use]
+    pub fn lookup_luminance(&self, uv: Vec2) -> f32 {
+        let (idx, wt) = self.footprint(uv);
+        (0..4).map(|k| self.luminance[idx[k]] * wt[k]).sum()
     }
 
     /// Mean of each channel over all texels.
@@ -238,6 +262,17 @@ mod tests {
     fn bilinear_lookup_interpolates_between_texel_centres() {
         let t = Texture::from_texels(2, 1, vec![[0.0; 3], [1.0; 3]]);
         assert!((t.lookup(Vec2::new(0.5, 0.5))[0] - 0.5).abs() < 1e-6);
+        // The luminance lookup is the luminance of the colour lookup, wrapping in u too.
+        let t = Texture::from_texels(
+            3,
+            2,
+            (0..6).map(|i| [i as f32, 0.5, 6.0 - i as f32]).collect(),
+        );
+        for uv in [(0.1, 0.3), (0.95, 0.8), (1.3, 0.5), (-0.2, 1.2)] {
+            let uv = Vec2::new(uv.0, uv.1);
+            let (a, b) = (t.lookup_luminance(uv), luminance(t.lookup(uv)));
+            assert!((a - b).abs() < 1e-5, "{uv}: {a} against {b}");
+        }
         assert!((t.lookup(Vec2::new(0.25, 0.5))[0]).abs() < 1e-6);
     }
 

@@ -31,7 +31,7 @@ pub struct Variant {
 }
 
 /// The steps in the order they were added, each on top of the one before (the first is the
-/// renderer before any of them, the sixth today's default), then two other normal-probe
+/// renderer before any of them, the seventh today's default), then two other normal-probe
 /// probabilities on top of the fourth.
 #[must_use]
 pub fn variants() -> Vec<Variant> {
@@ -63,6 +63,10 @@ pub fn variants() -> Vec<Variant> {
         exit_light_samples: 2,
         ..normal
     };
+    let pair = PathSettings {
+        sampler: SamplerKind::SobolPair,
+        ..two_lights
+    };
     [
         ("before (independent + uniform λ)", before),
         ("+ Sobol", sobol),
@@ -70,6 +74,7 @@ pub fn variants() -> Vec<Variant> {
         ("+ exit light at every skin hit", split),
         ("+ normal probes 0.95", normal),
         ("+ 2 light samples per exit", two_lights),
+        ("+ two Sobol half-sequences", pair),
         (
             "normal probes 0.8",
             PathSettings {

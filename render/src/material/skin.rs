@@ -11,7 +11,7 @@
 use crate::bssrdf::{Directional, EnergySplit, Subsurface};
 use crate::material::{SurfaceKind, TextureRef};
 use crate::spectrum::SpectrumTable;
-use crate::texture::{Texture, luminance};
+use crate::texture::Texture;
 use brdf::TorranceSparrow;
 use glam::Vec2;
 use rayon::prelude::*;
@@ -206,7 +206,7 @@ impl SkinMaterial {
     #[must_use]
     pub fn texture_factor(&self, uv: Vec2, textures: &[Texture]) -> f32 {
         self.albedo_texture.map_or(1.0, |t| {
-            luminance(textures[t.index].lookup(uv)) / t.mean_luminance
+            textures[t.index].lookup_luminance(uv) / t.mean_luminance
         })
     }
 }
