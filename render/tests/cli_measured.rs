@@ -106,14 +106,30 @@ fn sci_full_fit_of_a_generated_spectrum_reports_its_model() {
     std::fs::remove_file(path).ok();
 }
 
+/// A colour target takes the instrument's geometry and the model, as a spectrum does, and comes
+/// as sRGB or as CIELAB; bad CIELAB text is a usage error naming the coordinate and its range.
 #[test]
-fn colour_fits_refuse_the_full_model_and_a_geometry() {
-    let out = skin(&["fit", "--srgb", "#b69a89", "--model", "full"]);
-    assert!(!out.status.success());
-    assert!(text(&out.stderr).contains("--model full needs --spectrum"));
-    let out = skin(&["fit", "--srgb", "#b69a89", "--geometry", "sci"]);
-    assert!(!out.status.success());
-    assert!(text(&out.stderr).contains("--geometry applies to --spectrum"));
+fn colour_fits_take_a_lab_target_the_geometry_and_the_model() {
+    for (lab, says) in [
+        ("55,x,1", "a* 'x' is not a number"),
+        ("101,0,0", "L* = 101 outside [0, 100]"),
+        ("55,12", "2 comma-separated fields"),
+    ] {
+        let out = skin(&["fit", "--lab", lab]);
+        assert_eq!(out.status.code(), Some(2), "{lab}");
+        assert!(text(&out.stderr).contains(says), "{lab}: {}", text(&out.stderr));
+    }
+    // A colour of the seed model's gamut under SCI: reached (the fit's ΔE00 is ~1e-6 for a colour
+    // the model produces; 0.1 is a tenth of a just-noticeable difference).
+    let out = skin(&[
+        "fit", "--lab", "55,10,15", "--geometry", "sci", "--model", "full", "--method",
+        "multipole", "--json",
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["geometry"], "sci");
+    assert_eq!(v["free_parameters"].as_object().unwrap().len(), 11);
+    assert!(v["residual"]["delta_e_2000"].as_f64().unwrap() < 0.1, "{v}");
     let out = skin(&["fit", "--srgb", "#b69a89", "--model", "tiny"]);
     assert_eq!(out.status.code(), Some(2));
     assert!(text(&out.stderr).contains("valid: seed, full, auto"));

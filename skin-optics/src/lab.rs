@@ -125,6 +125,68 @@ impl Lab {
     }
 }
 
+/// Why a text is not a CIELAB colour `L,a,b`.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum LabParseError {
+    /// Not three comma-separated fields.
+    #[error("'{text}' has {found} comma-separated fields; a CIELAB colour is L,a,b (e.g. 55.2,12.1,17.5)")]
+    Fields {
+        /// The text given.
+        text: String,
+        /// Fields found.
+        found: usize,
+    },
+    /// A field that is not a number.
+    #[error("{coordinate} '{text}' is not a number")]
+    Number {
+        /// `L*`, `a*` or `b*`.
+        coordinate: &'static str,
+        /// The field.
+        text: String,
+    },
+    /// A coordinate outside its range.
+    #[error(transparent)]
+    Range(#[from] crate::OpticsError),
+}
+
+impl std::str::FromStr for Lab {
+    type Err = LabParseError;
+
+    /// `L,a,b` (spaces allowed): L* in [0, 100], a* and b* in [−200, 200] (beyond every
+    /// surface colour under D65).
+    fn from_str(s: &str) -> Result<Lab, LabParseError> {
+        let fields: Vec<&str> = s.split(',').map(str::trim).collect();
+        if fields.len() != 3 {
+            return Err(LabParseError::Fields {
+                text: s.to_string(),
+                found: fields.len(),
+            });
+        }
+        let mut v = [0.0; 3];
+        for (i, (name, range, lo, hi)) in [
+            ("L*", "[0, 100]", 0.0, 100.0),
+            ("a*", "[-200, 200]", -200.0, 200.0),
+            ("b*", "[-200, 200]", -200.0, 200.0),
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            let x = fields[i]
+                .parse::<f64>()
+                .map_err(|_| LabParseError::Number {
+                    coordinate: name,
+                    text: fields[i].to_string(),
+                })?;
+            v[i] = crate::error::check_range(name, x, lo, hi, range)?;
+        }
+        Ok(Lab {
+            l: v[0],
+            a: v[1],
+            b: v[2],
+        })
+    }
+}
+
 impl From<Xyz> for Lab {
     fn from(xyz: Xyz) -> Lab {
         Lab::from_xyz(xyz)
@@ -154,6 +216,28 @@ const C7_REF: f64 = 6_103_515_625.0;
 /// for hues on opposite sides of 0°/360° and for achromatic colours). Symmetric; 0 for equal colours.
 #[must_use]
 pub fn delta_e_2000(c1: Lab, c2: Lab) -> f64 {
+    let [tl, tc, th, r_t] = weighted_differences(c1, c2);
+    // The rotation term can make the radicand a rounding error below zero for tiny differences.
+    (tl * tl + tc * tc + th * th + r_t * tc * th)
+        .max(0.0)
+        .sqrt()
+}
+
+/// ΔE00 as three terms whose Euclidean norm is [`delta_e_2000`] (to rounding): ΔL'/S_L,
+/// ΔC'/S_C + (R_T/2) ΔH'/S_H and √(1 − R_T²/4) ΔH'/S_H ([SWD05] eq. 22 with its cross term
+/// completed to a square; |R_T| ≤ 2). A least-squares fit to a colour minimises their squares.
+#[must_use]
+pub fn delta_e_2000_terms(c1: Lab, c2: Lab) -> [f64; 3] {
+    let [tl, tc, th, r_t] = weighted_differences(c1, c2);
+    [
+        tl,
+        tc + 0.5 * r_t * th,
+        (1.0 - 0.25 * r_t * r_t).max(0.0).sqrt() * th,
+    ]
+}
+
+/// [SWD05] eqs 2–22 up to the final sum: ΔL'/S_L, ΔC'/S_C, ΔH'/S_H and the rotation R_T.
+fn weighted_differences(c1: Lab, c2: Lab) -> [f64; 4] {
     // Eqs 2–6: rescale a* so near-neutral colours get a hue scale closer to perception.
     let c_bar = 0.5 * (c1.chroma() + c2.chroma());
     let c_bar7 = c_bar.powi(7);
@@ -211,11 +295,7 @@ pub fn delta_e_2000(c1: Lab, c2: Lab) -> f64 {
     let s_h = 1.0 + 0.015 * cp_bar * t;
     let r_t = -(2.0 * d_theta_deg).to_radians().sin() * r_c;
 
-    let (tl, tc, th) = (dl / s_l, dc / s_c, dh_big / s_h);
-    // The rotation term can make the radicand a rounding error below zero for tiny differences.
-    (tl * tl + tc * tc + th * th + r_t * tc * th)
-        .max(0.0)
-        .sqrt()
+    [dl / s_l, dc / s_c, dh_big / s_h, r_t]
 }
 
 /// Smallest b* the ITA° formula divides by (see [`Lab::ita_deg`]); skin is yellowish, b* well
@@ -341,6 +421,32 @@ mod tests {
             );
             assert!((delta_e_2000(y, x) - got).abs() < 1e-12, "symmetry");
         }
+    }
+
+    /// The three terms square-sum to ΔE00 on every published pair (the blue ones carry a large
+    /// rotation term R_T, so the completed square is exercised); 1e-9 is rounding.
+    #[test]
+    fn delta_e_2000_terms_square_sum_to_the_difference() {
+        for (p, q, _) in SHARMA_PAIRS {
+            let (x, y) = (lab(p[0], p[1], p[2]), lab(q[0], q[1], q[2]));
+            let t = delta_e_2000_terms(x, y);
+            let norm = t.iter().map(|v| v * v).sum::<f64>().sqrt();
+            assert!((norm - delta_e_2000(x, y)).abs() < 1e-9, "{p:?} {q:?}");
+        }
+    }
+
+    #[test]
+    fn lab_text_parses_and_bad_text_is_a_typed_error() {
+        let c: Lab = " 55.2, 12.1 ,17.5".parse().unwrap();
+        assert_eq!((c.l, c.a, c.b), (55.2, 12.1, 17.5));
+        let e = "55,12".parse::<Lab>().unwrap_err();
+        assert_eq!(e, LabParseError::Fields { text: "55,12".into(), found: 2 });
+        let e = "55,x,1".parse::<Lab>().unwrap_err();
+        assert!(matches!(e, LabParseError::Number { coordinate: "a*", .. }), "{e}");
+        let e = "101,0,0".parse::<Lab>().unwrap_err();
+        assert_eq!(e.to_string(), "L* = 101 outside [0, 100]");
+        let e = "50,0,NaN".parse::<Lab>().unwrap_err();
+        assert!(matches!(e, LabParseError::Range(crate::OpticsError::NonFinite { name: "b*", .. })), "{e}");
     }
 
     #[test]

@@ -7,6 +7,7 @@ pub mod shape_error;
 pub use multipole::montecarlo;
 pub mod measured;
 pub mod measured_colour;
+pub mod mean_colours;
 pub mod measured_report;
 pub mod noise_chart;
 pub mod presets;

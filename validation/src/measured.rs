@@ -87,6 +87,9 @@ pub struct RecordFit {
     pub record: Record,
     /// Its fit.
     pub fit: MeasuredFit,
+    /// CPU time of the fit on the thread that ran it, s (one core's cost when rayon runs one
+    /// thread, `RAYON_NUM_THREADS=1`; with more threads the nested per-wavelength work spreads).
+    pub cpu_s: f64,
 }
 
 /// Fit every record (rayon across records, with a progress bar on stderr).
@@ -100,11 +103,14 @@ pub fn fit_records(records: &[Record], opts: &MeasuredOptions) -> Result<Vec<Rec
     let fits = records
         .par_iter()
         .map(|r| {
+            let cpu = cpu_time::ThreadTime::now();
             let fit = fit_measured(&r.spectrum, opts);
+            let cpu_s = cpu.elapsed().as_secs_f64();
             bar.inc(1);
             fit.map(|fit| RecordFit {
                 record: r.clone(),
                 fit,
+                cpu_s,
             })
         })
         .collect::<Result<Vec<_>, _>>();

@@ -56,7 +56,8 @@ pub fn record_colours(fits: &[RecordFit]) -> anyhow::Result<Vec<RecordColour>> {
         .collect()
 }
 
-fn mean_lab(labs: impl Iterator<Item = Lab>) -> Lab {
+/// The mean of CIELAB colours, coordinate by coordinate.
+pub(crate) fn mean_lab(labs: impl Iterator<Item = Lab>) -> Lab {
     let (mut s, mut n) = ([0.0; 3], 0.0);
     for c in labs {
         s[0] += c.l;

@@ -71,16 +71,19 @@ pub fn run_measured(
                 b <= 1e-3 || b >= 1.0 - 1e-3
             })
             .count();
+        let cpu: Vec<f64> = fits.iter().map(|f| f.cpu_s).collect();
         writeln!(
             summary,
-            "{name} {} geometry {} model {label}: {} spectra, RMS median {:.4}, p90 {:.4}, β_m at a bound {:.0} %, wall {:.1} s",
+            "{name} {} geometry {} model {label}: {} spectra, RMS median {:.4}, p90 {:.4}, β_m at a bound {:.0} %, wall {:.1} s, thread CPU per fit median {:.2} s, max {:.2} s",
             opts.fit.method,
             opts.geometry,
             fits.len(),
             quantile(&rms, 0.5),
             quantile(&rms, 0.9),
             100.0 * pinned as f64 / fits.len().max(1) as f64,
-            t
+            t,
+            quantile(&cpu, 0.5),
+            quantile(&cpu, 1.0)
         )?;
     }
     for (label, fits) in [("seed", &seed), (&*opts.model.to_string(), &chosen)] {
@@ -140,7 +143,7 @@ const PARAMS: [Parameter; 11] = [
 ];
 
 fn fits_csv(seed: &[RecordFit], chosen: &[RecordFit]) -> String {
-    let mut csv = String::from("record,group,site,seed_rms,rms,free,at_bounds");
+    let mut csv = String::from("record,group,site,seed_rms,rms,seed_cpu_s,cpu_s,free,at_bounds");
     for p in PARAMS {
         let _ = write!(csv, ",{p}");
     }
@@ -149,12 +152,14 @@ fn fits_csv(seed: &[RecordFit], chosen: &[RecordFit]) -> String {
         let free: Vec<&str> = c.fit.parameters.iter().map(|p| p.name()).collect();
         let _ = write!(
             csv,
-            "{},{},{},{:.5},{:.5},{},{}",
+            "{},{},{},{:.5},{:.5},{:.3},{:.3},{},{}",
             c.record.id,
             c.record.group,
             c.record.site,
             s.fit.rms,
             c.fit.rms,
+            s.cpu_s,
+            c.cpu_s,
             free.join(" "),
             bounds_text(c)
         );

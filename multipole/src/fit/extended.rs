@@ -18,7 +18,7 @@
 
 use super::forward::Forward;
 use super::geometry::{Geometry, unit_surface_reflectance};
-use super::least_squares::{LM, LmBudget, minimize};
+use select::ln_binomial;
 use super::model::{ModelChoice, Parameter};
 use super::{FitError, FitOptions, MeasuredSpectrum, SpectrumFit, fit_spectrum};
 use skin_optics::{SkinParams, Wavelength};
@@ -123,10 +123,7 @@ pub fn fit_measured(
         Some(measured.weights().to_vec()),
     )?;
     let start = fit_spectrum(&start_data, &opts.fit)?;
-    let mut seed_params = Parameter::SEED.to_vec();
-    if opts.geometry == Geometry::Sci && opts.fit_oiliness {
-        seed_params.push(Parameter::Oiliness);
-    }
+    let seed_params = seed_parameters(opts);
     let mut problem = Problem::new(measured, opts, unit_surface)?;
     let n = measured.len() as f64;
     let m = Parameter::CANDIDATES.len();
@@ -134,82 +131,22 @@ pub fn fit_measured(
         n * (rms / opts.noise).powi(2) + k as f64 * n.ln() + 2.0 * ln_binomial(m, j)
     };
     let plain_seed = opts.geometry == Geometry::Sce && opts.model == ModelChoice::Seed;
-    let (mut skin, mut rms) = if plain_seed {
+    let seed = if plain_seed {
         // Today's fit, unchanged.
         (start.skin, start.rms)
     } else {
-        problem.refine(start.skin, &seed_params)?
+        select::refine(&mut problem, start.skin, &seed_params)?
     };
-    let seed_rms = rms;
-    let mut params = seed_params.clone();
-    let mut steps = Vec::new();
-    match opts.model {
-        ModelChoice::Seed => {}
+    let seed_rms = seed.1;
+    let (params, skin, rms, steps) = match opts.model {
+        ModelChoice::Seed => (seed_params.clone(), seed.0, seed.1, Vec::new()),
         ModelChoice::Full => {
-            params.extend(Parameter::CANDIDATES);
-            // Several starts: every candidate at the base skin's value (where the seed fit left
-            // the spectrum), at mid-range, and at a quarter and three quarters of its range. With
-            // seven parameters that trade against each other (blood near the surface against
-            // C_h, ρ_s against the scattering scales), one local descent can stop in a valley.
-            let mut best = problem.refine(skin, &params)?;
-            for t in FULL_STARTS {
-                let start = Parameter::CANDIDATES.iter().try_fold(best.0, |s, p| {
-                    let [lo, hi] = p.range();
-                    p.set(s, lo + t * (hi - lo))
-                })?;
-                let trial = problem.refine(start, &params)?;
-                if trial.1 < best.1 {
-                    best = trial;
-                }
-            }
-            (skin, rms) = best;
+            let all = with_candidates(&seed_params);
+            let (skin, rms) = select::full(&mut problem, seed.0, &all)?;
+            (all, skin, rms, Vec::new())
         }
-        ModelChoice::Auto => {
-            let mut chosen = 0;
-            loop {
-                let remaining: Vec<Parameter> = Parameter::CANDIDATES
-                    .into_iter()
-                    .filter(|p| !params.contains(p))
-                    .collect();
-                let mut best: Option<(Parameter, SkinParams, f64)> = None;
-                for p in remaining {
-                    let mut trial = params.clone();
-                    trial.push(p);
-                    let (s, r) = problem.trial(skin, &trial)?;
-                    if best.as_ref().is_none_or(|b| r < b.2) {
-                        best = Some((p, s, r));
-                    }
-                }
-                let Some((p, s, _)) = best else { break };
-                let mut trial = params.clone();
-                trial.push(p);
-                // Two starts for the new parameter: where the trial left it, and mid-range (a
-                // parameter that trades off against the seed's, like blood near the surface
-                // against C_h, can sit in a long valley).
-                let [lo, hi] = p.range();
-                let mid = p.set(s, 0.5 * (lo + hi))?;
-                let (s, r) = {
-                    let a = problem.refine(s, &trial)?;
-                    let b = problem.refine(mid, &trial)?;
-                    if b.1 < a.1 { b } else { a }
-                };
-                let delta =
-                    criterion(r, trial.len(), chosen + 1) - criterion(rms, params.len(), chosen);
-                let accepted = delta < 0.0;
-                steps.push(SelectionStep {
-                    parameter: p,
-                    rms_before: rms,
-                    rms_after: r,
-                    delta_criterion: delta,
-                    accepted,
-                });
-                if !accepted {
-                    break;
-                }
-                (params, skin, rms, chosen) = (trial, s, r, chosen + 1);
-            }
-        }
-    }
+        ModelChoice::Auto => select::auto(&mut problem, seed, &seed_params, criterion)?,
+    };
     let model = problem.full_model(&skin)?;
     let chosen = params.len() - seed_params.len();
     Ok(MeasuredFit {
@@ -226,10 +163,6 @@ pub fn fit_measured(
         search_evaluations: problem.search_evals,
     })
 }
-
-/// Where the extra starts of a `full` fit put every candidate, as a fraction of its range (the
-/// seed's C_m, β_m, C_h and ρ_s start from the best fit so far).
-const FULL_STARTS: [f64; 3] = [0.5, 0.25, 0.75];
 
 /// A fitted value closer than this fraction of its range to a bound counts as on the bound.
 pub const AT_BOUND_FRACTION: f64 = 1e-3;
@@ -258,13 +191,19 @@ impl MeasuredFit {
     }
 }
 
-/// ln C(m, j).
-fn ln_binomial(m: usize, j: usize) -> f64 {
-    (0..j).map(|i| ((m - i) as f64 / (i + 1) as f64).ln()).sum()
+/// The seed's free parameters for `opts`: C_m, β_m, C_h, and ρ_s when SCI data fit it.
+pub(crate) fn seed_parameters(opts: &MeasuredOptions) -> Vec<Parameter> {
+    let mut p = Parameter::SEED.to_vec();
+    if opts.geometry == Geometry::Sci && opts.fit_oiliness {
+        p.push(Parameter::Oiliness);
+    }
+    p
 }
 
-/// Space-mapping rounds of a refinement at most (each one full-model spectrum and one LM run).
-const MAPPING_ROUNDS: usize = 4;
+/// `seed` followed by every candidate (the `full` model).
+pub(crate) fn with_candidates(seed: &[Parameter]) -> Vec<Parameter> {
+    seed.iter().copied().chain(Parameter::CANDIDATES).collect()
+}
 
 /// The measurement, the two forward models and the current space-mapping shift.
 struct Problem<'a> {
@@ -339,52 +278,23 @@ impl<'a> Problem<'a> {
             .map(|((m, r), w)| (w / self.weight_sum).sqrt() * (m - r))
             .collect()
     }
+}
 
-    /// LM over `params` from `skin` on the search model with the current shift (or the full model
-    /// when there is no cheaper one); returns the refined skin.
-    fn run(
-        &mut self,
-        skin: SkinParams,
-        params: &[Parameter],
-        budget: LmBudget,
-    ) -> Result<SkinParams, FitError> {
+impl select::Target for Problem<'_> {
+    fn shifted_residuals(&mut self, skin: &SkinParams) -> Result<Vec<f64>, FitError> {
         let forward = self.search.unwrap_or(self.full);
-        let to_skin = |u: &[f64]| -> Option<SkinParams> {
-            params.iter().zip(u).try_fold(skin, |s, (p, &v)| {
-                let [lo, hi] = p.range();
-                p.set(s, lo + (hi - lo) * v).ok()
-            })
-        };
-        let u0: Vec<f64> = params
-            .iter()
-            .map(|p| {
-                let [lo, hi] = p.range();
-                ((p.get(&skin) - lo) / (hi - lo)).clamp(0.0, 1.0)
-            })
-            .collect();
-        let mut evals = 0;
-        let mut residuals = |u: &[f64]| -> Option<Vec<f64>> {
-            evals += 1;
-            let s = to_skin(u)?;
-            let mut m = self.seen(&forward, &s).ok()?;
-            for (v, b) in m.iter_mut().zip(&self.shift) {
-                *v += b;
-            }
-            Some(self.residuals(&m))
-        };
-        let result = minimize(&mut residuals, &u0, budget);
         if self.search.is_some() {
-            self.search_evals += evals;
+            self.search_evals += 1;
         } else {
-            self.full_evals += evals;
+            self.full_evals += 1;
         }
-        to_skin(&result.u).ok_or_else(|| {
-            FitError::NotEnoughData("refined parameters left their valid range".to_string())
-        })
+        let mut m = self.seen(&forward, skin)?;
+        for (v, b) in m.iter_mut().zip(&self.shift) {
+            *v += b;
+        }
+        Ok(self.residuals(&m))
     }
 
-    /// Install the shift that makes the search model equal the full one at `skin`; returns the
-    /// full model's RMS there.
     fn reshift(&mut self, skin: &SkinParams) -> Result<f64, FitError> {
         let full = self.full_model(skin)?;
         if let Some(search) = self.search {
@@ -395,53 +305,14 @@ impl<'a> Problem<'a> {
         Ok(self.rms(&full))
     }
 
-    /// Refine with space mapping until the full RMS stops falling; returns the best skin and its
-    /// full-model RMS.
-    fn refine(
-        &mut self,
-        skin: SkinParams,
-        params: &[Parameter],
-    ) -> Result<(SkinParams, f64), FitError> {
-        let mut best = (skin, self.reshift(&skin)?);
-        for _ in 0..MAPPING_ROUNDS {
-            let next = self.run(best.0, params, LM)?;
-            let r = self.reshift(&next)?;
-            let gain = best.1 - r;
-            if r < best.1 {
-                best = (next, r);
-            } else {
-                self.reshift(&best.0)?;
-            }
-            if self.search.is_none() || gain <= 1e-3 * best.1 {
-                break;
-            }
-        }
-        Ok(best)
-    }
-
-    /// A quick trial of `params` from `skin` on the current shift (no re-shift): the selection's
-    /// ranking of candidates. Returns the trial skin and its shifted-model RMS.
-    fn trial(
-        &mut self,
-        skin: SkinParams,
-        params: &[Parameter],
-    ) -> Result<(SkinParams, f64), FitError> {
-        let s = self.run(
-            skin,
-            params,
-            LmBudget {
-                max_iterations: 15,
-                ..LM
-            },
-        )?;
-        let forward = self.search.unwrap_or(self.full);
-        let mut m = self.seen(&forward, &s)?;
-        for (v, b) in m.iter_mut().zip(&self.shift) {
-            *v += b;
-        }
-        Ok((s, self.rms(&m)))
+    fn has_search(&self) -> bool {
+        self.search.is_some()
     }
 }
 
+mod colour;
+mod select;
+
+pub use colour::{MeasuredColourFit, fit_measured_colour};
 #[cfg(test)]
 mod tests;

@@ -57,7 +57,10 @@ mod spectrum;
 
 pub use colour::{ColourFit, ColourModel, fit_colour};
 pub use error::FitError;
-pub use extended::{AT_BOUND_FRACTION, MeasuredFit, MeasuredOptions, SelectionStep, fit_measured};
+pub use extended::{
+    AT_BOUND_FRACTION, MeasuredColourFit, MeasuredFit, MeasuredOptions, SelectionStep,
+    fit_measured, fit_measured_colour,
+};
 pub use geometry::Geometry;
 pub use measured::{MAX_NM, MIN_NM, MIN_POINTS, MeasuredSpectrum};
 pub use model::{ModelChoice, Parameter};

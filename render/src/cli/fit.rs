@@ -8,7 +8,7 @@ use clap::{ArgGroup, Args};
 use multipole::Method;
 use multipole::fit::{
     BetaRange, FitOptions, Geometry, MeasuredOptions, MeasuredSpectrum, ModelChoice, fit_colour,
-    fit_measured, fit_spectrum,
+    fit_measured, fit_measured_colour, fit_spectrum,
 };
 use skin_optics::SkinParams;
 use skin_optics::WavelengthGrid;
@@ -19,12 +19,16 @@ use std::path::{Path, PathBuf};
 
 /// Arguments of `skin fit`.
 #[derive(Args, Debug, Clone)]
-#[command(group(ArgGroup::new("target").required(true).args(["srgb", "spectrum"])))]
+#[command(group(ArgGroup::new("target").required(true).args(["srgb", "lab", "spectrum"])))]
 pub struct FitArgs {
     /// Target colour, sRGB hex '#RRGGBB' (e.g. picked from a photograph), read as the skin's diffuse
     /// colour under D65.
     #[arg(long, value_name = "HEX", value_parser = Checked(parse_hex), allow_hyphen_values = true)]
     pub srgb: Option<Hex>,
+    /// Target colour as CIELAB (D65, CIE 1931 2°) 'L,a,b', L* in [0, 100], a* and b* in
+    /// [-200, 200]: e.g. a published mean skin colour, as the instrument (--geometry) measured it.
+    #[arg(long, value_name = "L,a,b", value_parser = Checked(parse_lab), allow_hyphen_values = true)]
+    pub lab: Option<Lab>,
     /// Measured diffuse reflectance, CSV with header `lambda_nm,reflectance` (optional third column
     /// `weight`), wavelengths increasing within 400-700 nm, '#' comment lines allowed.
     #[arg(long, value_name = "FILE.csv")]
@@ -35,15 +39,16 @@ pub struct FitArgs {
     /// so its melanin is fitted too high).
     #[arg(long, value_name = "METHOD", default_value = "exact", value_parser = Checked(parse_method), allow_hyphen_values = true)]
     pub method: Method,
-    /// Instrument geometry of a --spectrum: `sce` (d/8, specular component excluded: the model's
+    /// Instrument geometry of the target: `sce` (d/8, specular component excluded: the model's
     /// diffuse reflectance as is) or `sci` (d/8, specular included: adds the oily layer's surface
-    /// reflection at 8°, with ρ_s fitted).
+    /// reflection at 8°, with ρ_s fitted), for a spectrum and a colour alike.
     #[arg(long, value_name = "GEOMETRY", default_value = "sce", value_parser = parse_geometry)]
     pub geometry: Geometry,
     /// Parameters to fit: `seed` (C_m, β_m, C_h, plus ρ_s under sci), `full` (also blood near the
     /// surface, epidermis thickness, γ, scattering scales, bilirubin) or `auto` (the seed's plus
-    /// what the information criterion accepts at --noise). A colour has three coordinates, so
-    /// with --srgb `auto` keeps the seed's three and `full` is refused.
+    /// what the information criterion accepts at --noise). For a colour (three coordinates) the
+    /// criterion uses the colour noise that --noise implies; more parameters than coordinates
+    /// leave their values undetermined, so read a colour fit as "the model reaches this colour".
     #[arg(long, value_name = "MODEL", default_value = "seed", value_parser = parse_model)]
     pub model: ModelChoice,
     /// Noise σ of one measured reflectance, for `--model auto`'s criterion, in (0, 1).
@@ -77,6 +82,10 @@ fn parse_hex(s: &str) -> Result<Hex, String> {
         text: srgb.to_hex(),
         srgb,
     })
+}
+
+fn parse_lab(s: &str) -> Result<Lab, String> {
+    s.parse::<Lab>().map_err(|e| e.to_string())
 }
 
 fn parse_method(s: &str) -> Result<Method, String> {
@@ -222,6 +231,17 @@ impl Found<'_> {
     }
 }
 
+/// The instrument and model options the command line asks for.
+fn measured_options(args: &FitArgs, fit: FitOptions) -> MeasuredOptions {
+    MeasuredOptions {
+        geometry: args.geometry,
+        model: args.model,
+        noise: args.noise,
+        fit,
+        ..MeasuredOptions::default()
+    }
+}
+
 /// Run `skin fit`.
 pub fn run(args: &FitArgs) -> anyhow::Result<()> {
     let opts = FitOptions {
@@ -229,43 +249,35 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
         step_nm: args.step_nm,
         ..FitOptions::default()
     };
-    if let Some(hex) = &args.srgb {
-        if args.model == ModelChoice::Full {
-            anyhow::bail!(
-                "--model full needs --spectrum: a colour has three coordinates and cannot determine more than the seed's three parameters"
-            );
+    let colour = match (&args.srgb, args.lab) {
+        (Some(hex), _) => Some((Lab::from_srgb(hex.srgb), hex.text.clone())),
+        (None, Some(lab)) => Some((lab, lab.to_srgb().to_hex())),
+        (None, None) => None,
+    };
+    if let Some((target, text)) = colour {
+        if args.geometry != Geometry::Sce || args.model != ModelChoice::Seed {
+            let fit = fit_measured_colour(target, &measured_options(args, opts))?;
+            return super::fit_measured::report_colour(args, &text, &fit, &opts);
         }
-        if args.geometry != Geometry::Sce {
-            anyhow::bail!(
-                "--geometry applies to --spectrum only (a colour is the diffuse reflectance's)"
-            );
-        }
-        let target = Lab::from_srgb(hex.srgb);
         let fit = fit_colour(target, &opts)?;
         let fitted_hex = hex_of(fit.xyz);
         let found = found!(fit, &fitted_hex, opts);
         if args.json {
             let out = found.json(serde_json::json!({
-                "target": { "srgb": hex.text, "lab": lab_json(target) },
+                "target": { "srgb": text, "lab": lab_json(target) },
                 "residual": { "delta_e_2000": fit.delta_e },
                 "in_gamut": fit.in_gamut,
                 "gamut_threshold_delta_e_2000": opts.gamut_threshold_de,
             }));
             println!("{out}");
         } else {
-            println!("{}", colour_line("target", &hex.text, target));
+            println!("{}", colour_line("target", &text, target));
             found.print(&format!("ΔE2000 = {:.3}", fit.delta_e), "ΔE2000");
-            if args.model == ModelChoice::Auto {
-                println!(
-                    "{:<9}auto: the seed's C_m, β_m, C_h (three colour coordinates determine three parameters)",
-                    "model"
-                );
-            }
         }
         if !fit.in_gamut {
             anyhow::bail!(
                 "{} is out of gamut: no skin has this colour; the nearest skin (above) is ΔE2000 {:.1} away (threshold {})",
-                hex.text,
+                text,
                 fit.delta_e,
                 opts.gamut_threshold_de
             );
@@ -274,20 +286,13 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
     }
     let Some(path) = &args.spectrum else {
         // clap's ArgGroup requires one of the two.
-        anyhow::bail!("give --srgb '#RRGGBB' or --spectrum FILE.csv");
+        anyhow::bail!("give --srgb '#RRGGBB', --lab L,a,b or --spectrum FILE.csv");
     };
     let text = crate::input::SPECTRUM.read_text(path)?;
     let measured =
         MeasuredSpectrum::parse_csv(&text).with_context(|| path.display().to_string())?;
     if args.geometry != Geometry::Sce || args.model != ModelChoice::Seed {
-        let m = MeasuredOptions {
-            geometry: args.geometry,
-            model: args.model,
-            noise: args.noise,
-            fit: opts,
-            ..MeasuredOptions::default()
-        };
-        let fit = fit_measured(&measured, &m)?;
+        let fit = fit_measured(&measured, &measured_options(args, opts))?;
         return super::fit_measured::report(args, path, &measured, &fit, &opts);
     }
     let fit = fit_spectrum(&measured, &opts)?;

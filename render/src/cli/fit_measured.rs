@@ -1,8 +1,11 @@
-//! `skin fit --spectrum` output for a fit with the instrument's geometry and a chosen model
-//! (`--geometry sci` or `--model full|auto`): the free parameters, the surface term, the selection.
+//! `skin fit` output for a fit with the instrument's geometry and a chosen model (`--geometry sci`
+//! or `--model full|auto`), to a spectrum or a colour: the free parameters, the surface term, the
+//! selection.
 
 use super::fit::{FitArgs, colour_line, lab_json, params_json, skin_line, within_tolerance};
-use multipole::fit::{FitOptions, MeasuredFit, MeasuredSpectrum};
+use multipole::fit::{
+    FitOptions, MeasuredColourFit, MeasuredFit, MeasuredSpectrum, Parameter, SelectionStep,
+};
 use skin_optics::lab::Lab;
 use std::path::Path;
 
@@ -18,22 +21,8 @@ pub(crate) fn report(
         multipole::fit::ColourModel::new(opts.step_nm, opts.method, fit.skin)?.lab(&fit.skin)?;
     let hex = lab.to_srgb().to_hex();
     let free: Vec<&str> = fit.parameters.iter().map(|p| p.name()).collect();
-    let values: serde_json::Map<String, serde_json::Value> = fit
-        .parameters
-        .iter()
-        .map(|p| (p.name().to_string(), p.get(&fit.skin).into()))
-        .collect();
-    let steps: Vec<serde_json::Value> = fit
-        .steps
-        .iter()
-        .map(|s| {
-            serde_json::json!({
-                "parameter": s.parameter.name(), "rms_before": s.rms_before,
-                "rms_after": s.rms_after, "delta_criterion": s.delta_criterion,
-                "accepted": s.accepted,
-            })
-        })
-        .collect();
+    let values = free_json(&fit.parameters, &fit.skin);
+    let steps = steps_json(&fit.steps);
     let bounds: serde_json::Map<String, serde_json::Value> = fit
         .at_bounds()
         .iter()
@@ -118,16 +107,114 @@ fn print_text(
             bounds.join(", ")
         );
     }
-    for s in &fit.steps {
+    print_steps(&fit.steps, "RMS", 5, args.noise);
+}
+
+fn free_json(
+    parameters: &[Parameter],
+    skin: &skin_optics::SkinParams,
+) -> serde_json::Map<String, serde_json::Value> {
+    parameters
+        .iter()
+        .map(|p| (p.name().to_string(), p.get(skin).into()))
+        .collect()
+}
+
+fn steps_json(steps: &[SelectionStep]) -> Vec<serde_json::Value> {
+    steps
+        .iter()
+        .map(|s| {
+            serde_json::json!({
+                "parameter": s.parameter.name(), "rms_before": s.rms_before,
+                "rms_after": s.rms_after, "delta_criterion": s.delta_criterion,
+                "accepted": s.accepted,
+            })
+        })
+        .collect()
+}
+
+/// The `auto` rounds, residuals in `unit` with `digits` decimals.
+fn print_steps(steps: &[SelectionStep], unit: &str, digits: usize, noise: f64) {
+    for s in steps {
         println!(
-            "{:<9}{} {}: RMS {:.5} → {:.5}, Δcriterion {:+.1} at σ = {}",
+            "{:<9}{} {}: {unit} {:.digits$} → {:.digits$}, Δcriterion {:+.1} at σ = {noise}",
             "",
             if s.accepted { "added" } else { "not added" },
             s.parameter,
             s.rms_before,
             s.rms_after,
             s.delta_criterion,
-            args.noise
         );
     }
+}
+
+/// Print a colour fit with the instrument's geometry and a chosen model (text or JSON) and fail
+/// when it is beyond the gamut threshold.
+pub(crate) fn report_colour(
+    args: &FitArgs,
+    target_hex: &str,
+    fit: &MeasuredColourFit,
+    opts: &FitOptions,
+) -> anyhow::Result<()> {
+    let hex = fit.lab.to_srgb().to_hex();
+    let free: Vec<&str> = fit.parameters.iter().map(|p| p.name()).collect();
+    if args.json {
+        let out = serde_json::json!({
+            "target": { "srgb": target_hex, "lab": lab_json(fit.target) },
+            "method": args.method.to_string(),
+            "geometry": args.geometry.to_string(),
+            "model": args.model.to_string(),
+            "noise": args.noise,
+            "noise_delta_e_2000": fit.noise_delta_e,
+            "parameters": params_json(&fit.skin),
+            "free_parameters": free_json(&fit.parameters, &fit.skin),
+            "fitted": { "srgb": hex, "lab": lab_json(fit.lab) },
+            "residual": { "delta_e_2000": fit.delta_e, "seed_delta_e_2000": fit.seed_delta_e },
+            "selection": steps_json(&fit.steps),
+            "in_gamut": fit.delta_e <= opts.gamut_threshold_de,
+        });
+        println!("{out}");
+    } else {
+        println!(
+            "{} (geometry {})",
+            colour_line("target", target_hex, fit.target),
+            args.geometry
+        );
+        println!("{}", skin_line(&fit.skin, args.method));
+        let extra: Vec<String> = fit
+            .parameters
+            .iter()
+            .skip(3)
+            .map(|p| format!("{p} = {:.4}", p.get(&fit.skin)))
+            .collect();
+        if !extra.is_empty() {
+            println!("{:<9}{}", "also", extra.join("  "));
+        }
+        println!("{}", colour_line("fitted", &hex, fit.lab));
+        println!(
+            "{:<9}ΔE2000 = {:.3} (seed model {:.3}); colour noise σ_c = {:.3} ΔE2000 per coordinate from σ = {}",
+            "residual", fit.delta_e, fit.seed_delta_e, fit.noise_delta_e, args.noise
+        );
+        let note = if free.len() > 3 {
+            " (more free parameters than the colour's three coordinates: their values are not determined)"
+        } else {
+            ""
+        };
+        println!(
+            "{:<9}{} ({}): {}{note}",
+            "model",
+            args.model,
+            free.len(),
+            free.join(", ")
+        );
+        print_steps(&fit.steps, "ΔE2000", 3, args.noise);
+    }
+    if fit.delta_e > opts.gamut_threshold_de {
+        anyhow::bail!(
+            "{target_hex} is out of gamut: the nearest skin (above) is ΔE2000 {:.1} away (threshold {})",
+            fit.delta_e,
+            opts.gamut_threshold_de
+        );
+    }
+    Ok(())
 }

@@ -42,6 +42,9 @@ enum Command {
     /// Fit the measured ISSA spectra (explore or held-out subjects) with the seed model and a
     /// chosen one; residual bands and fitted parameters as CSV and PNG into --out.
     Measured(MeasuredArgs),
+    /// Fit the mean colour of each group/site of the measured ISSA spectra as a colour target with
+    /// each model (SCI): the ΔE2000 per model as CSV and a summary into --out.
+    MeanColours(MeanColourArgs),
     /// Fit the ISSA group/site medians (SCI, model auto) and write the measured-preset table.
     Presets(PresetArgs),
     /// Error against cost (build CPU-s, evaluation ms) for every knob of the exact profile's shape
@@ -154,6 +157,41 @@ struct MeasuredArgs {
     /// Output folder.
     #[arg(long, value_name = "DIR", default_value = "out/measured")]
     out: PathBuf,
+}
+
+#[derive(Args, Debug)]
+struct MeanColourArgs {
+    /// Which subjects: `heldout` (report these) or `explore`.
+    #[arg(long, default_value = "heldout", value_parser = ["heldout", "explore"])]
+    set: String,
+    /// Models to fit, comma-separated (`seed`, `full`, `auto`).
+    #[arg(long, value_delimiter = ',', default_value = "seed,auto,full", value_parser = parse_model)]
+    models: Vec<multipole::fit::ModelChoice>,
+    /// Noise σ of one reflectance, (0, 1): the criterion's colour noise follows from it.
+    #[arg(long, default_value_t = 0.005)]
+    noise: f64,
+    /// Output folder.
+    #[arg(long, value_name = "DIR", default_value = "out/measured")]
+    out: PathBuf,
+}
+
+fn run_mean_colours(args: &MeanColourArgs) -> anyhow::Result<()> {
+    use validation::measured_report::Subset;
+    let subset = if args.set == "explore" {
+        Subset::Explore
+    } else {
+        Subset::Heldout
+    };
+    let opts = multipole::fit::MeasuredOptions {
+        geometry: multipole::fit::Geometry::Sci,
+        noise: args.noise,
+        fit: multipole::fit::FitOptions {
+            beta_scan: 0,
+            ..multipole::fit::FitOptions::default()
+        },
+        ..multipole::fit::MeasuredOptions::default()
+    };
+    validation::mean_colours::run_mean_colours(subset, &args.models, &opts, &args.out)
 }
 
 fn parse_geometry(s: &str) -> Result<multipole::fit::Geometry, String> {
@@ -287,6 +325,7 @@ fn main() {
         Some(Command::Noise(args)) => run_noise(args),
         Some(Command::NoiseChart(args)) => run_noise_chart(args),
         Some(Command::Measured(args)) => run_measured(args),
+        Some(Command::MeanColours(args)) => run_mean_colours(args),
         Some(Command::Presets(args)) => validation::presets::run_presets(args.noise, &args.out),
         Some(Command::TableKnobs(args)) => {
             validation::compare::table_knobs::run_table_knobs(args.photons, &args.out)

@@ -1,0 +1,196 @@
+//! Refinement and model selection shared by the spectrum and the colour target (docs/physics.md
+//! §13.3): bounded Levenberg–Marquardt on the unit box of the free parameters' ranges, re-shifted
+//! onto the full model (output space mapping, module `forward`), the multi-start `full` fit and the
+//! greedy `auto` selection. A target supplies the residual vector and its shift through [`Target`];
+//! the residual figure is the RMS reflectance for a spectrum and ΔE00 for a colour.
+
+use super::SelectionStep;
+use crate::fit::FitError;
+use crate::fit::least_squares::{LM, LmBudget, minimize};
+use crate::fit::model::Parameter;
+use skin_optics::SkinParams;
+
+/// Space-mapping rounds of a refinement at most (each one full-model evaluation and one LM run).
+const MAPPING_ROUNDS: usize = 4;
+
+/// Where the extra starts of a `full` fit put every candidate, as a fraction of its range (the
+/// seed's C_m, β_m, C_h and ρ_s start from the best fit so far).
+const FULL_STARTS: [f64; 3] = [0.5, 0.25, 0.75];
+
+/// What a fit target provides: residuals of the cheap model with the current shift, and the
+/// shift itself.
+pub(super) trait Target {
+    /// Residuals of the shifted cheap model (the full model when there is no cheaper one) for
+    /// `skin`; their squares sum to the residual figure squared.
+    fn shifted_residuals(&mut self, skin: &SkinParams) -> Result<Vec<f64>, FitError>;
+    /// Install the shift that makes the cheap model equal the full one at `skin`; returns the full
+    /// model's residual figure there.
+    fn reshift(&mut self, skin: &SkinParams) -> Result<f64, FitError>;
+    /// Whether a cheaper model stands in for the full one (space mapping needed).
+    fn has_search(&self) -> bool;
+}
+
+/// `skin` with `params` set from unit coordinates `u` (each mapped onto its range), or `None` when
+/// the skin rejects a value.
+fn skin_at(skin: SkinParams, params: &[Parameter], u: &[f64]) -> Option<SkinParams> {
+    params.iter().zip(u).try_fold(skin, |s, (p, &v)| {
+        let [lo, hi] = p.range();
+        p.set(s, lo + (hi - lo) * v).ok()
+    })
+}
+
+/// LM over `params` from `skin` on the shifted cheap model; returns the refined skin.
+fn run(
+    target: &mut impl Target,
+    skin: SkinParams,
+    params: &[Parameter],
+    budget: LmBudget,
+) -> Result<SkinParams, FitError> {
+    let u0: Vec<f64> = params
+        .iter()
+        .map(|p| {
+            let [lo, hi] = p.range();
+            ((p.get(&skin) - lo) / (hi - lo)).clamp(0.0, 1.0)
+        })
+        .collect();
+    let mut residuals = |u: &[f64]| -> Option<Vec<f64>> {
+        let s = skin_at(skin, params, u)?;
+        target.shifted_residuals(&s).ok()
+    };
+    let result = minimize(&mut residuals, &u0, budget);
+    skin_at(skin, params, &result.u).ok_or_else(|| {
+        FitError::NotEnoughData("refined parameters left their valid range".to_string())
+    })
+}
+
+/// Refine with space mapping until the full residual stops falling; returns the best skin and its
+/// full-model residual figure.
+pub(super) fn refine(
+    target: &mut impl Target,
+    skin: SkinParams,
+    params: &[Parameter],
+) -> Result<(SkinParams, f64), FitError> {
+    let mut best = (skin, target.reshift(&skin)?);
+    for _ in 0..MAPPING_ROUNDS {
+        let next = run(target, best.0, params, LM)?;
+        let r = target.reshift(&next)?;
+        let gain = best.1 - r;
+        if r < best.1 {
+            best = (next, r);
+        } else {
+            target.reshift(&best.0)?;
+        }
+        if !target.has_search() || gain <= 1e-3 * best.1 {
+            break;
+        }
+    }
+    Ok(best)
+}
+
+/// A quick trial of `params` from `skin` on the current shift (no re-shift): the selection's
+/// ranking of candidates. Returns the trial skin and its shifted-model residual figure.
+fn trial(
+    target: &mut impl Target,
+    skin: SkinParams,
+    params: &[Parameter],
+) -> Result<(SkinParams, f64), FitError> {
+    let s = run(
+        target,
+        skin,
+        params,
+        LmBudget {
+            max_iterations: 15,
+            ..LM
+        },
+    )?;
+    let r = target.shifted_residuals(&s)?;
+    Ok((s, r.iter().map(|v| v * v).sum::<f64>().sqrt()))
+}
+
+/// Every candidate freed, refined from `skin` and from [`FULL_STARTS`]; the lowest residual.
+///
+/// Several starts: every candidate at the base skin's value (where the seed fit left the target),
+/// at mid-range, and at a quarter and three quarters of its range. With seven parameters that
+/// trade against each other (blood near the surface against C_h, ρ_s against the scattering
+/// scales), one local descent can stop in a valley.
+pub(super) fn full(
+    target: &mut impl Target,
+    skin: SkinParams,
+    params: &[Parameter],
+) -> Result<(SkinParams, f64), FitError> {
+    let mut best = refine(target, skin, params)?;
+    for t in FULL_STARTS {
+        let start = Parameter::CANDIDATES.iter().try_fold(best.0, |s, p| {
+            let [lo, hi] = p.range();
+            p.set(s, lo + t * (hi - lo))
+        })?;
+        let trial = refine(target, start, params)?;
+        if trial.1 < best.1 {
+            best = trial;
+        }
+    }
+    Ok(best)
+}
+
+/// The `auto` selection from the seed's fit (`skin`, residual `rms`, `params`): each round tries
+/// every candidate not yet in, refines the best and keeps it while `criterion(residual, k, j)`
+/// falls (k free parameters, j candidates chosen). Returns the final parameters, skin, residual
+/// and the rounds.
+pub(super) fn auto(
+    target: &mut impl Target,
+    start: (SkinParams, f64),
+    seed_params: &[Parameter],
+    criterion: impl Fn(f64, usize, usize) -> f64,
+) -> Result<(Vec<Parameter>, SkinParams, f64, Vec<SelectionStep>), FitError> {
+    let (mut skin, mut rms) = start;
+    let mut params = seed_params.to_vec();
+    let mut steps = Vec::new();
+    let mut chosen = 0;
+    loop {
+        let remaining: Vec<Parameter> = Parameter::CANDIDATES
+            .into_iter()
+            .filter(|p| !params.contains(p))
+            .collect();
+        let mut best: Option<(Parameter, SkinParams, f64)> = None;
+        for p in remaining {
+            let mut trial_params = params.clone();
+            trial_params.push(p);
+            let (s, r) = trial(target, skin, &trial_params)?;
+            if best.as_ref().is_none_or(|b| r < b.2) {
+                best = Some((p, s, r));
+            }
+        }
+        let Some((p, s, _)) = best else { break };
+        let mut with = params.clone();
+        with.push(p);
+        // Two starts for the new parameter: where the trial left it, and mid-range (a parameter
+        // that trades off against the seed's, like blood near the surface against C_h, can sit
+        // in a long valley).
+        let [lo, hi] = p.range();
+        let mid = p.set(s, 0.5 * (lo + hi))?;
+        let (s, r) = {
+            let a = refine(target, s, &with)?;
+            let b = refine(target, mid, &with)?;
+            if b.1 < a.1 { b } else { a }
+        };
+        let delta = criterion(r, with.len(), chosen + 1) - criterion(rms, params.len(), chosen);
+        let accepted = delta < 0.0;
+        steps.push(SelectionStep {
+            parameter: p,
+            rms_before: rms,
+            rms_after: r,
+            delta_criterion: delta,
+            accepted,
+        });
+        if !accepted {
+            break;
+        }
+        (params, skin, rms, chosen) = (with, s, r, chosen + 1);
+    }
+    Ok((params, skin, rms, steps))
+}
+
+/// ln C(m, j).
+pub(super) fn ln_binomial(m: usize, j: usize) -> f64 {
+    (0..j).map(|i| ((m - i) as f64 / (i + 1) as f64).ln()).sum()
+}
