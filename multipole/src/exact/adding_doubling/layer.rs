@@ -8,8 +8,8 @@
 //! Fresnel interface is diagonal even though radiance jumps by n² across it.
 
 use super::matrix::{Mat, Singular};
-use super::quadrature::legendre_with_derivative;
 use super::memo::{Memo, memoized};
+use super::quadrature::legendre_with_derivative;
 use std::sync::{Arc, OnceLock};
 
 /// Quadrature directions inside the slab, shared by every layer of a stack.

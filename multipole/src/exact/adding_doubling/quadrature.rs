@@ -31,7 +31,9 @@ pub(crate) fn slab_rule(n: usize, mu_critical: f64) -> Rule {
 /// grid, and the Newton iterations for the nodes cost as much as a small layer solve.
 pub(crate) fn slab_rule_cached(n: usize, mu_critical: f64) -> std::sync::Arc<Rule> {
     static MEMO: Memo<(usize, u64), Rule> = std::sync::OnceLock::new();
-    memoized(&MEMO, (n, mu_critical.to_bits()), || slab_rule(n, mu_critical))
+    memoized(&MEMO, (n, mu_critical.to_bits()), || {
+        slab_rule(n, mu_critical)
+    })
 }
 
 #[cfg(test)]

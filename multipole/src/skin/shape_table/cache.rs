@@ -91,7 +91,10 @@ fn read(path: &Path, g: f64, n: f64, opts: &ShapeTableOptions) -> Option<ShapeTa
 /// (`tempfile`), persisted onto the path: a reader never sees a half-written table, and two
 /// writers never share a temporary.
 fn write(path: &Path, table: &ShapeTable) -> std::io::Result<()> {
-    let dir = path.parent().unwrap_or(Path::new("."));
+    let dir = path
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
     std::fs::create_dir_all(dir)?;
     let mut bytes = Vec::with_capacity(MAGIC.len() + 4 * table.counts.len());
     bytes.extend_from_slice(MAGIC);
