@@ -23,7 +23,7 @@
 //! in 1 of 1000 case runs each must pass |z| ≤ t₃₉(1 − 0.001/(2·23)) = 4.60, rounded up to 4.64
 //! (the 26-comparison value). MCML prints R_d(r) to 5 and A_l to 4 significant digits: the rounding
 //! (≤ 5·10⁻⁵ and 5·10⁻⁴ relative) is forgiven in the A_l comparison and negligible for R_d(r);
-//! A_l also forgives a measured, unresolved difference of the codes (`LAYER_DISCREPANCY`).
+//! A_l also forgives a measured difference of the codes, traced to MCML's `ran3` (`LAYER_DISCREPANCY`).
 //! Power: R_d's combined standard error is 0.2% (light) to 0.4% (dark) of R_d, so a bias of 1–2% in
 //! a total, or of 5–10% in a group holding a tenth of R_d, fails.
 
@@ -33,13 +33,16 @@ use validation::mcml::{self, DR_MM, NR, ReferenceData};
 const RUNS: u64 = 40;
 /// Bound on |z| for every comparison (derivation above).
 const Z_MAX: f64 = 4.64;
-/// Relative difference in absorption per layer forgiven (besides MCML's rounding): the two codes
-/// differ by up to 0.9% in the epidermis of light skin (ours higher: +0.24%, +0.72%, +0.88% at 450,
-/// 550, 650 nm, z = 2.6, 7.4, 9.9 with 10⁶ photons of ours, `cargo run --release -p validation
-/// --example mcml_agreement`), unresolved; adding-doubling's R_d there (0.4095, 0.4367, 0.6077)
-/// sides with ours (0.4099, 0.4365, 0.6075) rather than MCML's (0.4090, 0.4370, 0.6091), as for
-/// the bias of MCML's `ran3` on two-layer totals (`determinism.rs`). Dark skin and the half-space
-/// agree within their errors.
+/// Relative difference in absorption per layer forgiven (besides MCML's rounding): in light skin
+/// our epidermis absorbs up to 0.9% more than the committed MCML runs (+0.24%, +0.72%, +0.88% at
+/// 450, 550, 650 nm, z = 2.6, 7.4, 9.9 with 10⁶ photons of ours, `cargo run --release -p
+/// validation --example mcml_agreement`). The cause is MCML's `ran3` generator: MCML with only
+/// its generator replaced by xoshiro256** (`validation/data/mcml/random_num_xoshiro.c`, README
+/// there) absorbs 0.87% more in the epidermis at 650 nm (0.09633 ± 0.00007 against 0.09550 ±
+/// 0.00006 for the same build with `ran3`), ours 0.0964, and its R_d moves from 0.6093 to 0.6076,
+/// onto ours (0.6075) and adding-doubling's (0.6077). The reference data are `ran3`'s, so the
+/// allowance stays, scoped to per-layer absorption; dark skin and the half-space agree within
+/// their errors.
 const LAYER_DISCREPANCY: f64 = 0.01;
 /// Least of our escaping photons (≈ weight sum) per compared group.
 const MIN_ESCAPES: f64 = 200.0;

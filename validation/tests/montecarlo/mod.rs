@@ -3,6 +3,7 @@
 mod closed_forms;
 mod determinism;
 mod energy;
+mod far_field;
 pub(crate) mod mcml;
 mod reference;
 
