@@ -227,9 +227,11 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let calls = std::cell::Cell::new(0);
         let key = "test key";
-        let (a, o) = load_or_build(Some(dir.path()), DEFAULT_MAX_BYTES, key, || build(&calls)).unwrap();
+        let (a, o) =
+            load_or_build(Some(dir.path()), DEFAULT_MAX_BYTES, key, || build(&calls)).unwrap();
         assert!(matches!(o, CacheOutcome::Built(_)), "{o:?}");
-        let (b, o) = load_or_build(Some(dir.path()), DEFAULT_MAX_BYTES, key, || build(&calls)).unwrap();
+        let (b, o) =
+            load_or_build(Some(dir.path()), DEFAULT_MAX_BYTES, key, || build(&calls)).unwrap();
         assert!(matches!(o, CacheOutcome::Hit(_)), "{o:?}");
         assert_eq!(calls.get(), 1);
         let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
@@ -248,11 +250,13 @@ mod tests {
         for (want, bytes) in cases {
             std::fs::write(&path, bytes).unwrap();
             let before = calls.get();
-            let (v, o) = load_or_build(Some(dir.path()), DEFAULT_MAX_BYTES, key, || build(&calls)).unwrap();
+            let (v, o) =
+                load_or_build(Some(dir.path()), DEFAULT_MAX_BYTES, key, || build(&calls)).unwrap();
             assert_eq!(o, CacheOutcome::Rebuilt(path.clone(), want));
             assert_eq!((calls.get(), bits(&v)), (before + 1, bits(&a)));
             // ...and the rewritten entry is trusted again.
-            let (_, o) = load_or_build(Some(dir.path()), DEFAULT_MAX_BYTES, key, || build(&calls)).unwrap();
+            let (_, o) =
+                load_or_build(Some(dir.path()), DEFAULT_MAX_BYTES, key, || build(&calls)).unwrap();
             assert!(matches!(o, CacheOutcome::Hit(_)), "{o:?}");
         }
         let (_, o) = load_or_build(None, DEFAULT_MAX_BYTES, key, || build(&calls)).unwrap();

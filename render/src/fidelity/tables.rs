@@ -171,9 +171,11 @@ mod tests {
             })
         };
         let fresh = build().unwrap();
-        let (first, o) = cache::load_or_build(Some(dir), cache::DEFAULT_MAX_BYTES, &k, build).unwrap();
+        let (first, o) =
+            cache::load_or_build(Some(dir), cache::DEFAULT_MAX_BYTES, &k, build).unwrap();
         assert!(matches!(o, CacheOutcome::Built(_)));
-        let (hit, o) = cache::load_or_build(Some(dir), cache::DEFAULT_MAX_BYTES, &k, build).unwrap();
+        let (hit, o) =
+            cache::load_or_build(Some(dir), cache::DEFAULT_MAX_BYTES, &k, build).unwrap();
         assert!(matches!(o, CacheOutcome::Hit(_)), "{o:?}");
         assert_eq!(bits(&hit.table), bits(&fresh.table));
         assert_eq!(bits(&first.table), bits(&fresh.table));
@@ -185,7 +187,8 @@ mod tests {
         corrupt[mid] = if corrupt[mid] == b'1' { b'2' } else { b'1' };
         for bad in [corrupt, good[..good.len() / 3].to_vec()] {
             std::fs::write(&path, bad).unwrap();
-            let (again, o) = cache::load_or_build(Some(dir), cache::DEFAULT_MAX_BYTES, &k, build).unwrap();
+            let (again, o) =
+                cache::load_or_build(Some(dir), cache::DEFAULT_MAX_BYTES, &k, build).unwrap();
             assert!(matches!(o, CacheOutcome::Rebuilt(..)), "{o:?}");
             assert_eq!(bits(&again.table), bits(&fresh.table));
         }

@@ -10,9 +10,9 @@
 use multipole::{Method, MultipoleError};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
+use skin_optics::color::Xyz;
 use skin_optics::lab::Lab;
 use skin_optics::spectrum::GridSpectrum;
-use skin_optics::color::Xyz;
 use skin_optics::{SkinParams, Wavelength, WavelengthGrid, color};
 
 /// Steps tried, nm, widest first: every step dividing the 400-nm range into whole intervals.
