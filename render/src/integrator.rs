@@ -12,6 +12,9 @@
 //! T(θ_o) · R(r) · N / pdf (spectral MIS) · √(m_o m_i) / q, light at the exit point is gathered by
 //! next-event estimation with S_ω (MIS against the cosine-weighted continuation), and the path
 //! continues from the exit point with a cosine-weighted direction (weight T(θ_i) / c).
+//!
+//! The sampler's dimension table and the knobs are plain lists of named constants and documented
+//! fields; their shape repeats other such lists (the surface lobe's parameters) by nature.
 
 use crate::bssrdf::{Exit, ProbeAxes, ProbeFrame, Subsurface, texture_modulation};
 use crate::geometry::SurfaceHit;
@@ -255,6 +258,32 @@ struct PrevVertex {
     p: Vec3,
 }
 
+impl PrevVertex {
+    /// Make the vertex (position, shading normal, density of the direction sampled there, sr⁻¹)
+    /// the previous one: it takes over `pick` (zeroed first when nothing lit it), and `pick`
+    /// gets the old vertex's buffer back, so no path allocates after its first bounce.
+    fn record(
+        prev: &mut Option<PrevVertex>,
+        pick: &mut Vec<f32>,
+        lit: bool,
+        n_lights: usize,
+        (p, ns, bsdf_pdf): (Vec3, Vec3, f32),
+    ) {
+        if !lit {
+            pick.clear();
+            pick.resize(n_lights, 0.0);
+        }
+        let mut prev_pick = prev.take().map(|v| v.pick).unwrap_or_default();
+        std::mem::swap(&mut prev_pick, pick);
+        *prev = Some(PrevVertex {
+            p,
+            ns,
+            bsdf_pdf,
+            pick: prev_pick,
+        });
+    }
+}
+
 /// Radiance arriving at `origin` from direction `-dir` (i.e. along the ray), at the path's
 /// wavelengths; `rays` counts the rays traced (closest hit and shadow).
 pub fn radiance(
@@ -437,18 +466,8 @@ pub fn radiance(
                     break;
                 }
                 beta = beta_exit * (ss.directional.cosine_sample_weight(local.z) / q_sss);
-                if !lit_exit {
-                    exit_pick.clear();
-                    exit_pick.resize(n_lights, 0.0);
-                }
-                let mut prev_pick = prev.take().map(|v| v.pick).unwrap_or_default();
-                std::mem::swap(&mut prev_pick, &mut exit_pick);
-                prev = Some(PrevVertex {
-                    p: exit.p,
-                    ns: ens,
-                    bsdf_pdf: local.z * FRAC_1_PI,
-                    pick: prev_pick,
-                });
+                let vertex = (exit.p, ens, local.z * FRAC_1_PI);
+                PrevVertex::record(&mut prev, &mut exit_pick, lit_exit, n_lights, vertex);
                 if !russian_roulette(&mut beta, depth, settings, sampler) {
                     break;
                 }
@@ -471,18 +490,8 @@ pub fn radiance(
             break;
         }
         beta *= bs.f * (bs.wi.dot(ns).abs() / bs.pdf);
-        if !lit {
-            pick.clear();
-            pick.resize(n_lights, 0.0);
-        }
-        let mut prev_pick = prev.take().map(|v| v.pick).unwrap_or_default();
-        std::mem::swap(&mut prev_pick, &mut pick);
-        prev = Some(PrevVertex {
-            p: si.p,
-            ns,
-            bsdf_pdf: if bs.delta { f32::INFINITY } else { bs.pdf },
-            pick: prev_pick,
-        });
+        let bsdf_pdf = if bs.delta { f32::INFINITY } else { bs.pdf };
+        PrevVertex::record(&mut prev, &mut pick, lit, n_lights, (si.p, ns, bsdf_pdf));
         if !russian_roulette(&mut beta, depth, settings, sampler) {
             break;
         }
