@@ -151,7 +151,10 @@ mod tests {
         assert_eq!(m.len(), 24);
         for c in &m {
             assert_eq!(c.n, 12, "{}", c.key);
-            assert!((30.0..75.0).contains(&c.lab.l) && c.lab.a > 0.0 && c.lab.b > 0.0, "{c:?}");
+            assert!(
+                (30.0..75.0).contains(&c.lab.l) && c.lab.a > 0.0 && c.lab.b > 0.0,
+                "{c:?}"
+            );
         }
     }
 }

@@ -106,7 +106,10 @@ pub fn progress(len: usize, msg: String) -> ProgressBar {
 
 /// Fit every record (rayon across records, with a progress bar on stderr).
 pub fn fit_records(records: &[Record], opts: &MeasuredOptions) -> Result<Vec<RecordFit>, FitError> {
-    let bar = progress(records.len(), format!("fit {} {}", opts.geometry, opts.model));
+    let bar = progress(
+        records.len(),
+        format!("fit {} {}", opts.geometry, opts.model),
+    );
     let fits = records
         .par_iter()
         .map(|r| {

@@ -22,9 +22,9 @@
 
 use super::forward::Forward;
 use super::geometry::{Geometry, unit_surface_reflectance};
-use select::ln_binomial;
 use super::model::{ModelChoice, Parameter};
 use super::{FitError, FitOptions, MeasuredSpectrum, SpectrumFit, fit_spectrum};
+use select::ln_binomial;
 use skin_optics::{SkinParams, Wavelength};
 
 /// Knobs of [`fit_measured`].

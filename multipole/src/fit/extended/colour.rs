@@ -246,7 +246,11 @@ mod tests {
         assert!(fit.delta_e < ROUND_TRIP_DE, "ΔE00 {}", fit.delta_e);
         assert_eq!(fit.parameters.len(), 4, "{:?}", fit.steps);
         // σ = 0.005 per reflectance on 31 wavelengths: about a third of a ΔE00 per coordinate.
-        assert!((0.1..1.0).contains(&fit.noise_delta_e), "{}", fit.noise_delta_e);
+        assert!(
+            (0.1..1.0).contains(&fit.noise_delta_e),
+            "{}",
+            fit.noise_delta_e
+        );
     }
 
     #[test]
@@ -255,7 +259,11 @@ mod tests {
         let fit = fit_measured_colour(colour_of(&thin_skin(), &opts), &opts).unwrap();
         assert!(fit.seed_delta_e > 3.0, "seed ΔE00 {}", fit.seed_delta_e);
         assert!(fit.delta_e < ROUND_TRIP_DE, "ΔE00 {}", fit.delta_e);
-        assert!(fit.parameters.len() > 4 && fit.steps[0].accepted, "{:?}", fit.steps);
+        assert!(
+            fit.parameters.len() > 4 && fit.steps[0].accepted,
+            "{:?}",
+            fit.steps
+        );
     }
 
     /// The default exact model (two-stage: 8-point search shifted to the full model).
