@@ -117,13 +117,25 @@ fn colour_fits_take_a_lab_target_the_geometry_and_the_model() {
     ] {
         let out = skin(&["fit", "--lab", lab]);
         assert_eq!(out.status.code(), Some(2), "{lab}");
-        assert!(text(&out.stderr).contains(says), "{lab}: {}", text(&out.stderr));
+        assert!(
+            text(&out.stderr).contains(says),
+            "{lab}: {}",
+            text(&out.stderr)
+        );
     }
     // A colour of the seed model's gamut under SCI: reached (the fit's ΔE00 is ~1e-6 for a colour
     // the model produces; 0.1 is a tenth of a just-noticeable difference).
     let out = skin(&[
-        "fit", "--lab", "55,10,15", "--geometry", "sci", "--model", "full", "--method",
-        "multipole", "--json",
+        "fit",
+        "--lab",
+        "55,10,15",
+        "--geometry",
+        "sci",
+        "--model",
+        "full",
+        "--method",
+        "multipole",
+        "--json",
     ]);
     assert!(out.status.success(), "{}", text(&out.stderr));
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();

@@ -129,7 +129,9 @@ impl Lab {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum LabParseError {
     /// Not three comma-separated fields.
-    #[error("'{text}' has {found} comma-separated fields; a CIELAB colour is L,a,b (e.g. 55.2,12.1,17.5)")]
+    #[error(
+        "'{text}' has {found} comma-separated fields; a CIELAB colour is L,a,b (e.g. 55.2,12.1,17.5)"
+    )]
     Fields {
         /// The text given.
         text: String,
@@ -440,13 +442,34 @@ mod tests {
         let c: Lab = " 55.2, 12.1 ,17.5".parse().unwrap();
         assert_eq!((c.l, c.a, c.b), (55.2, 12.1, 17.5));
         let e = "55,12".parse::<Lab>().unwrap_err();
-        assert_eq!(e, LabParseError::Fields { text: "55,12".into(), found: 2 });
+        assert_eq!(
+            e,
+            LabParseError::Fields {
+                text: "55,12".into(),
+                found: 2
+            }
+        );
         let e = "55,x,1".parse::<Lab>().unwrap_err();
-        assert!(matches!(e, LabParseError::Number { coordinate: "a*", .. }), "{e}");
+        assert!(
+            matches!(
+                e,
+                LabParseError::Number {
+                    coordinate: "a*",
+                    ..
+                }
+            ),
+            "{e}"
+        );
         let e = "101,0,0".parse::<Lab>().unwrap_err();
         assert_eq!(e.to_string(), "L* = 101 outside [0, 100]");
         let e = "50,0,NaN".parse::<Lab>().unwrap_err();
-        assert!(matches!(e, LabParseError::Range(crate::OpticsError::NonFinite { name: "b*", .. })), "{e}");
+        assert!(
+            matches!(
+                e,
+                LabParseError::Range(crate::OpticsError::NonFinite { name: "b*", .. })
+            ),
+            "{e}"
+        );
     }
 
     #[test]

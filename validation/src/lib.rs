@@ -5,9 +5,9 @@ pub mod mcml;
 pub mod shape_error;
 /// The layered Monte Carlo (owned by `multipole`, which uses it for exact profile shapes).
 pub use multipole::montecarlo;
+pub mod mean_colours;
 pub mod measured;
 pub mod measured_colour;
-pub mod mean_colours;
 pub mod measured_report;
 pub mod noise_chart;
 pub mod presets;

@@ -4,11 +4,10 @@
 //! model under the SCI geometry (`multipole::fit::fit_measured_colour`), which measures whether
 //! the model's gamut reaches the measured colours.
 
-use crate::measured::{EXPLORE_CSV, HELDOUT_CSV, Record, parse_records, quantile};
+use crate::measured::{EXPLORE_CSV, HELDOUT_CSV, Record, parse_records, progress, quantile};
 use crate::measured_colour::{lab_of, mean_lab};
 use crate::measured_report::Subset;
 use anyhow::Context;
-use indicatif::{ProgressBar, ProgressStyle};
 use multipole::fit::{MeasuredColourFit, MeasuredOptions, ModelChoice, fit_measured_colour};
 use rayon::prelude::*;
 use skin_optics::lab::Lab;
@@ -69,12 +68,7 @@ pub fn run_mean_colours(
     let mut summary = String::new();
     for &model in models {
         let o = MeasuredOptions { model, ..*opts };
-        let bar = ProgressBar::new(targets.len() as u64);
-        if let Ok(style) = ProgressStyle::with_template("{msg} {bar:40} {pos}/{len} [{elapsed}<{eta}]")
-        {
-            bar.set_style(style);
-        }
-        bar.set_message(format!("colour fit {} {model}", o.geometry));
+        let bar = progress(targets.len(), format!("colour fit {} {model}", o.geometry));
         let f = targets
             .par_iter()
             .map(|t| {
@@ -157,7 +151,10 @@ mod tests {
         assert_eq!(m.len(), 24);
         for c in &m {
             assert_eq!(c.n, 12, "{}", c.key);
-            assert!((30.0..75.0).contains(&c.lab.l) && c.lab.a > 0.0 && c.lab.b > 0.0, "{c:?}");
+            assert!(
+                (30.0..75.0).contains(&c.lab.l) && c.lab.a > 0.0 && c.lab.b > 0.0,
+                "{c:?}"
+            );
         }
     }
 }

@@ -92,14 +92,24 @@ pub struct RecordFit {
     pub cpu_s: f64,
 }
 
-/// Fit every record (rayon across records, with a progress bar on stderr).
-pub fn fit_records(records: &[Record], opts: &MeasuredOptions) -> Result<Vec<RecordFit>, FitError> {
-    let bar = ProgressBar::new(records.len() as u64);
+/// A progress bar on stderr for `len` fits, labelled `msg`.
+#[must_use]
+pub fn progress(len: usize, msg: String) -> ProgressBar {
+    let bar = ProgressBar::new(len as u64);
     if let Ok(style) = ProgressStyle::with_template("{msg} {bar:40} {pos}/{len} [{elapsed}<{eta}]")
     {
         bar.set_style(style);
     }
-    bar.set_message(format!("fit {} {}", opts.geometry, opts.model));
+    bar.set_message(msg);
+    bar
+}
+
+/// Fit every record (rayon across records, with a progress bar on stderr).
+pub fn fit_records(records: &[Record], opts: &MeasuredOptions) -> Result<Vec<RecordFit>, FitError> {
+    let bar = progress(
+        records.len(),
+        format!("fit {} {}", opts.geometry, opts.model),
+    );
     let fits = records
         .par_iter()
         .map(|r| {

@@ -15,12 +15,16 @@
 //!    for n wavelengths, k free parameters, j of the m candidates chosen. The last term charges
 //!    for having picked the best of several candidates; without it a spectrum of the seed model
 //!    plus noise gains a spurious parameter about 40 % of the time (best of 7 χ²₁ draws above ln 31).
+//!
+//! A colour target (module `colour`) shares the refinement and selection (module `select`).
+//! The result's fields and the options' `Default` are listed one by one, the shape of the other
+//! result types of the workspace (shape only, different fields).
 
 use super::forward::Forward;
 use super::geometry::{Geometry, unit_surface_reflectance};
-use select::ln_binomial;
 use super::model::{ModelChoice, Parameter};
 use super::{FitError, FitOptions, MeasuredSpectrum, SpectrumFit, fit_spectrum};
+use select::ln_binomial;
 use skin_optics::{SkinParams, Wavelength};
 
 /// Knobs of [`fit_measured`].
@@ -138,15 +142,8 @@ pub fn fit_measured(
         select::refine(&mut problem, start.skin, &seed_params)?
     };
     let seed_rms = seed.1;
-    let (params, skin, rms, steps) = match opts.model {
-        ModelChoice::Seed => (seed_params.clone(), seed.0, seed.1, Vec::new()),
-        ModelChoice::Full => {
-            let all = with_candidates(&seed_params);
-            let (skin, rms) = select::full(&mut problem, seed.0, &all)?;
-            (all, skin, rms, Vec::new())
-        }
-        ModelChoice::Auto => select::auto(&mut problem, seed, &seed_params, criterion)?,
-    };
+    let (params, skin, rms, steps) =
+        select::fit_model(&mut problem, opts.model, seed, &seed_params, criterion)?;
     let model = problem.full_model(&skin)?;
     let chosen = params.len() - seed_params.len();
     Ok(MeasuredFit {

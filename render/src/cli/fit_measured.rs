@@ -73,16 +73,7 @@ fn print_text(
         measured.lambda_nm()[n - 1],
         args.geometry
     );
-    println!("{}", skin_line(&fit.skin, args.method));
-    let extra: Vec<String> = fit
-        .parameters
-        .iter()
-        .skip(3)
-        .map(|p| format!("{p} = {:.4}", p.get(&fit.skin)))
-        .collect();
-    if !extra.is_empty() {
-        println!("{:<9}{}", "also", extra.join("  "));
-    }
+    print_skin(&fit.skin, &fit.parameters, args);
     println!("{}", colour_line("fitted", hex, lab));
     println!(
         "{:<9}RMS reflectance = {:.5} (seed model {:.5}); surface term {:.4}",
@@ -108,6 +99,19 @@ fn print_text(
         );
     }
     print_steps(&fit.steps, "RMS", 5, args.noise);
+}
+
+/// The `skin` line and the free parameters beyond the seed's three (`also`).
+fn print_skin(skin: &skin_optics::SkinParams, parameters: &[Parameter], args: &FitArgs) {
+    println!("{}", skin_line(skin, args.method));
+    let extra: Vec<String> = parameters
+        .iter()
+        .skip(3)
+        .map(|p| format!("{p} = {:.4}", p.get(skin)))
+        .collect();
+    if !extra.is_empty() {
+        println!("{:<9}{}", "also", extra.join("  "));
+    }
 }
 
 fn free_json(
@@ -180,16 +184,7 @@ pub(crate) fn report_colour(
             colour_line("target", target_hex, fit.target),
             args.geometry
         );
-        println!("{}", skin_line(&fit.skin, args.method));
-        let extra: Vec<String> = fit
-            .parameters
-            .iter()
-            .skip(3)
-            .map(|p| format!("{p} = {:.4}", p.get(&fit.skin)))
-            .collect();
-        if !extra.is_empty() {
-            println!("{:<9}{}", "also", extra.join("  "));
-        }
+        print_skin(&fit.skin, &fit.parameters, args);
         println!("{}", colour_line("fitted", &hex, fit.lab));
         println!(
             "{:<9}ΔE2000 = {:.3} (seed model {:.3}); colour noise σ_c = {:.3} ΔE2000 per coordinate from σ = {}",

@@ -175,13 +175,18 @@ struct MeanColourArgs {
     out: PathBuf,
 }
 
-fn run_mean_colours(args: &MeanColourArgs) -> anyhow::Result<()> {
+/// The subset a `--set` value names (clap has checked it is one of the two).
+fn subset_of(set: &str) -> validation::measured_report::Subset {
     use validation::measured_report::Subset;
-    let subset = if args.set == "explore" {
+    if set == "explore" {
         Subset::Explore
     } else {
         Subset::Heldout
-    };
+    }
+}
+
+fn run_mean_colours(args: &MeanColourArgs) -> anyhow::Result<()> {
+    let subset = subset_of(&args.set);
     let opts = multipole::fit::MeasuredOptions {
         geometry: multipole::fit::Geometry::Sci,
         noise: args.noise,
@@ -210,12 +215,7 @@ fn parse_method(s: &str) -> Result<multipole::Method, String> {
 }
 
 fn run_measured(args: &MeasuredArgs) -> anyhow::Result<()> {
-    use validation::measured_report::Subset;
-    let subset = if args.set == "explore" {
-        Subset::Explore
-    } else {
-        Subset::Heldout
-    };
+    let subset = subset_of(&args.set);
     let opts = multipole::fit::MeasuredOptions {
         geometry: args.geometry,
         model: args.model,

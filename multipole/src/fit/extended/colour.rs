@@ -19,10 +19,10 @@
 //! measures is whether the model's gamut reaches the colour.
 
 use super::select::{self, Target, ln_binomial};
-use super::{MeasuredOptions, SelectionStep, seed_parameters, with_candidates};
+use super::{MeasuredOptions, SelectionStep, seed_parameters};
 use crate::fit::forward::Forward;
 use crate::fit::geometry::{Geometry, unit_surface_reflectance};
-use crate::fit::model::{ModelChoice, Parameter};
+use crate::fit::model::Parameter;
 use crate::fit::{ColourModel, FitError, fit_colour};
 use skin_optics::SkinParams;
 use skin_optics::color::{Xyz, reflectance_to_xyz};
@@ -75,15 +75,8 @@ pub fn fit_measured_colour(
     let criterion = |de: f64, k: usize, j: usize| {
         (de / sigma_c).powi(2) + k as f64 * n.ln() + 2.0 * ln_binomial(m, j)
     };
-    let (parameters, skin, _, steps) = match opts.model {
-        ModelChoice::Seed => (seed_params.clone(), seed.0, seed.1, Vec::new()),
-        ModelChoice::Full => {
-            let all = with_candidates(&seed_params);
-            let (skin, de) = select::full(&mut problem, seed.0, &all)?;
-            (all, skin, de, Vec::new())
-        }
-        ModelChoice::Auto => select::auto(&mut problem, seed, &seed_params, criterion)?,
-    };
+    let (parameters, skin, _, steps) =
+        select::fit_model(&mut problem, opts.model, seed, &seed_params, criterion)?;
     let lab = problem.lab(&problem.full, &skin)?;
     Ok(MeasuredColourFit {
         skin,
@@ -253,7 +246,11 @@ mod tests {
         assert!(fit.delta_e < ROUND_TRIP_DE, "ΔE00 {}", fit.delta_e);
         assert_eq!(fit.parameters.len(), 4, "{:?}", fit.steps);
         // σ = 0.005 per reflectance on 31 wavelengths: about a third of a ΔE00 per coordinate.
-        assert!((0.1..1.0).contains(&fit.noise_delta_e), "{}", fit.noise_delta_e);
+        assert!(
+            (0.1..1.0).contains(&fit.noise_delta_e),
+            "{}",
+            fit.noise_delta_e
+        );
     }
 
     #[test]
@@ -262,7 +259,11 @@ mod tests {
         let fit = fit_measured_colour(colour_of(&thin_skin(), &opts), &opts).unwrap();
         assert!(fit.seed_delta_e > 3.0, "seed ΔE00 {}", fit.seed_delta_e);
         assert!(fit.delta_e < ROUND_TRIP_DE, "ΔE00 {}", fit.delta_e);
-        assert!(fit.parameters.len() > 4 && fit.steps[0].accepted, "{:?}", fit.steps);
+        assert!(
+            fit.parameters.len() > 4 && fit.steps[0].accepted,
+            "{:?}",
+            fit.steps
+        );
     }
 
     /// The default exact model (two-stage: 8-point search shifted to the full model).

@@ -4,10 +4,10 @@
 //! greedy `auto` selection. A target supplies the residual vector and its shift through [`Target`];
 //! the residual figure is the RMS reflectance for a spectrum and ΔE00 for a colour.
 
-use super::SelectionStep;
+use super::{SelectionStep, with_candidates};
 use crate::fit::FitError;
 use crate::fit::least_squares::{LM, LmBudget, minimize};
-use crate::fit::model::Parameter;
+use crate::fit::model::{ModelChoice, Parameter};
 use skin_optics::SkinParams;
 
 /// Space-mapping rounds of a refinement at most (each one full-model evaluation and one LM run).
@@ -113,7 +113,7 @@ fn trial(
 /// at mid-range, and at a quarter and three quarters of its range. With seven parameters that
 /// trade against each other (blood near the surface against C_h, ρ_s against the scattering
 /// scales), one local descent can stop in a valley.
-pub(super) fn full(
+fn full(
     target: &mut impl Target,
     skin: SkinParams,
     params: &[Parameter],
@@ -136,7 +136,7 @@ pub(super) fn full(
 /// every candidate not yet in, refines the best and keeps it while `criterion(residual, k, j)`
 /// falls (k free parameters, j candidates chosen). Returns the final parameters, skin, residual
 /// and the rounds.
-pub(super) fn auto(
+fn auto(
     target: &mut impl Target,
     start: (SkinParams, f64),
     seed_params: &[Parameter],
@@ -188,6 +188,27 @@ pub(super) fn auto(
         (params, skin, rms, chosen) = (with, s, r, chosen + 1);
     }
     Ok((params, skin, rms, steps))
+}
+
+/// The fit `model` asks for, from the seed's fit `seed` over `seed_params`: the seed itself, every
+/// candidate ([`full`]) or the selection ([`auto`] with `criterion`). Returns the free
+/// parameters, skin, residual figure and the selection rounds.
+pub(super) fn fit_model(
+    target: &mut impl Target,
+    model: ModelChoice,
+    seed: (SkinParams, f64),
+    seed_params: &[Parameter],
+    criterion: impl Fn(f64, usize, usize) -> f64,
+) -> Result<(Vec<Parameter>, SkinParams, f64, Vec<SelectionStep>), FitError> {
+    match model {
+        ModelChoice::Seed => Ok((seed_params.to_vec(), seed.0, seed.1, Vec::new())),
+        ModelChoice::Full => {
+            let all = with_candidates(seed_params);
+            let (skin, r) = full(target, seed.0, &all)?;
+            Ok((all, skin, r, Vec::new()))
+        }
+        ModelChoice::Auto => auto(target, seed, seed_params, criterion),
+    }
 }
 
 /// ln C(m, j).
