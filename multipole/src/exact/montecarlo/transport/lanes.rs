@@ -51,9 +51,10 @@ struct Streams {
 }
 
 impl Streams {
-    /// Lane states from 256 bits of the batch's generator each. Streams of random 256-bit seeds
-    /// overlap within 2⁶⁴ draws with probability below 2⁻¹²⁰ per pair; the all-zero state (the
-    /// generator's fixed point) has probability 2⁻²⁵⁶.
+    /// Lane states from 256 bits of the batch's generator each. Two streams started at random
+    /// points of the generator's cycle (length 2²⁵⁶ − 1) overlap within L draws each with
+    /// probability about 2L/2²⁵⁶: 2⁻¹⁹¹ for L = 2⁶⁴. The all-zero state (the generator's fixed
+    /// point) has probability 2⁻²⁵⁶.
     fn seeded(rng: &mut Xoshiro256StarStar) -> Self {
         let mut s = [[0; W]; 4];
         for lane in 0..W {
