@@ -14,6 +14,9 @@
 //! dark. A pixel stops when the mean squared relative error over its 3×3 neighbourhood is below the
 //! target²: pooling nine pixels keeps a pixel whose own few samples happened to agree (no firefly
 //! seen yet) from stopping early, the source of adaptive sampling's downward bias.
+//!
+//! The film's `variance` pass keeps σ̂²/n whatever the estimate (smooth, as denoisers expect it);
+//! with Sobol points it is an upper bound on the error.
 
 use crate::film::Film;
 use crate::noise::lit_threshold;
