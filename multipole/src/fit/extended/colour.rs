@@ -195,7 +195,7 @@ impl Target for ColourTarget {
 mod tests {
     use super::*;
     use crate::Method;
-    use crate::fit::FitOptions;
+    use crate::fit::{FitOptions, ModelChoice};
 
     fn options(model: ModelChoice) -> MeasuredOptions {
         MeasuredOptions {
