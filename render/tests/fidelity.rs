@@ -1,5 +1,9 @@
 //! The fidelity choices end to end: the level-of-detail switch keeps a flat slab's reflected
-//! energy, and `--fidelity full` keeps the reference tables.
+//! energy, `--fidelity full` keeps the reference tables, thin parts take the volumetric walk and
+//! thick ones keep the BSSRDF.
+//!
+//! Each scene is spelled out as TOML text (camera, skin, mesh, light), the shape of the other
+//! render tests' scenes, so a reader sees the whole scene a number comes from.
 
 use render::integrator::PathSettings;
 use render::material::Material;

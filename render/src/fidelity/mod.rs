@@ -18,6 +18,11 @@
 //! profile's own 99.9% extent) and shades every skin hit with the full BSSRDF: the reference the
 //! automatic choices are measured against. Each choice can be overridden alone
 //! ([`FidelityKnobs`]).
+//!
+//! The name parsing of [`Fidelity`] (a `Display`/`FromStr` pair, one arm per name), the option
+//! struct's field list and [`FidelityError`] (knob, value, valid range) have the shape of the same
+//! items for the workspace's other enums and settings: each is kept with its type so that its
+//! error names its own knob and valid values.
 
 pub mod cache;
 pub mod explain;
