@@ -8,8 +8,9 @@
 //! `--thin-walk`) — the hit is thin and the path takes the volumetric walk (`crate::volumetric`,
 //! §15) through the mesh instead of the BSSRDF. r₉₉ is the profile's own reach: a slab thicker
 //! than it holds 99% of the half-space's light within its depth, so the BSSRDF's answer stands;
-//! measured, the dark preset's 3-mm slab (r₉₉ 2.2 mm) agrees with the walk within 0.3% and takes
-//! the BSSRDF, the light and medium slabs (r₉₉ 5.0 and 4.0 mm) take the walk.
+//! measured, the dark preset's 3-mm slab (r₉₉ 2.2 mm) agrees with the walk within noise
+//! (−0.3% ± 4.8%) and takes the BSSRDF, the light and medium slabs (r₉₉ 5.0 and 4.0 mm) take the
+//! walk.
 //!
 //! The walk needs each material's epidermis region, a distance grid over its triangles that takes
 //! seconds for a head: it is built at the first thin hit of that material (`OnceLock`), so a scene
