@@ -367,7 +367,7 @@ pub fn radiance(
         // (crate::fidelity::transport) and the rest takes the BSSRDF.
         let volume = match (&scene.volumetric, &scene.thin_parts) {
             (Some(v), _) => v.medium(si.material),
-            (None, Some(thin)) if q_sss > 0.0 => thin.walk_at(scene, &si, ng, rays),
+            (None, Some(thin)) if q_sss > 0.0 => thin.walk_at(scene, &si, ng, footprint_mm, rays),
             _ => None,
         };
         // A skin rendered by the volumetric walk takes no BSSRDF exit: its body is walked.
