@@ -1,5 +1,8 @@
 //! Two-layer skin ([DJ06]): an epidermis slab of the given thickness (index `skin.eta()` above it,
 //! matched below) over a semi-infinite dermis (dipole with A = 1), stacked in the frequency domain.
+//!
+//! `Method`'s `FromStr` has the shape of every option parser of the workspace (trim, lower case,
+//! match the names, a typed error naming the value); each returns its own crate's error type.
 
 use crate::diffusion::boundary::observable_reflectance;
 use crate::diffusion::profile::Profile;

@@ -204,29 +204,17 @@ impl Bsdf<'_> {
     fn specular_probability(&self, o_z: f32) -> f32 {
         match &self.lobes {
             Lobes::Skin { surface, body } => {
-                let s = surface.albedo(o_z);
                 let d = body.average() * std::f32::consts::PI * surface.transmitted(o_z);
-                if s <= 0.0 {
-                    0.0
-                } else if d <= 0.0 {
-                    1.0
-                } else {
-                    (s / (s + d)).clamp(0.05, 0.95)
-                }
+                surface_share(surface.albedo(o_z), d, 0.0)
             }
             Lobes::SkinSurface {
                 surface,
                 subsurface_albedo,
             } => {
-                let s = surface.albedo(o_z);
                 let d = subsurface_albedo * surface.transmitted(o_z);
-                if s <= 0.0 {
-                    0.05
-                } else if d <= 0.0 {
-                    1.0
-                } else {
-                    (s / (s + d)).clamp(0.05, 0.95)
-                }
+                // The subsurface branch keeps at least 5% for the surface even where it
+                // reflects nothing, so the branch's weight 1/q stays bounded.
+                surface_share(surface.albedo(o_z), d, 0.05)
             }
             Lobes::Lambert { .. } => 0.0,
         }
@@ -290,6 +278,19 @@ impl Bsdf<'_> {
             pdf,
             delta: false,
         })
+    }
+}
+
+/// Share of the surface lobe among the lobes: its albedo `s` against the body's `d` (both
+/// dimensionless), clamped to [0.05, 0.95] so neither lobe's weight grows without bound;
+/// `without_surface` where the surface reflects nothing.
+fn surface_share(s: f32, d: f32, without_surface: f32) -> f32 {
+    if s <= 0.0 {
+        without_surface
+    } else if d <= 0.0 {
+        1.0
+    } else {
+        (s / (s + d)).clamp(0.05, 0.95)
     }
 }
 

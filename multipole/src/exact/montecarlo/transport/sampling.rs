@@ -1,5 +1,8 @@
 //! The random draws of one scattering ([WJZ95] §3.5): Henyey–Greenstein polar cosine, a uniform
 //! azimuth, and the rotation of the direction.
+//!
+//! `HgLanes` holds `HgSampler`'s constants one array per field, and rebuilds the scalar sampler
+//! for a lane from them field by field, so the scalar code stays the one owner of the formula.
 
 use super::Photon;
 use rand::RngCore;
