@@ -220,7 +220,7 @@ fn slab_scene(dir: &std::path::Path, thickness_mm: f32, backlit: bool) -> String
     )
 }
 
-/// The slab scene with the thin-part walk at `thin_walk_r99` (`None`: auto's default).
+/// The slab scene with the thin-part walk at `thin_walk_r99` (`None`: the default, off).
 fn load_slab(toml: &str, thin_walk_r99: Option<f64>) -> Scene {
     let opts = SceneOptions {
         fidelity: render::fidelity::FidelityKnobs {
@@ -270,7 +270,10 @@ struct AutoSlab {
 fn auto_slab(thickness_mm: f32, backlit: bool, side: usize, spp: u32, seed: u64) -> AutoSlab {
     let dir = tempfile::tempdir().unwrap();
     let toml = slab_scene(dir.path(), thickness_mm, backlit);
-    let scene = load_slab(&toml, None);
+    let scene = load_slab(
+        &toml,
+        Some(render::fidelity::transport::DEFAULT_THIN_WALK_R99),
+    );
     let (y, err, film) = mean_y(&scene, side, spp, seed);
     let counts = scene.thin_parts.as_ref().unwrap().part(0).unwrap().counts();
     AutoSlab {
@@ -283,14 +286,14 @@ fn auto_slab(thickness_mm: f32, backlit: bool, side: usize, spp: u32, seed: u64)
     }
 }
 
-/// A backlit 2-mm slab of light skin is thinner than its r99 (4.95 mm): auto walks it (every
+/// A backlit 2-mm slab of light skin is thinner than its r99 (4.95 mm): `--thin-walk 1` walks it (every
 /// hit the camera sees), and its image agrees with the volumetric reference
 /// (`--integrator volumetric`, another seed) within 4 standard errors of the difference (each
 /// mean's error from its variance pass: 16² pixels × 128 paths, about 2.5% each; measured
 /// 0.1136 ± 0.0027 against 0.1210 ± 0.0029, 1.9σ); the BSSRDF alone (`thin_walk` 0) returns
 /// 60–85% less (BENCHMARKS.md; here 0.047, −61%), far outside that, so the check can fail.
 #[test]
-fn auto_walks_a_thin_slab_and_matches_the_volumetric_reference() {
+fn the_thin_walk_takes_a_thin_slab_and_matches_the_volumetric_reference() {
     let auto = auto_slab(2.0, true, 16, 128, 1);
     let (tested, walked) = auto.counts;
     assert!(
@@ -314,10 +317,10 @@ fn auto_walks_a_thin_slab_and_matches_the_volumetric_reference() {
     );
 }
 
-/// A 20-mm slab is thicker than r99: auto probes every subsurface hit, walks none, and renders
+/// A 20-mm slab is thicker than r99: `--thin-walk 1` probes every subsurface hit, walks none, and renders
 /// the same image, bit for bit, as the BSSRDF alone (the probe ray draws no random numbers).
 #[test]
-fn auto_keeps_the_bssrdf_on_a_thick_slab() {
+fn the_thin_walk_keeps_the_bssrdf_on_a_thick_slab() {
     let auto = auto_slab(20.0, false, 8, 4, 7);
     let (tested, walked) = auto.counts;
     assert!(tested > 0 && walked == 0, "{walked}/{tested} walked");

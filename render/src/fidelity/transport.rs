@@ -30,7 +30,8 @@ use glam::Vec3;
 use std::sync::OnceLock;
 use std::sync::atomic::{AtomicU64, Ordering};
 
-/// Default factor of r₉₉ below which a hit's local thickness takes the walk (`Fidelity::Auto`).
+/// Factor of r₉₉ below which a hit's local thickness takes the walk, as measured on the backlit
+/// slabs (`--thin-walk 1`; the walk is off unless asked for).
 pub const DEFAULT_THIN_WALK_R99: f64 = 1.0;
 
 /// One skin material's thin-part walk: its threshold, its medium (built at first use) and the
