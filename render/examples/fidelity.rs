@@ -22,8 +22,8 @@
 //! (blue, green, red) and the largest over the table's rows (what the level of detail uses), and the
 //! ratio of the pixel footprint at the skin's mean camera distance to each.
 //!
-//! `cargo run --release -p render --example fidelity -- [OUT] [SPP_FAR] [SPP_EAR] [NOISE]`
-//! (default out/fidelity, 64, 16, 0.1)
+//! `cargo run --release -p render --example fidelity -- [OUT] [SPP_FAR] [SPP_EAR] [NOISE] [MAX_SPP]`
+//! (default out/fidelity, 64, 16, 0.1, 4096; MAX_SPP 0 skips the renders to the noise target)
 
 use render::fidelity::{Fidelity, FidelityKnobs, LodBand, LodSetting};
 use render::film::Film;
@@ -39,8 +39,6 @@ use std::time::Instant;
 
 const WIDTH: usize = 768;
 const HEIGHT: usize = 384;
-/// Most samples a pixel takes under the noise target.
-const MAX_SPP: u32 = 4096;
 
 /// One configuration to render.
 struct Config {
@@ -49,6 +47,7 @@ struct Config {
     seed: u64,
     spp: u32,
     noise: Option<f64>,
+    max_spp: u32,
 }
 
 /// One rendered configuration.
@@ -68,6 +67,8 @@ fn knobs(fidelity: Fidelity, lod: LodSetting, no_subsurface: bool) -> SceneOptio
         fidelity: FidelityKnobs {
             fidelity: Some(fidelity),
             lod,
+            // The footprint the shape photons are chosen from.
+            image_height: Some(HEIGHT as u32),
             ..FidelityKnobs::default()
         },
         no_subsurface,
@@ -89,7 +90,7 @@ fn render_one(spec: &str, c: &Config, out: &Path) -> Run {
     let settings = RenderOptions {
         width: WIDTH,
         height: HEIGHT,
-        spp: c.noise.map_or(c.spp, |_| MAX_SPP),
+        spp: c.noise.map_or(c.spp, |_| c.max_spp),
         seed: c.seed,
         noise: c.noise,
         time_limit: None,
@@ -181,8 +182,8 @@ fn errors(run: &Run, reference: &Run, skin: &[bool], nx: usize, ny: usize) -> Er
 }
 
 /// The far view's configurations: the reference, where the time goes at `spp`, and time to the
-/// noise target `noise`.
-fn far_configs(spp: u32, noise: f64) -> Vec<Config> {
+/// noise target `noise` with at most `max_spp` samples a pixel (0: not rendered to the target).
+fn far_configs(spp: u32, noise: f64, max_spp: u32) -> Vec<Config> {
     let full = || knobs(Fidelity::Full, LodSetting::ByFidelity, false);
     let auto = || knobs(Fidelity::Auto, LodSetting::ByFidelity, false);
     let narrow = || knobs(Fidelity::Auto, band(0.25, 1.0), false);
@@ -194,6 +195,7 @@ fn far_configs(spp: u32, noise: f64) -> Vec<Config> {
         seed,
         spp,
         noise: None,
+        max_spp,
     };
     let target = |label, opts, seed| Config {
         label,
@@ -201,8 +203,9 @@ fn far_configs(spp: u32, noise: f64) -> Vec<Config> {
         seed,
         spp,
         noise: Some(noise),
+        max_spp,
     };
-    vec![
+    let mut configs = vec![
         Config {
             spp: 4 * spp,
             ..fixed("full-reference", full(), 1)
@@ -216,11 +219,15 @@ fn far_configs(spp: u32, noise: f64) -> Vec<Config> {
             knobs(Fidelity::Auto, LodSetting::Off, true),
             6,
         ),
-        target("full-to-noise", full(), 7),
-        target("auto-to-noise", auto(), 8),
-        target("auto-band-0.25-1-to-noise", narrow(), 9),
-        target("collapsed-to-noise", collapsed(), 10),
-    ]
+    ];
+    if max_spp > 0 {
+        configs.extend([
+            target("full-to-noise", full(), 7),
+            target("auto-to-noise", auto(), 8),
+            target("collapsed-to-noise", collapsed(), 10),
+        ]);
+    }
+    configs
 }
 
 /// The close-up's configurations (all at `spp`, the reference at four times as many).
@@ -232,11 +239,17 @@ fn ear_configs(spp: u32) -> Vec<Config> {
         seed,
         spp,
         noise: None,
+        max_spp: spp,
     };
     vec![
         config("full-reference", full, 1, 4 * spp),
         config("full", full, 2, spp),
-        config("auto", SceneOptions::default(), 3, spp),
+        config(
+            "auto",
+            knobs(Fidelity::Auto, LodSetting::ByFidelity, false),
+            3,
+            spp,
+        ),
         config(
             "auto-band-0.25-1",
             knobs(Fidelity::Auto, band(0.25, 1.0), false),
@@ -292,11 +305,13 @@ fn main() {
             .map_or(default, |s| s.parse().expect("a number"))
     };
     let (spp_far, spp_ear, noise) = (next(64.0) as u32, next(16.0) as u32, next(0.1));
+    let max_spp = next(4096.0) as u32;
     std::fs::create_dir_all(&out).expect("create OUT");
     print!("{}", lod_ratios("builtin:three-heads-far", &out));
     let mut csv = String::from(
         "scene,config,spp,noise_target,mean_spp,load_s,render_cpu_s,speedup,cell_rel_rms,\
-         pixel_rel_rms,chi2,skin_noise,skin_pixels\n",
+         pixel_rel_rms,chi2,skin_noise,cpu_s_to_skin_noise,speedup_to_skin_noise,pixel_noise,\
+         cpu_s_to_pixel_noise,speedup_to_pixel_noise,skin_pixels\n",
     );
     let mut chart = LineChart::new(
         "Automatic fidelity against --fidelity full",
@@ -305,7 +320,12 @@ fn main() {
     );
     let mut worst: f64 = 0.0;
     for (spec, nx, ny, configs) in [
-        ("builtin:three-heads-far", 5, 3, far_configs(spp_far, noise)),
+        (
+            "builtin:three-heads-far",
+            5,
+            3,
+            far_configs(spp_far, noise, max_spp),
+        ),
         ("builtin:ear", 1, 1, ear_configs(spp_ear)),
     ] {
         let runs: Vec<Run> = configs.iter().map(|c| render_one(spec, c, &out)).collect();
@@ -317,8 +337,24 @@ fn main() {
             .collect();
         let skin_pixels = skin.iter().filter(|&&s| s).count();
         let (mut fixed, mut targeted) = (Vec::new(), Vec::new());
+        // CPU time at which uniform sampling at the run's cost per sample brings the skin pixels'
+        // RMS relative noise to the target: noise² falls as 1/samples, time grows with them.
+        let to_noise = |run: &Run, e: &Errors| run.cpu_s * (e.noise / noise).powi(2);
+        let full = runs[1..].iter().find(|r| r.label == "full");
+        let full_errors = full.map(|r| errors(r, &runs[0], &skin, nx, ny));
+        let full_to_noise = full.zip(full_errors.as_ref()).map(|(r, e)| to_noise(r, e));
+        // The same from the measured difference to the reference: full at n samples against the
+        // reference at 4n has pixel_rel² = σ² + σ²/4, so the reference's own share is
+        // pixel_rel²(full) / 5; what is left of a run's pixel_rel² is its noise (and any bias).
+        let reference_noise2 = full_errors.as_ref().map_or(0.0, |e| e.pixel.powi(2) / 5.0);
+        let pixel_noise = |e: &Errors| (e.pixel.powi(2) - reference_noise2).max(0.0).sqrt();
+        let to_pixel_noise = |run: &Run, e: &Errors| run.cpu_s * (pixel_noise(e) / noise).powi(2);
+        let full_to_pixel_noise = full
+            .zip(full_errors.as_ref())
+            .map(|(r, e)| to_pixel_noise(r, e));
         for run in &runs[1..] {
             let e = errors(run, &runs[0], &skin, nx, ny);
+            let t_noise = to_noise(run, &e);
             // Speed-up against full fidelity under the same stop rule.
             let base = runs[1..]
                 .iter()
@@ -326,7 +362,8 @@ fn main() {
                 .map_or(run.cpu_s, |r| r.cpu_s);
             let _ = writeln!(
                 csv,
-                "{spec},{},{},{},{:.1},{:.3},{:.2},{:.3},{:.5},{:.5},{:.3},{:.5},{skin_pixels}",
+                "{spec},{},{},{},{:.1},{:.3},{:.2},{:.3},{:.5},{:.5},{:.3},{:.5},{:.1},{:.2},{:.5},{:.1},{:.2},\
+                 {skin_pixels}",
                 run.label,
                 run.spp,
                 run.noise.map_or("none".into(), |n| n.to_string()),
@@ -337,7 +374,12 @@ fn main() {
                 e.cell,
                 e.pixel,
                 e.chi2,
-                e.noise
+                e.noise,
+                t_noise,
+                full_to_noise.map_or(1.0, |t| t / t_noise),
+                pixel_noise(&e),
+                to_pixel_noise(run, &e),
+                full_to_pixel_noise.map_or(1.0, |t| t / to_pixel_noise(run, &e)),
             );
             if run.label != "no-subsurface" {
                 let points = if run.noise.is_some() {

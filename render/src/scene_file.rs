@@ -191,6 +191,8 @@ pub struct FidelityDesc {
     pub lod: Option<LodDesc>,
     /// Local thickness, in r99, below which a hit takes the volumetric walk, in [0, 10] (0: never).
     pub thin_walk: Option<f64>,
+    /// Photons of the universal shape table, in [1e4, 1e9] (auto: from the pixel footprint).
+    pub shape_photons: Option<u64>,
 }
 
 /// `fidelity.lod`: "off" or [LO, HI].

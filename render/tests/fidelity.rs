@@ -110,6 +110,89 @@ fn full_fidelity_keeps_the_reference_tables() {
     assert!(skin.lod().is_none());
 }
 
+/// The shape photons follow the pixel footprint: the slab seen at 4 pixels (4.4 mm each) takes the
+/// cheapest table, whose measured shape error is within what that footprint can see; the same skin
+/// seen at 0.004 mm per pixel takes the default table, and run-time escapes scale the same way;
+/// the key overrides the choice.
+#[test]
+fn shape_photons_follow_the_pixel_footprint() {
+    use render::fidelity::photons::{self, PhotonChoice, TABLE_PHOTON_LAW};
+    let opts = |height| SceneOptions {
+        fidelity: render::fidelity::FidelityKnobs {
+            image_height: Some(height),
+            ..Default::default()
+        },
+        ..SceneOptions::default()
+    };
+    let scene = Scene::from_toml(SLAB, "slab.toml", None, &opts(4)).unwrap();
+    let Material::Skin(skin) = &scene.materials[0] else {
+        panic!("skin first")
+    };
+    let choices = skin.choices.as_ref().unwrap();
+    let PhotonChoice::Footprint {
+        footprint_mm,
+        visible_share,
+        tolerance,
+        measured,
+    } = choices.photons
+    else {
+        panic!("{:?}", choices.photons)
+    };
+    // The camera is 500 mm from the slab on its axis: F = 500 · 2 tan(1°) / 4 (f32 rounding).
+    let expected = 500.0 * 2.0 * 1f32.to_radians().tan() / 4.0;
+    assert!(
+        (footprint_mm / expected - 1.0).abs() < 1e-4,
+        "{footprint_mm} vs {expected}"
+    );
+    assert!(
+        choices.shape.contains(&TABLE_PHOTON_LAW[0].0.to_string()),
+        "{}",
+        choices.shape
+    );
+    assert!(measured <= tolerance, "{measured} > {tolerance}");
+    // s(F) against an independent integral of the table's own rows: the largest share of a row's
+    // energy beyond F/2, by the midpoint rule on 20,000 steps out to the table's end (the
+    // interpolated density is piecewise smooth on ~100 nodes, so the rule is within 1e-3).
+    let table = &skin.subsurface.as_ref().unwrap().table;
+    let r_half = 0.5 * footprint_mm;
+    let r_end = *table.radii_mm().last().unwrap();
+    let step_nm = choices.wavelengths.step_nm as f32;
+    let independent = (0..table.wavelengths())
+        .map(|j| {
+            let nm = 380.0 + j as f32 * step_nm;
+            let n = 20_000;
+            let dr = r_half / n as f32;
+            let within: f32 = (0..n)
+                .map(|i| {
+                    let r = (i as f32 + 0.5) * dr;
+                    std::f32::consts::TAU * r * table.eval(nm, r) * dr
+                })
+                .sum();
+            1.0 - within / table.total(nm)
+        })
+        .fold(0.0f32, f32::max);
+    assert!(r_half < r_end);
+    assert!(
+        (visible_share - independent).abs() < 2e-3,
+        "{visible_share} vs {independent}"
+    );
+    // Seen 1000 times closer, the same skin needs the default table; escapes scale by s².
+    let (close, why) = photons::choose(table, footprint_mm / 1000.0, None);
+    assert_eq!(close, TABLE_PHOTON_LAW[2].0, "{why:?}");
+    let far_escapes = photons::choose(table, footprint_mm, Some(4000)).0;
+    assert!(far_escapes < photons::choose(table, footprint_mm / 1000.0, Some(4000)).0);
+    // The key wins over the footprint.
+    let keyed = format!("{SLAB}\n[fidelity]\nshape_photons = 50000\nwavelength_step_nm = 100\n");
+    let scene = Scene::from_toml(&keyed, "slab.toml", None, &opts(4096)).unwrap();
+    let Material::Skin(skin) = &scene.materials[0] else {
+        panic!("skin first")
+    };
+    assert_eq!(
+        skin.choices.as_ref().unwrap().photons,
+        PhotonChoice::Override
+    );
+}
+
 /// The scene's `[fidelity]` keys set the choices (a flag would win, `FidelityKnobs::over`), and a
 /// bad key is an error naming it.
 #[test]
@@ -132,6 +215,7 @@ fn scene_keys_set_the_fidelity_and_bad_ones_are_named() {
         ("energy_tolerance = 0.5", "fidelity.energy_tolerance"),
         ("wavelength_step_nm = 7", "fidelity.wavelength_step_nm"),
         ("fidelity = \"half\"", "fidelity.fidelity"),
+        ("shape_photons = 10", "fidelity.shape_photons"),
     ] {
         let e = Scene::from_toml(&with(keys), "slab.toml", None, &SceneOptions::default())
             .err()
@@ -178,6 +262,7 @@ fn explain_prints_the_choices_and_multipole_warns() {
         "profile extent",
         "table size",
         "shapes",
+        "shape photons",
         "level of detail",
         "transport",
         "cache            off",

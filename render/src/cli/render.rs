@@ -101,6 +101,10 @@ pub struct RenderArgs {
     /// many of the skin's largest 99% energy radii, in [0, 10] (0: never; auto: 1, full: 0).
     #[arg(long, value_name = "R99S", value_parser = Checked(parse_thin_walk), allow_hyphen_values = true)]
     pub thin_walk: Option<f64>,
+    /// Photons of the universal shape table, in [1e4, 1e9] (auto: the fewest whose measured shape
+    /// error the smallest pixel footprint on the skin cannot see; full: 500000).
+    #[arg(long, value_name = "N", value_parser = Checked(parse_shape_photons), allow_hyphen_values = true)]
+    pub shape_photons: Option<u64>,
     /// Neither read nor write the disk cache of skin tables.
     #[arg(long)]
     pub no_cache: bool,
@@ -168,6 +172,9 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         wavelength_step_nm: args.wavelength_step,
         lod: args.lod.unwrap_or_default(),
         thin_walk_r99: args.thin_walk,
+        shape_photons: args.shape_photons,
+        image_height: Some(args.height),
+        smallest_footprint_mm: None,
         cache: !args.no_cache,
     };
     fidelity
@@ -307,6 +314,10 @@ fn parse_small_count(s: &str) -> Result<u32, String> {
 
 fn parse_escapes(s: &str) -> Result<u64, String> {
     parse_whole(s, 100, 1_000_000_000, "[100, 1e9]")
+}
+
+fn parse_shape_photons(s: &str) -> Result<u64, String> {
+    parse_whole(s, 10_000, 1_000_000_000, "[1e4, 1e9]")
 }
 
 fn parse_fraction(s: &str) -> Result<f64, String> {

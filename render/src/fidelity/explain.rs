@@ -5,6 +5,7 @@
 //! workspace's other result records (fits, spectra) by design.
 
 use super::cache::CacheOutcome;
+use super::photons::PhotonChoice;
 use super::{Fidelity, Lod, WavelengthChoice};
 use multipole::skin::DIFFUSION_OK;
 use multipole::{DEFAULT_G, LayeredMedium, Method};
@@ -148,6 +149,8 @@ pub struct SkinChoices {
     pub radii: usize,
     /// Where the profile shapes come from.
     pub shape: String,
+    /// How the shapes' photon count was chosen.
+    pub photons: PhotonChoice,
     /// The level of detail, if on.
     pub lod: Option<Lod>,
     /// BSSRDF or the stand-in.
@@ -158,6 +161,28 @@ pub struct SkinChoices {
     pub build_ms: f64,
     /// With `--method multipole`: where diffusion is wrong.
     pub diffusion_failures: Option<DiffusionFailures>,
+}
+
+/// Why the shapes have their photon count, in words.
+fn photon_reason(p: &PhotonChoice) -> String {
+    match p {
+        PhotonChoice::Fixed => {
+            "fixed (full fidelity, diffusion, or no pixel footprint known)".into()
+        }
+        PhotonChoice::Override => "set by --shape-photons / fidelity.shape_photons".into(),
+        PhotonChoice::Footprint {
+            footprint_mm,
+            visible_share,
+            tolerance,
+            measured,
+        } => format!(
+            "from the smallest pixel footprint, {footprint_mm:.3} mm: {:.1}% of the energy \
+             leaves beyond half of it, so a {:.1}% shape error is invisible; measured {:.2}%",
+            100.0 * visible_share,
+            100.0 * tolerance,
+            100.0 * measured
+        ),
+    }
 }
 
 /// The `--explain` table: one block per skin material (`name`, its choices).
@@ -228,6 +253,7 @@ pub fn explain_table(skins: &[(&str, &SkinChoices)]) -> String {
                 ),
             ),
             ("shapes", c.shape.clone()),
+            ("shape photons", photon_reason(&c.photons)),
             ("level of detail", lod),
             ("transport", transport),
             (

@@ -11,6 +11,8 @@
 //! - [`cache`]: the tables on disk, keyed by everything they depend on, verified before use.
 //! - [`explain`]: what was chosen for each skin material and why; the diffusion warning.
 //! - [`tables`]: a skin's tables with the choices applied, through the cache.
+//! - [`photons`]: the Monte Carlo shape's photon count from the smallest pixel footprint on the
+//!   skin and the measured error-vs-photons law.
 //! - [`transport`]: the volumetric walk instead of the BSSRDF where the body under a hit is
 //!   thinner than the profile's reach.
 //!
@@ -28,6 +30,7 @@ pub mod cache;
 pub mod explain;
 pub mod extent;
 pub mod lod;
+pub mod photons;
 pub mod tables;
 pub mod transport;
 pub mod wavelengths;
@@ -115,6 +118,15 @@ pub struct FidelityKnobs {
     /// Local thickness, in units of the skin's largest r₉₉, below which a hit takes the
     /// volumetric walk, in [0, 10] (0: never).
     pub thin_walk_r99: Option<f64>,
+    /// Photons of the universal shape table, in [1e4, 1e9] (auto: from the pixel footprint,
+    /// `photons`; full: 500,000).
+    pub shape_photons: Option<u64>,
+    /// Image height the scene is rendered at, pixels (with the camera, the pixel footprint; `None`:
+    /// unknown, so no choice from the footprint).
+    pub image_height: Option<u32>,
+    /// Smallest pixel footprint on this skin, mm (set per material by the scene loader from
+    /// `image_height`, the camera and the skin's meshes).
+    pub smallest_footprint_mm: Option<f32>,
     /// Read and write the disk cache of skin tables (default true; `--no-cache` clears it).
     pub cache: bool,
 }
@@ -128,9 +140,23 @@ impl Default for FidelityKnobs {
             wavelength_step_nm: None,
             lod: LodSetting::ByFidelity,
             thin_walk_r99: None,
+            shape_photons: None,
+            image_height: None,
+            smallest_footprint_mm: None,
             cache: true,
         }
     }
+}
+
+/// How the shape's photons are chosen.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum PhotonPolicy {
+    /// The default table (500,000 photons) or the escapes asked for.
+    Fixed,
+    /// This many table photons (`--shape-photons`, `fidelity.shape_photons`).
+    Override(u64),
+    /// From this smallest pixel footprint, mm (`photons`).
+    Footprint(f32),
 }
 
 /// How the wavelength step is chosen.
@@ -160,6 +186,8 @@ pub struct Resolved {
     pub lod: Option<LodBand>,
     /// The thin-part walk's threshold in r₉₉, if on.
     pub thin_walk_r99: Option<f64>,
+    /// How the shape photons are chosen.
+    pub photons: PhotonPolicy,
 }
 
 /// A fidelity knob outside its range.
@@ -188,6 +216,9 @@ impl FidelityKnobs {
                 set => set,
             },
             thin_walk_r99: self.thin_walk_r99.or(under.thin_walk_r99),
+            shape_photons: self.shape_photons.or(under.shape_photons),
+            image_height: self.image_height.or(under.image_height),
+            smallest_footprint_mm: self.smallest_footprint_mm.or(under.smallest_footprint_mm),
             cache: self.cache,
         }
     }
@@ -241,12 +272,25 @@ impl FidelityKnobs {
             // through its exit rays) took the 60-s image from 2.6% to 8% noise (BENCHMARKS.md).
             None => None,
         };
+        let photons = match (self.shape_photons, self.smallest_footprint_mm) {
+            (Some(n), _) if !(1e4..=1e9).contains(&(n as f64)) => {
+                return Err(FidelityError {
+                    name: "fidelity.shape_photons",
+                    value: n as f64,
+                    range: "[1e4, 1e9]",
+                });
+            }
+            (Some(n), _) => PhotonPolicy::Override(n),
+            (None, Some(f)) if auto && f.is_finite() && f > 0.0 => PhotonPolicy::Footprint(f),
+            (None, _) => PhotonPolicy::Fixed,
+        };
         Ok(Resolved {
             energy_tolerance,
             radial_error,
             step,
             lod,
             thin_walk_r99,
+            photons,
         })
     }
 }
@@ -270,6 +314,35 @@ mod tests {
         assert_eq!(full.step, StepChoice::Fixed(10.0));
         assert_eq!(full.lod, None);
         assert_eq!(full.thin_walk_r99, None);
+        let seen = FidelityKnobs {
+            smallest_footprint_mm: Some(6.0),
+            ..FidelityKnobs::default()
+        };
+        assert_eq!(
+            seen.resolve().unwrap().photons,
+            PhotonPolicy::Footprint(6.0)
+        );
+        let seen_full = FidelityKnobs {
+            fidelity: Some(Fidelity::Full),
+            ..seen
+        };
+        assert_eq!(seen_full.resolve().unwrap().photons, PhotonPolicy::Fixed);
+        let forced = FidelityKnobs {
+            shape_photons: Some(200_000),
+            ..seen
+        };
+        assert_eq!(
+            forced.resolve().unwrap().photons,
+            PhotonPolicy::Override(200_000)
+        );
+        let too_few = FidelityKnobs {
+            shape_photons: Some(10),
+            ..seen
+        };
+        assert_eq!(
+            too_few.resolve().unwrap_err().name,
+            "fidelity.shape_photons"
+        );
         let auto = FidelityKnobs::default().resolve().unwrap();
         assert_eq!(auto.energy_tolerance, Some(DEFAULT_ENERGY_TOLERANCE));
         assert!(matches!(auto.step, StepChoice::Colour { .. }));

@@ -1,12 +1,13 @@
 //! A skin's BSSRDF tables with every fidelity choice applied, through the disk cache, and the
 //! record of what was chosen ([`SkinChoices`]).
 
-use super::cache::{self, CacheOutcome};
+use super::cache;
 use super::explain::{SkinChoices, TransportChoice, diffusion_failures};
+use super::photons::{self, PhotonChoice};
 use super::wavelengths::{self, WavelengthChoice};
-use super::{FidelityKnobs, Lod, Resolved, StepChoice};
+use super::{FidelityKnobs, Lod, PhotonPolicy, Resolved, StepChoice};
 use crate::bssrdf::{ProfileTable, TableOptions};
-use multipole::skin::ExactShape;
+use multipole::skin::{ExactShape, ShapeTableOptions};
 use multipole::{Method, MultipoleError};
 use serde::{Deserialize, Serialize};
 use skin_optics::SkinParams;
@@ -19,13 +20,17 @@ struct Stored {
     wavelengths: WavelengthChoice,
 }
 
-/// The table options of `resolved` at wavelength step `step_nm` and phase `phase_g`.
-fn table_options(
-    resolved: &Resolved,
-    shape_escapes: Option<u64>,
-    phase_g: f64,
-    step_nm: f64,
-) -> TableOptions {
+/// Where the shapes' photons come from: run-time escapes, or the universal table's photons
+/// (`None`: the default table).
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Shapes {
+    Escapes(u64),
+    Table(Option<u64>),
+}
+
+/// The table options of `resolved` with shapes `shapes`, at wavelength step `step_nm` and phase
+/// `phase_g`.
+fn table_options(resolved: &Resolved, shapes: Shapes, phase_g: f64, step_nm: f64) -> TableOptions {
     let mut opts = TableOptions {
         step_nm,
         energy_tolerance: resolved.energy_tolerance,
@@ -33,8 +38,15 @@ fn table_options(
         ..TableOptions::default()
     };
     opts.profile.phase_g = phase_g;
-    if let Some(escapes) = shape_escapes {
-        opts.profile.exact_shape = ExactShape::MonteCarlo { escapes };
+    match shapes {
+        Shapes::Escapes(escapes) => opts.profile.exact_shape = ExactShape::MonteCarlo { escapes },
+        Shapes::Table(Some(photons)) => {
+            opts.profile.exact_shape = ExactShape::Table(ShapeTableOptions {
+                photons,
+                ..ShapeTableOptions::default()
+            });
+        }
+        Shapes::Table(None) => {}
     }
     opts
 }
@@ -64,16 +76,17 @@ pub fn skin_table(
         value: e.value,
         range: e.range,
     })?;
-    // The key holds the options before the wavelength choice (the choice is part of the value).
-    let probe = table_options(&resolved, shape_escapes, phase_g, 10.0);
-    let key = key(params, method, &probe, &resolved);
     let dir = knobs
         .cache
         .then(multipole::skin::cache_dir)
         .flatten()
         .map(|d| d.join("tables"));
-    let (stored, outcome): (Stored, CacheOutcome) =
-        cache::load_or_build(dir.as_deref(), cache::max_bytes()?, &key, || {
+    let max_bytes = cache::max_bytes()?;
+    let get = |shapes: Shapes| {
+        // The key holds the options before the wavelength choice (the choice is part of the value).
+        let probe = table_options(&resolved, shapes, phase_g, 10.0);
+        let key = key(params, method, &probe, &resolved);
+        let (stored, outcome) = cache::load_or_build(dir.as_deref(), max_bytes, &key, || {
             let wavelengths = match resolved.step {
                 StepChoice::Fixed(step_nm) => WavelengthChoice::fixed(step_nm),
                 StepChoice::Colour {
@@ -85,10 +98,40 @@ pub fn skin_table(
                     max_luminance_error,
                 ),
             };
-            let opts = table_options(&resolved, shape_escapes, phase_g, wavelengths.step_nm);
+            let opts = table_options(&resolved, shapes, phase_g, wavelengths.step_nm);
             let table = ProfileTable::build(params, method, &opts)?;
             Ok::<_, MultipoleError>(Stored { table, wavelengths })
         })?;
+        Ok::<_, MultipoleError>((stored, outcome, probe))
+    };
+    let (stored, outcome, probe, photon_choice) = match (method, resolved.photons) {
+        (Method::Multipole, _) | (_, PhotonPolicy::Fixed) => {
+            let shapes = shape_escapes.map_or(Shapes::Table(None), Shapes::Escapes);
+            let (stored, outcome, probe) = get(shapes)?;
+            (stored, outcome, probe, PhotonChoice::Fixed)
+        }
+        (_, PhotonPolicy::Override(n)) => {
+            let (stored, outcome, probe) = get(Shapes::Table(Some(n)))?;
+            (stored, outcome, probe, PhotonChoice::Override)
+        }
+        (_, PhotonPolicy::Footprint(footprint_mm)) => {
+            // The share the footprint can see, from the cheapest table (`photons` module doc).
+            let cheapest = photons::TABLE_PHOTON_LAW[0].0;
+            let first = get(Shapes::Table(Some(cheapest)))?;
+            let (n, choice) = photons::choose(&first.0.table, footprint_mm, shape_escapes);
+            let shapes = if shape_escapes.is_some() {
+                Shapes::Escapes(n)
+            } else {
+                Shapes::Table(Some(n))
+            };
+            if shapes == Shapes::Table(Some(cheapest)) {
+                (first.0, first.1, first.2, choice)
+            } else {
+                let (stored, outcome, probe) = get(shapes)?;
+                (stored, outcome, probe, choice)
+            }
+        }
+    };
     let table = stored.table;
     let r99_mm = table.largest_radius_for_energy_mm(0.99);
     let choices = SkinChoices {
@@ -100,6 +143,7 @@ pub fn skin_table(
         r99_mm,
         radii: table.radii_mm().len(),
         shape: shape_source(method, &probe),
+        photons: photon_choice,
         lod: resolved.lod.map(|band| Lod { r99_mm, band }),
         transport: TransportChoice::bssrdf(
             params,
@@ -131,6 +175,7 @@ fn shape_source(method: Method, opts: &TableOptions) -> String {
 
 #[cfg(test)]
 mod tests {
+    use super::cache::CacheOutcome;
     use super::*;
     use crate::fidelity::Fidelity;
     use skin_optics::Preset;
@@ -152,7 +197,7 @@ mod tests {
             ..FidelityKnobs::default()
         };
         let resolved = knobs.resolve().unwrap();
-        let probe = table_options(&resolved, None, multipole::DEFAULT_G, 10.0);
+        let probe = table_options(&resolved, Shapes::Table(None), multipole::DEFAULT_G, 10.0);
         let k = key(params, Method::Exact, &probe, &resolved);
         let build = || {
             let (t, c) = skin_table(

@@ -192,8 +192,8 @@ impl Loader<'_> {
                 .over(&self.fidelity(desc.fidelity.as_ref())?),
             ..*self.opts
         };
-        let (materials, material_names, textures) = self.materials(&desc.materials, &knobs)?;
-
+        // Material ids follow the file's table in name order, as `materials` builds them.
+        let material_names: Vec<String> = desc.materials.keys().cloned().collect();
         let mut meshes = Vec::new();
         let mut cache: HashMap<String, TriangleMesh> = HashMap::new();
         for (i, m) in desc.meshes.iter().enumerate() {
@@ -212,21 +212,6 @@ impl Loader<'_> {
                     )
                 })?;
             let mut mesh = self.mesh(&key, m, &mut cache)?;
-            if let Material::Skin(SkinMaterial {
-                albedo_texture: Some(_),
-                ..
-            })
-            | Material::Diffuse(DiffuseMaterial {
-                albedo_texture: Some(_),
-                ..
-            }) = &materials[material]
-                && mesh.uvs.is_none()
-            {
-                return Err(self.err(
-                    &key,
-                    "the material has a texture but the mesh has no texture coordinates",
-                ));
-            }
             let placement = Placement {
                 units_mm: self.positive(&format!("{key}.units_mm"), m.units_mm)?,
                 scale: self.positive(&format!("{key}.scale"), m.scale)?,
@@ -254,6 +239,31 @@ impl Loader<'_> {
                 uvs.iter_mut().for_each(|uv| uv.y = 1.0 - uv.y);
             }
             meshes.push((mesh, material as u32));
+        }
+        let footprints = smallest_footprints_mm(
+            &camera,
+            knobs.fidelity.image_height,
+            &meshes,
+            material_names.len(),
+        );
+        let (materials, material_names, textures) =
+            self.materials(&desc.materials, &knobs, &footprints)?;
+        for (i, (mesh, material)) in meshes.iter().enumerate() {
+            if let Material::Skin(SkinMaterial {
+                albedo_texture: Some(_),
+                ..
+            })
+            | Material::Diffuse(DiffuseMaterial {
+                albedo_texture: Some(_),
+                ..
+            }) = &materials[*material as usize]
+                && mesh.uvs.is_none()
+            {
+                return Err(self.err(
+                    format!("meshes[{i}]"),
+                    "the material has a texture but the mesh has no texture coordinates",
+                ));
+            }
         }
 
         let lights = desc
@@ -464,4 +474,34 @@ impl Loader<'_> {
             )?)),
         }
     }
+}
+
+/// Per material, the smallest pixel footprint on its meshes, mm: the pixel angle at `image_height`
+/// times the distance from the camera to the nearest point of the bounding box of the material's
+/// placed meshes (0 with the camera inside it), a lower bound on every camera hit's footprint
+/// (`crate::fidelity::photons`). `None` without an image height or a mesh.
+fn smallest_footprints_mm(
+    camera: &Camera,
+    image_height: Option<u32>,
+    meshes: &[(TriangleMesh, u32)],
+    materials: usize,
+) -> Vec<Option<f32>> {
+    let Some(height) = image_height else {
+        return vec![None; materials];
+    };
+    let angle = camera.pixel_angle_rad(height as usize);
+    let eye = camera.position_mm();
+    let mut bounds: Vec<Option<(Vec3, Vec3)>> = vec![None; materials];
+    for (mesh, material) in meshes {
+        let Some(b) = bounds.get_mut(*material as usize) else {
+            continue;
+        };
+        for &p in &mesh.positions {
+            *b = Some(b.map_or((p, p), |(lo, hi)| (lo.min(p), hi.max(p))));
+        }
+    }
+    bounds
+        .into_iter()
+        .map(|b| b.map(|(lo, hi)| angle * (eye.clamp(lo, hi) - eye).length()))
+        .collect()
 }

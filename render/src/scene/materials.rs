@@ -21,17 +21,19 @@ use std::collections::{BTreeMap, HashMap};
 type Materials = (Vec<Material>, Vec<String>, Vec<Texture>);
 
 impl Loader<'_> {
-    /// Every material of the file, each texture read once.
+    /// Every material of the file, each texture read once; `footprints_mm[i]` is the smallest
+    /// pixel footprint on material i's meshes, mm (the shape photons' choice).
     pub(super) fn materials(
         &self,
         descs: &BTreeMap<String, MaterialDesc>,
         knobs: &SkinKnobs,
+        footprints_mm: &[Option<f32>],
     ) -> Result<Materials, RenderError> {
         let mut textures = Vec::new();
         let mut texture_ids: HashMap<String, usize> = HashMap::new();
         let mut material_names = Vec::new();
         let mut materials = Vec::new();
-        for (name, m) in descs {
+        for (index, (name, m)) in descs.iter().enumerate() {
             let key = format!("materials.{name}");
             let mut texture = |spec: &Option<String>| -> Result<Option<TextureRef>, RenderError> {
                 let Some(spec) = spec else { return Ok(None) };
@@ -69,7 +71,9 @@ impl Loader<'_> {
                         |e: brdf::BrdfError| self.err(format!("{key}.roughness"), e.to_string());
                     brdf::check_roughness(m_rough).map_err(rough_err)?;
                     let tex = texture(albedo_texture)?;
-                    let knobs = self.skin_knobs(knobs, &key, *phase_g, surface.as_deref())?;
+                    let mut knobs = self.skin_knobs(knobs, &key, *phase_g, surface.as_deref())?;
+                    knobs.fidelity.smallest_footprint_mm =
+                        footprints_mm.get(index).copied().flatten();
                     let skin =
                         SkinMaterial::build(params, m_rough, tex, &knobs).map_err(|e| match e {
                             SkinBuildError::Surface(e) => rough_err(e),
@@ -161,6 +165,9 @@ impl Loader<'_> {
             wavelength_step_nm: d.wavelength_step_nm,
             lod,
             thin_walk_r99: d.thin_walk,
+            shape_photons: d.shape_photons,
+            image_height: None,
+            smallest_footprint_mm: None,
             cache: true,
         };
         knobs
