@@ -23,12 +23,14 @@
 
 mod eigen;
 mod layer;
+mod layer_cache;
 mod matrix;
 mod memo;
 mod modes;
 mod quadrature;
 mod split;
 
+pub use layer_cache::LAYER_CACHE_BYTES;
 pub use split::{LayerTotals, skin_layer_totals};
 
 use crate::error::MultipoleError;
@@ -36,6 +38,7 @@ use crate::layered::{Layer, LayeredMedium};
 use layer::{Angles, LayerBuild, Operator};
 use matrix::Mat;
 use skin_optics::{SkinParams, Wavelength, WavelengthGrid};
+use std::rc::Rc;
 use thiserror::Error;
 
 pub use crate::layered::DEFAULT_G;
@@ -90,6 +93,7 @@ fn check(
 pub struct AddingDoublingOptions {
     quadrature_points: usize,
     g: f64,
+    cache_layers: bool,
 }
 
 impl AddingDoublingOptions {
@@ -109,7 +113,26 @@ impl AddingDoublingOptions {
         Ok(Self {
             quadrature_points,
             g,
+            cache_layers: false,
         })
+    }
+
+    /// The same options with the per-thread layer cache on or off (module `layer_cache`: a layer
+    /// whose albedo, optical thickness and g were solved before on this thread is reused; the totals
+    /// are bit for bit the same, only faster where consecutive solves share a layer, as a fit's
+    /// Jacobian does). Default off.
+    #[must_use]
+    pub fn with_layer_cache(self, on: bool) -> Self {
+        Self {
+            cache_layers: on,
+            ..self
+        }
+    }
+
+    /// Whether the layer cache is on.
+    #[must_use]
+    pub fn caches_layers(&self) -> bool {
+        self.cache_layers
     }
 
     /// Quadrature directions per hemisphere.
@@ -130,6 +153,7 @@ impl Default for AddingDoublingOptions {
         Self {
             quadrature_points: DEFAULT_QUADRATURE_POINTS,
             g: DEFAULT_G,
+            cache_layers: false,
         }
     }
 }
@@ -155,13 +179,18 @@ impl SlabTotals {
 
 /// The angular grid inside `medium`: split at the critical cosine of the top face if any.
 fn angles(medium: &LayeredMedium, eta: f64, quadrature_points: usize) -> Angles {
-    let mu_c = if medium.n_above() < eta {
+    let rule = quadrature::slab_rule_cached(quadrature_points, critical_cosine(medium, eta));
+    Angles::new(rule.nodes.clone(), rule.weights.clone())
+}
+
+/// The cosine inside the stack (index `eta`) at which the grid is split: the critical one of the top
+/// face, 0 when the stack is not denser than what lies above.
+fn critical_cosine(medium: &LayeredMedium, eta: f64) -> f64 {
+    if medium.n_above() < eta {
         (1.0 - (medium.n_above() / eta).powi(2)).sqrt()
     } else {
         0.0
-    };
-    let rule = quadrature::slab_rule_cached(quadrature_points, mu_c);
-    Angles::new(rule.nodes.clone(), rule.weights.clone())
+    }
 }
 
 /// The one refractive index of every layer of `medium`.
@@ -196,14 +225,29 @@ pub fn solve(
     let specular = top.r_down[(normal, normal)];
 
     // Fold from the bottom up: a semi-infinite bottom needs reflection only.
+    let mu_c = critical_cosine(medium, eta);
     let mut ops = Vec::with_capacity(medium.layers().len());
     for l in medium.layers() {
-        ops.push(build_layer(&angles, l)?);
+        ops.push(if options.cache_layers {
+            let key = layer_cache::LayerKey::new(
+                options.quadrature_points,
+                mu_c,
+                l.albedo(),
+                l.optical_thickness(),
+                l.g(),
+            );
+            layer_cache::cached(key, || build_layer(&angles, l))?
+        } else {
+            Rc::new(build_layer(&angles, l)?)
+        });
     }
     let diffuse;
     let transmittance;
     if medium.is_semi_infinite() {
-        let mut below = ops.pop().map(|o| o.r_down).unwrap_or_else(|| Mat::zeros(n));
+        let mut below = ops
+            .pop()
+            .map(|o| o.r_down.clone())
+            .unwrap_or_else(|| Mat::zeros(n));
         while let Some(op) = ops.pop() {
             below = op
                 .reflect_over(&below)

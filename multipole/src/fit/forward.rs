@@ -43,7 +43,7 @@ impl Forward {
         }
         AddingDoublingOptions::new(search_points, default.g())
             .ok()
-            .map(Forward::Exact)
+            .map(|o| Forward::Exact(o.with_layer_cache(true)))
     }
 
     /// Whether one wavelength costs enough (an adding-doubling solve) to spread a spectrum over threads.

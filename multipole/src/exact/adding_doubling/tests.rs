@@ -348,3 +348,51 @@ fn bad_input_is_a_typed_error() {
         Err(AddingDoublingError::OutOfRange { value, .. }) if value == 1.3
     ));
 }
+
+/// The layer cache returns what the build computes: skins that share one layer with the skin
+/// solved before them (melanin changes only the epidermis, C_h only the dermis, as a fit's Jacobian
+/// does) give the same totals bit for bit with the cache as without, at 8 and 24 points, and the
+/// cache is hit (a cache that never hits would test nothing).
+#[test]
+fn cached_layers_give_the_uncached_totals_bit_for_bit() {
+    let base = SkinParams::default();
+    let mut skins = Vec::new();
+    for c_m in [0.0, 0.05, 0.3] {
+        for c_h in [0.002, 0.02, 0.1] {
+            skins.push(
+                base.with_melanin(c_m)
+                    .and_then(|s| s.with_hemoglobin(c_h))
+                    .expect("valid skin"),
+            );
+        }
+    }
+    for n in [8, DEFAULT_QUADRATURE_POINTS] {
+        let plain = opts(n);
+        let cached = plain.with_layer_cache(true);
+        let hits = layer_cache::hits();
+        for nm in [415.0, 550.0, 680.0] {
+            let lambda = Wavelength::new(nm).expect("visible");
+            // Twice: the second pass finds both layers of every skin in the cache.
+            for _ in 0..2 {
+                for skin in &skins {
+                    let a = skin_totals(skin, lambda, &plain).expect("solves");
+                    let b = skin_totals(skin, lambda, &cached).expect("solves");
+                    assert_eq!(
+                        (
+                            a.diffuse_reflectance.to_bits(),
+                            a.specular_reflectance.to_bits()
+                        ),
+                        (
+                            b.diffuse_reflectance.to_bits(),
+                            b.specular_reflectance.to_bits()
+                        ),
+                        "{nm} nm, {n} points: {a:?} vs {b:?}"
+                    );
+                }
+            }
+        }
+        // Per wavelength 9 skins of 3 epidermises and 3 dermises: 12 of the first pass's 18 layers
+        // were built for an earlier skin, and all 18 of the second pass.
+        assert!(layer_cache::hits() - hits >= 3 * (12 + 18), "{n} points");
+    }
+}
