@@ -53,7 +53,8 @@ pub struct RenderArgs {
     /// Trace a layered Monte Carlo shape per tabulated wavelength with this many escaping photons,
     /// in [100, 1e9] (shape noise ∝ 1/√N; 1000 with shapes every 20 nm: at most 6–9%
     /// energy-weighted shape error), instead of the default shapes from the universal table
-    /// (exact transport, 1–3% against a 10⁶-photon Monte Carlo, no run-time photons).
+    /// (exact transport, 1–3% against a 10⁶-photon Monte Carlo, no run-time photons). With
+    /// --fidelity auto the count is scaled down where the pixel footprint cannot see the shape.
     #[arg(long, value_name = "N",
           value_parser = Checked(parse_escapes), allow_hyphen_values = true)]
     pub shape_escapes: Option<u64>,
@@ -77,7 +78,7 @@ pub struct RenderArgs {
     #[arg(long)]
     pub quiet: bool,
     /// How much model each skin gets: auto (each choice from the scene: profile extent, table
-    /// radii, wavelengths, level of detail) or full (every knob at its reference value, the BSSRDF
+    /// radii, wavelengths, shape photons, level of detail) or full (every knob at its reference value, the BSSRDF
     /// at every hit). Each choice can be set alone with the flags below.
     /// (Default: the scene's `[fidelity]` key, else auto.)
     #[arg(long, value_name = "F")]

@@ -58,7 +58,8 @@ pub const DEFAULT_MAX_LUMINANCE_ERROR: f64 = 1e-3;
 /// (`Full`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Fidelity {
-    /// Each choice made from the scene (extent, radii, wavelengths, level of detail).
+    /// Each choice made from the scene (extent, radii, wavelengths, shape photons, level of
+    /// detail).
     #[default]
     Auto,
     /// Every choice at its reference: full tables and the BSSRDF at every skin hit.
