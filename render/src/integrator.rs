@@ -11,7 +11,10 @@
 //! takes the subsurface branch: an exit point is sampled with probe rays, the throughput gets
 //! T(θ_o) · R(r) · N / pdf (spectral MIS) · √(m_o m_i) / q, light at the exit point is gathered by
 //! next-event estimation with S_ω (MIS against the cosine-weighted continuation), and the path
-//! continues from the exit point with a cosine-weighted direction (weight T(θ_i) / c).
+//! continues from the exit point with a cosine-weighted direction (weight T(θ_i) / c). With
+//! `split_subsurface` the exit light is gathered at every skin hit, from `subsurface_probes`
+//! probes (each from its own scrambled sequence, [`PathSampler::fork`]) whose mean is the
+//! estimate; most of the image's variance is this first-hit subsurface light (BENCHMARKS.md).
 //!
 //! The sampler's dimension table and the knobs are plain lists of named constants and documented
 //! fields; their shape repeats other such lists (the surface lobe's parameters) by nature.
@@ -64,6 +67,13 @@ pub struct PathSettings {
     /// Gather the light at a subsurface exit point at every skin hit, not only when the
     /// subsurface branch is chosen for the continuation.
     pub split_subsurface: bool,
+    /// Probes (exit points, each with its light samples) at each skin hit whose exit light is
+    /// gathered, ≥ 1; only the first continues the path (only with `split_subsurface`; default 2:
+    /// BENCHMARKS.md, "Image noise").
+    pub subsurface_probes: u32,
+    /// Stratify the light choice of the light samples at one exit point (u₀ + j/n) instead of
+    /// drawing each from its own uniform.
+    pub stratified_exit_lights: bool,
 }
 
 impl Default for PathSettings {
@@ -77,6 +87,8 @@ impl Default for PathSettings {
             probe_axes: ProbeAxes::RENDER,
             exit_light_samples: 2,
             split_subsurface: true,
+            subsurface_probes: 2,
+            stratified_exit_lights: false,
         }
     }
 }
@@ -127,9 +139,9 @@ fn russian_roulette(
 }
 
 /// Next-event estimation at `p` (geometric normal `ng`, shading normal `ns`): pick a light with
-/// the probabilities `pick`, sample it, and return f · L_i · w / pdf with the power heuristic
-/// against the scattering density; `scatter(wi)` gives (f(wi) · |cos θ_i| per wavelength, its
-/// sampling density sr⁻¹).
+/// the probabilities `pick` by the uniform `u_pick`, sample it, and return f · L_i · w / pdf with
+/// the power heuristic against the scattering density; `scatter(wi)` gives (f(wi) · |cos θ_i| per
+/// wavelength, its sampling density sr⁻¹).
 #[allow(clippy::too_many_arguments)] // the shading point and its random state, nothing to group
 fn direct_light(
     scene: &Scene,
@@ -137,14 +149,13 @@ fn direct_light(
     ng: Vec3,
     ns: Vec3,
     wl: &SampledWavelengths,
-    pick: &[f32],
+    (pick, u_pick): (&[f32], f32),
     sampler: &mut PathSampler,
     rays: &mut u64,
     scatter: impl Fn(Vec3) -> (SampledSpectrum, f32),
 ) -> SampledSpectrum {
     let n_lights = pick.len();
     // Pick a light by its selection probability (inverse CDF over a handful of lights).
-    let u_pick = sampler.get_1d();
     let mut k = 0;
     let mut cdf = pick[0];
     while u_pick >= cdf && k + 1 < n_lights {
@@ -249,6 +260,64 @@ fn subsurface_exit(
     (!weight.is_black() && weight.is_finite()).then_some((exit, weight))
 }
 
+/// Next-event estimation at a subsurface exit point with S_ω (MIS against the cosine-weighted
+/// continuation): the mean of `settings.exit_light_samples` light samples sharing the exit
+/// (splitting), and whether any light can reach the point (`pick` holds its light probabilities).
+#[allow(clippy::too_many_arguments)] // the exit and its random state
+fn exit_light(
+    scene: &Scene,
+    settings: &PathSettings,
+    ss: &Subsurface,
+    exit: &Exit,
+    wl: &SampledWavelengths,
+    sampler: &mut PathSampler,
+    rays: &mut u64,
+    pick: &mut Vec<f32>,
+) -> (SampledSpectrum, bool) {
+    let n_lights = scene.lights.len() + usize::from(scene.environment.is_some());
+    let (eng, ens) = (exit.ng, exit.ns);
+    sampler.seek(dims::EXIT_LIGHT);
+    let lit = n_lights > 0 && light_probabilities(scene, exit.p, ens, pick);
+    if !lit {
+        return (SampledSpectrum::zero(), false);
+    }
+    let n = settings.exit_light_samples.max(1);
+    let mut direct = SampledSpectrum::zero();
+    let mut u_first = 0.0;
+    for j in 0..n {
+        sampler.seek(dims::EXIT_LIGHT + 4 * j.min(1));
+        let drawn = sampler.get_1d();
+        // Stratified light choice: the j-th sample picks at u₀ + j/n (mod 1), each uniform, so
+        // the n samples spread over the lights in proportion to their probabilities.
+        let u_pick = if j == 0 {
+            u_first = drawn;
+            drawn
+        } else if settings.stratified_exit_lights {
+            (u_first + j as f32 / n as f32).fract()
+        } else {
+            drawn
+        };
+        direct += direct_light(
+            scene,
+            exit.p,
+            eng,
+            ens,
+            wl,
+            (pick, u_pick),
+            sampler,
+            rays,
+            |wi| {
+                let c = wi.dot(ens);
+                (
+                    SampledSpectrum::splat(ss.directional.s_omega(c) * c.max(0.0)),
+                    c.max(0.0) * FRAC_1_PI,
+                )
+            },
+        );
+    }
+    (direct / n as f32, true)
+}
+
 /// Where the previous scattering event was, for MIS of emission found by BSDF sampling.
 struct PrevVertex {
     ns: Vec3,
@@ -348,10 +417,19 @@ pub fn radiance(
         // Next-event estimation.
         let lit = n_lights > 0 && light_probabilities(scene, si.p, ns, &mut pick);
         if lit {
+            let u_pick = sampler.get_1d();
             l += beta
-                * direct_light(scene, si.p, ng, ns, wl, &pick, sampler, rays, |wi| {
-                    (bsdf.eval(wo, wi) * wi.dot(ns).abs(), bsdf.pdf(wo, wi))
-                });
+                * direct_light(
+                    scene,
+                    si.p,
+                    ng,
+                    ns,
+                    wl,
+                    (&pick, u_pick),
+                    sampler,
+                    rays,
+                    |wi| (bsdf.eval(wo, wi) * wi.dot(ns).abs(), bsdf.pdf(wo, wi)),
+                );
         }
 
         // Subsurface branch (skin rendered with the BSSRDF, crate::bssrdf): light leaving here
@@ -420,44 +498,66 @@ pub fn radiance(
             }
             _ => None,
         };
+        // Further probes at the same skin hit (splitting): each gathers the light at its own exit
+        // point from its own scrambled sequence; the mean over the probes is the estimate, and
+        // the continuation (below) keeps the first probe's exit.
+        let probes = if settings.split_subsurface {
+            settings.subsurface_probes.max(1)
+        } else {
+            1
+        };
+        let light_scale = if settings.split_subsurface {
+            1.0
+        } else {
+            1.0 / q_sss
+        } / probes as f32;
+        if probes > 1
+            && q_sss > 0.0
+            && volume.is_none()
+            && let Material::Skin(skin) = material
+            && let Some(ss) = &skin.subsurface
+        {
+            let entry = Entry {
+                si: &si,
+                ns,
+                wo,
+                frame: &bsdf.frame,
+            };
+            for k in 1..probes {
+                let mut fork = sampler.fork(k);
+                if let Some((exit, w)) =
+                    subsurface_exit(scene, settings, skin, ss, &entry, wl, &mut fork, rays)
+                {
+                    let (direct, _) = exit_light(
+                        scene,
+                        settings,
+                        ss,
+                        &exit,
+                        wl,
+                        &mut fork,
+                        rays,
+                        &mut exit_pick,
+                    );
+                    l += beta * w * direct * light_scale;
+                }
+            }
+        }
         if let Some((ss, exit, weight)) = found {
             let beta_exit = beta * weight;
-            let light_scale = if settings.split_subsurface {
-                1.0
-            } else {
-                1.0 / q_sss
-            };
             // At the exit point: next-event estimation with S_ω, then a cosine-weighted
             // continuation (weight S_ω cos / (cos / π) = T / c).
             let (eng, ens) = (exit.ng, exit.ns);
-            sampler.seek(dims::EXIT_LIGHT);
-            let lit_exit = n_lights > 0 && light_probabilities(scene, exit.p, ens, &mut exit_pick);
-            if lit_exit {
-                // Several light samples share one probe (splitting): their mean is the estimate.
-                let n = settings.exit_light_samples.max(1);
-                let mut direct = SampledSpectrum::zero();
-                for j in 0..n {
-                    sampler.seek(dims::EXIT_LIGHT + 4 * j.min(1));
-                    direct += direct_light(
-                        scene,
-                        exit.p,
-                        eng,
-                        ens,
-                        wl,
-                        &exit_pick,
-                        sampler,
-                        rays,
-                        |wi| {
-                            let c = wi.dot(ens);
-                            (
-                                SampledSpectrum::splat(ss.directional.s_omega(c) * c.max(0.0)),
-                                c.max(0.0) * FRAC_1_PI,
-                            )
-                        },
-                    );
-                }
-                l += beta_exit * direct * (light_scale / n as f32);
-            }
+            let (direct, lit_exit) = exit_light(
+                scene,
+                settings,
+                ss,
+                &exit,
+                wl,
+                sampler,
+                rays,
+                &mut exit_pick,
+            );
+            l += beta_exit * direct * light_scale;
             if take_sss {
                 sampler.seek(dims::EXIT_CONTINUATION);
                 let local = cosine_hemisphere(sampler.get_2d());

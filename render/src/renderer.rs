@@ -36,7 +36,7 @@ pub const MAX_SIDE: usize = 16384;
 pub const MAX_THREADS: usize = 1024;
 /// Longest path accepted, scattering events.
 pub const MAX_DEPTH: u32 = 1024;
-/// Most light samples per subsurface exit point accepted.
+/// Most light samples per subsurface exit point, and most probes per skin hit, accepted.
 pub const MAX_EXIT_LIGHT_SAMPLES: u32 = 64;
 
 /// What to render and how long, as requested; [`RenderOptions::validate`] checks it once and
@@ -130,6 +130,13 @@ impl RenderOptions {
             return Err(bad(
                 "path.exit_light_samples",
                 self.path.exit_light_samples.to_string(),
+                "[1, 64]",
+            ));
+        }
+        if !(1..=MAX_EXIT_LIGHT_SAMPLES).contains(&self.path.subsurface_probes) {
+            return Err(bad(
+                "path.subsurface_probes",
+                self.path.subsurface_probes.to_string(),
                 "[1, 64]",
             ));
         }

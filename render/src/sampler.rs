@@ -150,6 +150,20 @@ impl PathSampler {
         &mut self.rng
     }
 
+    /// Another sampler for the same pixel sample and region, whose Sobol dimensions are scrambled
+    /// apart by `k` (and whose independent stream is its own): for a decision split into several
+    /// estimates at one vertex, each stratified over the pixel's samples like the first.
+    #[must_use]
+    pub fn fork(&self, k: u32) -> Self {
+        let salt = mix64(u64::from(k).wrapping_mul(0xA076_1D64_78BD_642F) ^ self.sequence_seed);
+        Self {
+            rng: Xoshiro256PlusPlus::seed_from_u64(salt ^ u64::from(self.index)),
+            sequence_seed: salt,
+            cached_set: u32::MAX,
+            ..self.clone()
+        }
+    }
+
     /// The next two uniforms.
     pub fn get_2d(&mut self) -> Vec2 {
         let x = self.get_1d();

@@ -31,8 +31,9 @@ pub struct Variant {
 }
 
 /// The steps in the order they were added, each on top of the one before (the first is the
-/// renderer before any of them, the seventh today's default), then two other normal-probe
-/// probabilities on top of the fourth.
+/// renderer before any of them), then two other normal-probe probabilities on top of the fourth,
+/// then the splitting candidates on top of the seventh: the tenth (two probes per skin hit) is
+/// today's default.
 #[must_use]
 pub fn variants() -> Vec<Variant> {
     let before = PathSettings {
@@ -41,6 +42,8 @@ pub fn variants() -> Vec<Variant> {
         probe_axes: ProbeAxes::DEFAULT,
         exit_light_samples: 1,
         split_subsurface: false,
+        subsurface_probes: 1,
+        stratified_exit_lights: false,
         ..PathSettings::default()
     };
     let sobol = PathSettings {
@@ -87,6 +90,58 @@ pub fn variants() -> Vec<Variant> {
             PathSettings {
                 probe_axes: ProbeAxes::new(0.9).unwrap_or_default(),
                 ..split
+            },
+        ),
+        (
+            "+ 2 probes per skin hit",
+            PathSettings {
+                subsurface_probes: 2,
+                ..pair
+            },
+        ),
+        (
+            "2 probes, 1 light sample each",
+            PathSettings {
+                subsurface_probes: 2,
+                exit_light_samples: 1,
+                ..pair
+            },
+        ),
+        (
+            "4 light samples per exit",
+            PathSettings {
+                exit_light_samples: 4,
+                ..pair
+            },
+        ),
+        (
+            "direct light only (depth 1)",
+            PathSettings {
+                max_depth: 1,
+                ..pair
+            },
+        ),
+        (
+            "2 probes, stratified exit light choice",
+            PathSettings {
+                subsurface_probes: 2,
+                stratified_exit_lights: true,
+                ..pair
+            },
+        ),
+        (
+            "3 probes, 2 stratified light samples",
+            PathSettings {
+                subsurface_probes: 3,
+                stratified_exit_lights: true,
+                ..pair
+            },
+        ),
+        (
+            "3 probes",
+            PathSettings {
+                subsurface_probes: 3,
+                ..pair
             },
         ),
     ]
