@@ -164,14 +164,8 @@ pub fn fit_measured(
         select::refine(&mut problem, start.skin, &seed_params)?
     };
     let seed_rms = seed.1;
-    let (params, skin, rms, steps) = select::fit_model(
-        &mut problem,
-        opts.model,
-        seed,
-        &seed_params,
-        criterion,
-        opts.full_starts,
-    )?;
+    let (params, skin, rms, steps) =
+        select::fit_model(&mut problem, opts, seed, &seed_params, criterion)?;
     let model = problem.full_model(&skin)?;
     let chosen = params.len() - seed_params.len();
     Ok(MeasuredFit {

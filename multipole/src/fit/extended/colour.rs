@@ -69,14 +69,8 @@ pub fn fit_measured_colour(
     let criterion = |de: f64, k: usize, j: usize| {
         (de / sigma_c).powi(2) + k as f64 * n.ln() + 2.0 * ln_binomial(m, j)
     };
-    let (parameters, skin, _, steps) = select::fit_model(
-        &mut problem,
-        opts.model,
-        seed,
-        &seed_params,
-        criterion,
-        opts.full_starts,
-    )?;
+    let (parameters, skin, _, steps) =
+        select::fit_model(&mut problem, opts, seed, &seed_params, criterion)?;
     let lab = problem.lab(&problem.full, &skin)?;
     Ok(MeasuredColourFit {
         skin,

@@ -4,7 +4,7 @@
 //! greedy `auto` selection. A target supplies the residual vector and its shift through [`Target`];
 //! the residual figure is the RMS reflectance for a spectrum and ΔE00 for a colour.
 
-use super::{SelectionStep, with_candidates};
+use super::{MeasuredOptions, SelectionStep, with_candidates};
 use crate::fit::FitError;
 use crate::fit::least_squares::{LM, LmBudget, minimize};
 use crate::fit::model::{ModelChoice, Parameter};
@@ -192,22 +192,21 @@ fn auto(
     Ok((params, skin, rms, steps))
 }
 
-/// The fit `model` asks for, from the seed's fit `seed` over `seed_params`: the seed itself, every
-/// candidate ([`full`], from `full_starts` starts) or the selection ([`auto`] with `criterion`). Returns the free
+/// The fit `opts.model` asks for, from the seed's fit `seed` over `seed_params`: the seed itself,
+/// every candidate ([`full`], from `opts.full_starts` starts) or the selection ([`auto`] with `criterion`). Returns the free
 /// parameters, skin, residual figure and the selection rounds.
 pub(super) fn fit_model(
     target: &mut impl Target,
-    model: ModelChoice,
+    opts: &MeasuredOptions,
     seed: (SkinParams, f64),
     seed_params: &[Parameter],
     criterion: impl Fn(f64, usize, usize) -> f64,
-    full_starts: usize,
 ) -> Result<(Vec<Parameter>, SkinParams, f64, Vec<SelectionStep>), FitError> {
-    match model {
+    match opts.model {
         ModelChoice::Seed => Ok((seed_params.to_vec(), seed.0, seed.1, Vec::new())),
         ModelChoice::Full => {
             let all = with_candidates(seed_params);
-            let (skin, r) = full(target, seed.0, &all, full_starts)?;
+            let (skin, r) = full(target, seed.0, &all, opts.full_starts)?;
             Ok((all, skin, r, Vec::new()))
         }
         ModelChoice::Auto => auto(target, seed, seed_params, criterion),
