@@ -39,6 +39,11 @@ pub struct MeasuredOptions {
     pub noise: f64,
     /// Fit ρ_s under SCI (default true); false keeps the base skin's ρ_s.
     pub fit_oiliness: bool,
+    /// Starts of the `full` refinement, in [1, [`FULL_STARTS_MAX`]] (default 4): the seed fit's
+    /// point, then every candidate at mid-range, a quarter and three quarters of its range (module
+    /// `select`). Each start costs about as much as the first; fewer starts may stop in a worse
+    /// valley (measured in BENCHMARKS.md `## Fit`).
+    pub full_starts: usize,
     /// The seed fit's knobs (forward model, search, base skin).
     pub fit: FitOptions,
 }
@@ -50,8 +55,31 @@ impl Default for MeasuredOptions {
             model: ModelChoice::Seed,
             noise: 0.005,
             fit_oiliness: true,
+            full_starts: FULL_STARTS_MAX,
             fit: FitOptions::default(),
         }
+    }
+}
+
+impl MeasuredOptions {
+    /// Check the criterion's noise and the `full` starts against their ranges (the seed fit's
+    /// knobs are checked by [`FitOptions::validate`]).
+    pub fn validate(&self) -> Result<(), FitError> {
+        if !(self.noise > 0.0 && self.noise < 1.0) {
+            return Err(FitError::Option {
+                name: "noise",
+                value: self.noise,
+                range: "(0, 1)",
+            });
+        }
+        if !(1..=FULL_STARTS_MAX).contains(&self.full_starts) {
+            return Err(FitError::Option {
+                name: "full_starts",
+                value: self.full_starts as f64,
+                range: "[1, 4]",
+            });
+        }
+        Ok(())
     }
 }
 
@@ -103,13 +131,7 @@ pub fn fit_measured(
     opts: &MeasuredOptions,
 ) -> Result<MeasuredFit, FitError> {
     opts.fit.validate()?;
-    if !(opts.noise > 0.0 && opts.noise < 1.0) {
-        return Err(FitError::Option {
-            name: "noise",
-            value: opts.noise,
-            range: "(0, 1)",
-        });
-    }
+    opts.validate()?;
     let base = opts.fit.base;
     let unit_surface = match opts.geometry {
         Geometry::Sce => 0.0,
@@ -143,7 +165,7 @@ pub fn fit_measured(
     };
     let seed_rms = seed.1;
     let (params, skin, rms, steps) =
-        select::fit_model(&mut problem, opts.model, seed, &seed_params, criterion)?;
+        select::fit_model(&mut problem, opts, seed, &seed_params, criterion)?;
     let model = problem.full_model(&skin)?;
     let chosen = params.len() - seed_params.len();
     Ok(MeasuredFit {
@@ -160,6 +182,9 @@ pub fn fit_measured(
         search_evaluations: problem.search_evals,
     })
 }
+
+/// Most starts of the `full` refinement ([`MeasuredOptions::full_starts`]).
+pub const FULL_STARTS_MAX: usize = 4;
 
 /// A fitted value closer than this fraction of its range to a bound counts as on the bound.
 pub const AT_BOUND_FRACTION: f64 = 1e-3;

@@ -154,6 +154,9 @@ struct MeasuredArgs {
     /// Fit at most this many records, spread evenly over the subset.
     #[arg(long)]
     limit: Option<usize>,
+    /// Starts of the `full` refinement, [1, 4] (fewer: faster, may stop in a worse valley).
+    #[arg(long, default_value_t = multipole::fit::FULL_STARTS_MAX)]
+    full_starts: usize,
     /// Output folder.
     #[arg(long, value_name = "DIR", default_value = "out/measured")]
     out: PathBuf,
@@ -220,6 +223,7 @@ fn run_measured(args: &MeasuredArgs) -> anyhow::Result<()> {
         geometry: args.geometry,
         model: args.model,
         noise: args.noise,
+        full_starts: args.full_starts,
         fit: multipole::fit::FitOptions {
             method: args.method,
             beta_scan: 0,

@@ -54,13 +54,7 @@ pub fn fit_measured_colour(
     target: Lab,
     opts: &MeasuredOptions,
 ) -> Result<MeasuredColourFit, FitError> {
-    if !(opts.noise > 0.0 && opts.noise < 1.0) {
-        return Err(FitError::Option {
-            name: "noise",
-            value: opts.noise,
-            range: "(0, 1)",
-        });
-    }
+    opts.validate()?;
     let start = fit_colour(target, &opts.fit)?;
     let unit_surface = match opts.geometry {
         Geometry::Sce => 0.0,
@@ -76,7 +70,7 @@ pub fn fit_measured_colour(
         (de / sigma_c).powi(2) + k as f64 * n.ln() + 2.0 * ln_binomial(m, j)
     };
     let (parameters, skin, _, steps) =
-        select::fit_model(&mut problem, opts.model, seed, &seed_params, criterion)?;
+        select::fit_model(&mut problem, opts, seed, &seed_params, criterion)?;
     let lab = problem.lab(&problem.full, &skin)?;
     Ok(MeasuredColourFit {
         skin,

@@ -4,7 +4,7 @@
 //! greedy `auto` selection. A target supplies the residual vector and its shift through [`Target`];
 //! the residual figure is the RMS reflectance for a spectrum and ΔE00 for a colour.
 
-use super::{SelectionStep, with_candidates};
+use super::{MeasuredOptions, SelectionStep, with_candidates};
 use crate::fit::FitError;
 use crate::fit::least_squares::{LM, LmBudget, minimize};
 use crate::fit::model::{ModelChoice, Parameter};
@@ -107,7 +107,8 @@ fn trial(
     Ok((s, r.iter().map(|v| v * v).sum::<f64>().sqrt()))
 }
 
-/// Every candidate freed, refined from `skin` and from [`FULL_STARTS`]; the lowest residual.
+/// Every candidate freed, refined from `skin` and from the first `starts − 1` of [`FULL_STARTS`];
+/// the lowest residual.
 ///
 /// Several starts: every candidate at the base skin's value (where the seed fit left the target),
 /// at mid-range, and at a quarter and three quarters of its range. With seven parameters that
@@ -117,9 +118,10 @@ fn full(
     target: &mut impl Target,
     skin: SkinParams,
     params: &[Parameter],
+    starts: usize,
 ) -> Result<(SkinParams, f64), FitError> {
     let mut best = refine(target, skin, params)?;
-    for t in FULL_STARTS {
+    for &t in FULL_STARTS.iter().take(starts.saturating_sub(1)) {
         let start = Parameter::CANDIDATES.iter().try_fold(best.0, |s, p| {
             let [lo, hi] = p.range();
             p.set(s, lo + t * (hi - lo))
@@ -190,21 +192,21 @@ fn auto(
     Ok((params, skin, rms, steps))
 }
 
-/// The fit `model` asks for, from the seed's fit `seed` over `seed_params`: the seed itself, every
-/// candidate ([`full`]) or the selection ([`auto`] with `criterion`). Returns the free
+/// The fit `opts.model` asks for, from the seed's fit `seed` over `seed_params`: the seed itself,
+/// every candidate ([`full`], from `opts.full_starts` starts) or the selection ([`auto`] with `criterion`). Returns the free
 /// parameters, skin, residual figure and the selection rounds.
 pub(super) fn fit_model(
     target: &mut impl Target,
-    model: ModelChoice,
+    opts: &MeasuredOptions,
     seed: (SkinParams, f64),
     seed_params: &[Parameter],
     criterion: impl Fn(f64, usize, usize) -> f64,
 ) -> Result<(Vec<Parameter>, SkinParams, f64, Vec<SelectionStep>), FitError> {
-    match model {
+    match opts.model {
         ModelChoice::Seed => Ok((seed_params.to_vec(), seed.0, seed.1, Vec::new())),
         ModelChoice::Full => {
             let all = with_candidates(seed_params);
-            let (skin, r) = full(target, seed.0, &all)?;
+            let (skin, r) = full(target, seed.0, &all, opts.full_starts)?;
             Ok((all, skin, r, Vec::new()))
         }
         ModelChoice::Auto => auto(target, seed, seed_params, criterion),

@@ -141,6 +141,23 @@ fn bad_noise_is_rejected() {
     let m = MeasuredSpectrum::new(lambdas(), vec![0.3; 31], None).unwrap();
     let e = fit_measured(&m, &options(ModelChoice::Auto, 0.0)).unwrap_err();
     assert_eq!(e.to_string(), "fit option noise = 0 outside (0, 1)");
+    for starts in [0, FULL_STARTS_MAX + 1] {
+        let opts = MeasuredOptions {
+            full_starts: starts,
+            ..options(ModelChoice::Full, 0.003)
+        };
+        let e = fit_measured(&m, &opts).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                FitError::Option {
+                    name: "full_starts",
+                    ..
+                }
+            ),
+            "{e}"
+        );
+    }
 }
 
 /// `full` on a seed-model spectrum: the extra starts only ever replace the first descent by a
@@ -153,6 +170,17 @@ fn full_is_no_worse_than_seed_and_bounds_are_flagged() {
     let mut fit = fit_measured(&m, &options(ModelChoice::Full, 0.003)).unwrap();
     assert_eq!(fit.parameters.len(), 4 + Parameter::CANDIDATES.len());
     assert!(fit.rms <= fit.seed_rms, "{} > {}", fit.rms, fit.seed_rms);
+    // One start is the first of the four: the same descent, so never better than the best of four.
+    let one = fit_measured(
+        &m,
+        &MeasuredOptions {
+            full_starts: 1,
+            ..options(ModelChoice::Full, 0.003)
+        },
+    )
+    .unwrap();
+    assert!(fit.rms <= one.rms, "{} > {}", fit.rms, one.rms);
+    assert!(one.rms <= one.seed_rms, "{} > {}", one.rms, one.seed_rms);
     let bilirubin = Parameter::Extended(Extension::Bilirubin);
     let [lo, hi] = bilirubin.range();
     fit.skin = Parameter::Oiliness.set(fit.skin, 0.0).unwrap();
