@@ -24,6 +24,7 @@ use super::forward::Forward;
 use super::geometry::{Geometry, unit_surface_reflectance};
 use super::model::{ModelChoice, Parameter};
 use super::{FitError, FitOptions, MeasuredSpectrum, SpectrumFit, fit_spectrum};
+use super::least_squares::{LM, LmBudget};
 use select::ln_binomial;
 use skin_optics::{SkinParams, Wavelength};
 
@@ -239,6 +240,8 @@ struct Problem<'a> {
     weight_sum: f64,
     full_evals: usize,
     search_evals: usize,
+    /// The refinement's Levenberg–Marquardt budget (the reference scheme in a test).
+    budget: LmBudget,
 }
 
 impl<'a> Problem<'a> {
@@ -263,6 +266,7 @@ impl<'a> Problem<'a> {
             weight_sum: measured.weights().iter().sum(),
             full_evals: 0,
             search_evals: 0,
+            budget: LM,
         })
     }
 
@@ -329,6 +333,10 @@ impl select::Target for Problem<'_> {
 
     fn has_search(&self) -> bool {
         self.search.is_some()
+    }
+
+    fn budget(&self) -> LmBudget {
+        self.budget
     }
 }
 

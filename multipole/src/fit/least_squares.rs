@@ -4,6 +4,14 @@
 //! damped normal equations (JᵀJ + λ diag(JᵀJ)) δ = −Jᵀr (Marquardt 1963) and projects onto the box;
 //! a coordinate at a bound whose step points outward is held there for that step (a simple active
 //! set), so parameters whose best value is "off" (a blood fraction of 0) rest on their bound.
+//!
+//! Between finite-difference Jacobians (k residual evaluations each) the Jacobian is carried by
+//! Broyden's rank-1 update J ← J + (Δr − J δ) δᵀ / δᵀδ after each accepted step (Madsen, Nielsen
+//! & Tingleff 2004, *Methods for non-linear least squares problems*, §3.4): an iteration then
+//! costs one evaluation instead of k + 1. A fresh finite-difference Jacobian is taken every
+//! [`LmBudget::broyden_refresh`] accepted steps, after any rejected step on an updated Jacobian,
+//! and before stopping, so the stopping test is always made with a true Jacobian and the descent
+//! ends where the reference scheme's does (test `broyden_lands_on_the_reference_optimum`).
 //! k ≤ 12, so the k × k system is solved by Gaussian elimination with partial pivoting here rather
 //! than through a linear-algebra crate.
 
@@ -16,6 +24,9 @@ pub(crate) struct LmBudget {
     pub f_rtol: f64,
     /// Forward-difference step in unit coordinates.
     pub h: f64,
+    /// Accepted steps between finite-difference Jacobians; in between, Broyden rank-1 updates
+    /// stand in for them (0 = a finite-difference Jacobian every iteration, the reference scheme).
+    pub broyden_refresh: usize,
 }
 
 /// The default budget: 1e-4 of each range per difference step is well above the forward model's
@@ -24,6 +35,14 @@ pub(crate) const LM: LmBudget = LmBudget {
     max_iterations: 60,
     f_rtol: 1e-7,
     h: 1e-4,
+    broyden_refresh: 4,
+};
+
+/// The reference scheme: a forward-difference Jacobian at every iteration.
+#[cfg(test)]
+pub(crate) const LM_REFERENCE: LmBudget = LmBudget {
+    broyden_refresh: 0,
+    ..LM
 };
 
 /// Result of [`minimize`]: the point, its cost Σ r², and the residual evaluations spent.
@@ -32,14 +51,21 @@ pub(crate) struct LmResult {
     pub u: Vec<f64>,
     pub cost: f64,
     pub evals: usize,
+    /// The last Jacobian (columns), for a warm start of the next descent from `u` (empty when none
+    /// was formed).
+    pub jac: Vec<Vec<f64>>,
 }
 
 /// Minimise Σ r(u)² from `u0` in [0, 1]^k. `residuals` returns `None` where the model fails,
-/// which counts as an infinitely bad point.
+/// which counts as an infinitely bad point. `warm`, a Jacobian at `u0` from an earlier descent
+/// (of residuals that differ by a constant, as a re-shifted model's do), stands in for the first
+/// finite-difference one when Broyden updates are on; it counts as an updated one, so the stopping
+/// test is still made on a true Jacobian.
 pub(crate) fn minimize(
     residuals: &mut impl FnMut(&[f64]) -> Option<Vec<f64>>,
     u0: &[f64],
     budget: LmBudget,
+    warm: Vec<Vec<f64>>,
 ) -> LmResult {
     let k = u0.len();
     let mut u: Vec<f64> = u0.iter().map(|v| v.clamp(0.0, 1.0)).collect();
@@ -49,26 +75,43 @@ pub(crate) fn minimize(
             u,
             cost: f64::INFINITY,
             evals,
+            jac: Vec::new(),
         };
     };
     let mut cost = sum_sq(&r);
     let mut lambda = 1e-3;
+    let use_warm = budget.broyden_refresh > 0 && warm.len() == k && warm.iter().all(|c| c.len() == r.len());
+    let mut jac: Vec<Vec<f64>> = if use_warm { warm } else { Vec::new() };
+    // Accepted steps since the last finite-difference Jacobian (None: take one now).
+    let mut since_fd: Option<usize> = use_warm.then_some(0);
+    // Rejected steps in a row on an updated Jacobian.
+    let mut rejections = 0;
     for _ in 0..budget.max_iterations {
-        // Jacobian columns by forward differences (backward at the upper bound).
-        let mut jac: Vec<Vec<f64>> = Vec::with_capacity(k);
-        for j in 0..k {
-            let step = if u[j] + budget.h <= 1.0 {
-                budget.h
-            } else {
-                -budget.h
-            };
-            let mut up = u.clone();
-            up[j] += step;
-            evals += 1;
-            let Some(rj) = residuals(&up) else {
-                return LmResult { u, cost, evals };
-            };
-            jac.push(rj.iter().zip(&r).map(|(a, b)| (a - b) / step).collect());
+        let fresh = since_fd.is_none();
+        if fresh {
+            // Jacobian columns by forward differences (backward at the upper bound).
+            jac.clear();
+            for j in 0..k {
+                let step = if u[j] + budget.h <= 1.0 {
+                    budget.h
+                } else {
+                    -budget.h
+                };
+                let mut up = u.clone();
+                up[j] += step;
+                evals += 1;
+                let Some(rj) = residuals(&up) else {
+                    return LmResult {
+                        u,
+                        cost,
+                        evals,
+                        jac: Vec::new(),
+                    };
+                };
+                jac.push(rj.iter().zip(&r).map(|(a, b)| (a - b) / step).collect());
+            }
+            since_fd = Some(0);
+            rejections = 0;
         }
         let jtj =
             |a: usize, b: usize| -> f64 { jac[a].iter().zip(&jac[b]).map(|(x, y)| x * y).sum() };
@@ -89,19 +132,66 @@ pub(crate) fn minimize(
                 Some(rt) if sum_sq(&rt) < cost => {
                     let new_cost = sum_sq(&rt);
                     let gain = (cost - new_cost) / cost.max(f64::MIN_POSITIVE);
+                    if budget.broyden_refresh > 0 {
+                        broyden_update(&mut jac, &u, &trial, &r, &rt);
+                    }
                     (u, r, cost) = (trial, rt, new_cost);
                     lambda = (lambda / 3.0).max(1e-9);
+                    rejections = 0;
                     improved = gain > budget.f_rtol;
+                    let n = since_fd.map_or(0, |n| n + 1);
+                    since_fd = (budget.broyden_refresh > 0 && n < budget.broyden_refresh)
+                        .then_some(n);
+                    break;
+                }
+                rejected if !fresh => {
+                    // An updated Jacobian that fails to descend: learn from the failed step and
+                    // damp more; a second failure in a row refreshes it by finite differences.
+                    if let Some(rt) = rejected {
+                        broyden_update(&mut jac, &u, &trial, &r, &rt);
+                    }
+                    lambda *= 4.0;
+                    rejections += 1;
+                    if rejections >= 2 {
+                        since_fd = None;
+                    }
+                    improved = true;
                     break;
                 }
                 _ => lambda *= 4.0,
             }
         }
         if !improved {
-            break;
+            if fresh || budget.broyden_refresh == 0 {
+                break;
+            }
+            // Too small a gain on an updated Jacobian: check it with a true one before stopping.
+            since_fd = None;
         }
     }
-    LmResult { u, cost, evals }
+    LmResult {
+        u,
+        cost,
+        evals,
+        jac,
+    }
+}
+
+/// Broyden's rank-1 update of the Jacobian columns `jac` for the step `u → v` that moved the
+/// residuals `r → rv`: J ← J + (Δr − J δ) δᵀ / δᵀδ, δ = v − u (held coordinates have δ = 0).
+fn broyden_update(jac: &mut [Vec<f64>], u: &[f64], v: &[f64], r: &[f64], rv: &[f64]) {
+    let delta: Vec<f64> = v.iter().zip(u).map(|(a, b)| a - b).collect();
+    let dd = sum_sq(&delta);
+    if dd <= 0.0 || !dd.is_finite() {
+        return;
+    }
+    for (i, (a, b)) in rv.iter().zip(r).enumerate() {
+        let predicted: f64 = jac.iter().zip(&delta).map(|(col, d)| col[i] * d).sum();
+        let c = (a - b - predicted) / dd;
+        for (col, d) in jac.iter_mut().zip(&delta) {
+            col[i] += c * d;
+        }
+    }
 }
 
 fn sum_sq(r: &[f64]) -> f64 {
@@ -191,14 +281,14 @@ mod tests {
     fn solves_linear_problems_and_respects_the_box() {
         // r = (u0 − 0.3, 2(u1 − 0.6), u0 + u1 − 0.9): minimum at (0.3, 0.6), cost 0.
         let mut f = |u: &[f64]| Some(vec![u[0] - 0.3, 2.0 * (u[1] - 0.6), u[0] + u[1] - 0.9]);
-        let m = minimize(&mut f, &[0.9, 0.1], LM);
+        let m = minimize(&mut f, &[0.9, 0.1], LM, Vec::new());
         assert!(
             (m.u[0] - 0.3).abs() < 1e-6 && (m.u[1] - 0.6).abs() < 1e-6,
             "{m:?}"
         );
         // Unconstrained minimum at u0 = −0.5: held at 0, u1 free at 0.7.
         let mut g = |u: &[f64]| Some(vec![u[0] + 0.5, u[1] - 0.7]);
-        let m = minimize(&mut g, &[0.5, 0.5], LM);
+        let m = minimize(&mut g, &[0.5, 0.5], LM, Vec::new());
         assert_eq!(m.u[0], 0.0);
         assert!((m.u[1] - 0.7).abs() < 1e-6, "{m:?}");
     }
@@ -218,6 +308,7 @@ mod tests {
                 max_iterations: 500,
                 ..LM
             },
+            Vec::new(),
         );
         assert!(
             (m.u[0] - 0.75).abs() < 1e-4 && (m.u[1] - 0.75).abs() < 1e-4,

@@ -28,6 +28,10 @@ pub(super) trait Target {
     fn reshift(&mut self, skin: &SkinParams) -> Result<f64, FitError>;
     /// Whether a cheaper model stands in for the full one (space mapping needed).
     fn has_search(&self) -> bool;
+    /// The Levenberg–Marquardt budget of a refinement (default [`LM`]).
+    fn budget(&self) -> LmBudget {
+        LM
+    }
 }
 
 /// `skin` with `params` set from unit coordinates `u` (each mapped onto its range), or `None` when
@@ -39,13 +43,15 @@ fn skin_at(skin: SkinParams, params: &[Parameter], u: &[f64]) -> Option<SkinPara
     })
 }
 
-/// LM over `params` from `skin` on the shifted cheap model; returns the refined skin.
+/// LM over `params` from `skin` on the shifted cheap model, warm-started from `warm` (a Jacobian
+/// at `skin`, or empty); returns the refined skin and the last Jacobian.
 fn run(
     target: &mut impl Target,
     skin: SkinParams,
     params: &[Parameter],
     budget: LmBudget,
-) -> Result<SkinParams, FitError> {
+    warm: Vec<Vec<f64>>,
+) -> Result<(SkinParams, Vec<Vec<f64>>), FitError> {
     let u0: Vec<f64> = params
         .iter()
         .map(|p| {
@@ -57,10 +63,11 @@ fn run(
         let s = skin_at(skin, params, u)?;
         target.shifted_residuals(&s).ok()
     };
-    let result = minimize(&mut residuals, &u0, budget);
-    skin_at(skin, params, &result.u).ok_or_else(|| {
+    let result = minimize(&mut residuals, &u0, budget, warm);
+    let refined = skin_at(skin, params, &result.u).ok_or_else(|| {
         FitError::NotEnoughData("refined parameters left their valid range".to_string())
-    })
+    })?;
+    Ok((refined, result.jac))
 }
 
 /// Refine with space mapping until the full residual stops falling; returns the best skin and its
@@ -71,12 +78,17 @@ pub(super) fn refine(
     params: &[Parameter],
 ) -> Result<(SkinParams, f64), FitError> {
     let mut best = (skin, target.reshift(&skin)?);
+    // The re-shift adds a constant to the residuals, so a descent's last Jacobian serves the next
+    // round's start (the Broyden scheme of module `least_squares` only).
+    let mut warm = Vec::new();
     for _ in 0..MAPPING_ROUNDS {
-        let next = run(target, best.0, params, LM)?;
+        let budget = target.budget();
+        let (next, jac) = run(target, best.0, params, budget, std::mem::take(&mut warm))?;
         let r = target.reshift(&next)?;
         let gain = best.1 - r;
         if r < best.1 {
             best = (next, r);
+            warm = jac;
         } else {
             target.reshift(&best.0)?;
         }
@@ -94,15 +106,11 @@ fn trial(
     skin: SkinParams,
     params: &[Parameter],
 ) -> Result<(SkinParams, f64), FitError> {
-    let s = run(
-        target,
-        skin,
-        params,
-        LmBudget {
-            max_iterations: 15,
-            ..LM
-        },
-    )?;
+    let budget = LmBudget {
+        max_iterations: 15,
+        ..target.budget()
+    };
+    let (s, _) = run(target, skin, params, budget, Vec::new())?;
     let r = target.shifted_residuals(&s)?;
     Ok((s, r.iter().map(|v| v * v).sum::<f64>().sqrt()))
 }

@@ -202,3 +202,50 @@ fn full_is_no_worse_than_seed_and_bounds_are_flagged() {
             .all(|(p, _)| *p != Parameter::Oiliness)
     );
 }
+
+/// The refinement with Broyden updates between finite-difference Jacobians lands on the optimum
+/// of the reference scheme (a finite-difference Jacobian every iteration): all eleven `full`
+/// parameters freed on a spectrum with epidermal blood and noise σ = 0.002, from the same start.
+/// Both stop on the same relative-gain rule, checked on a true Jacobian, so their full-model RMS
+/// agree within 0.5 % and their spectra within 0.1 σ at every wavelength (measured: see the
+/// message), while the accelerated descent spends fewer than 70 % of the evaluations.
+#[test]
+fn broyden_lands_on_the_reference_optimum() {
+    let sigma = 0.002;
+    let x = Physiology::SEED
+        .with(Extension::EpidermisBlood, 0.015)
+        .unwrap();
+    let skin = SkinParams::new(0.05, 0.7, 0.02, 0.5)
+        .unwrap()
+        .with_physiology(x);
+    let m = synthetic_sci(&skin, sigma, 7);
+    let opts = options(ModelChoice::Full, sigma);
+    let unit = unit_surface_reflectance(opts.fit.base.eta()).unwrap();
+    let params = with_candidates(&seed_parameters(&opts));
+    let start = SkinParams::new(0.03, 0.5, 0.01, 0.3).unwrap();
+    let mut fast = Problem::new(&m, &opts, unit).unwrap();
+    let a = select::refine(&mut fast, start, &params).unwrap();
+    let mut reference = Problem::new(&m, &opts, unit).unwrap();
+    reference.budget = crate::fit::least_squares::LM_REFERENCE;
+    let b = select::refine(&mut reference, start, &params).unwrap();
+    let (ma, mb) = (
+        reference.full_model(&a.0).unwrap(),
+        reference.full_model(&b.0).unwrap(),
+    );
+    let worst = ma
+        .iter()
+        .zip(&mb)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max);
+    let msg = format!(
+        "rms {} vs {}, worst spectral difference {worst:.2e}, search evaluations {} vs {}",
+        a.1, b.1, fast.search_evals, reference.search_evals
+    );
+    eprintln!("{msg}");
+    assert!((a.1 / b.1 - 1.0).abs() < 5e-3, "{msg}");
+    assert!(worst < 0.1 * sigma, "{msg}");
+    assert!(
+        (fast.search_evals as f64) < 0.7 * reference.search_evals as f64,
+        "{msg}"
+    );
+}
