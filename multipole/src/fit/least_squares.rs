@@ -57,11 +57,10 @@ pub(crate) struct LmResult {
 }
 
 /// Minimise Σ r(u)² from `u0` in [0, 1]^k. `residuals` returns `None` where the model fails,
-/// which counts as an infinitely bad point. `warm`, Jacobian columns at `u0` for the leading
-/// coordinates from an earlier descent (of residuals that differ by a constant, as a re-shifted
-/// model's do), stands in for the first finite-difference Jacobian when Broyden updates are on
-/// (the missing columns are differenced); it counts as an updated one, so the stopping test is
-/// still made on a true Jacobian.
+/// which counts as an infinitely bad point. `warm`, a Jacobian at `u0` from an earlier descent
+/// (of residuals that differ by a constant, as a re-shifted model's do), stands in for the first
+/// finite-difference one when Broyden updates are on; it counts as an updated one, so the stopping
+/// test is still made on a true Jacobian.
 pub(crate) fn minimize(
     residuals: &mut impl FnMut(&[f64]) -> Option<Vec<f64>>,
     u0: &[f64],
@@ -81,27 +80,8 @@ pub(crate) fn minimize(
     };
     let mut cost = sum_sq(&r);
     let mut lambda = 1e-3;
-    let use_warm = budget.broyden_refresh > 0
-        && !warm.is_empty()
-        && warm.len() <= k
-        && warm.iter().all(|c| c.len() == r.len());
-    let mut jac: Vec<Vec<f64>> = Vec::with_capacity(k);
-    if use_warm {
-        jac = warm;
-        // Columns the warm Jacobian lacks (parameters freed after it was formed), by differences.
-        for j in jac.len()..k {
-            evals += 1;
-            let Some(col) = difference_column(residuals, &u, &r, j, budget.h) else {
-                return LmResult {
-                    u,
-                    cost,
-                    evals,
-                    jac: Vec::new(),
-                };
-            };
-            jac.push(col);
-        }
-    }
+    let use_warm = budget.broyden_refresh > 0 && warm.len() == k && warm.iter().all(|c| c.len() == r.len());
+    let mut jac: Vec<Vec<f64>> = if use_warm { warm } else { Vec::new() };
     // Accepted steps since the last finite-difference Jacobian (None: take one now).
     let mut since_fd: Option<usize> = use_warm.then_some(0);
     // Rejected steps in a row on an updated Jacobian.
@@ -112,8 +92,15 @@ pub(crate) fn minimize(
             // Jacobian columns by forward differences (backward at the upper bound).
             jac.clear();
             for j in 0..k {
+                let step = if u[j] + budget.h <= 1.0 {
+                    budget.h
+                } else {
+                    -budget.h
+                };
+                let mut up = u.clone();
+                up[j] += step;
                 evals += 1;
-                let Some(col) = difference_column(residuals, &u, &r, j, budget.h) else {
+                let Some(rj) = residuals(&up) else {
                     return LmResult {
                         u,
                         cost,
@@ -121,7 +108,7 @@ pub(crate) fn minimize(
                         jac: Vec::new(),
                     };
                 };
-                jac.push(col);
+                jac.push(rj.iter().zip(&r).map(|(a, b)| (a - b) / step).collect());
             }
             since_fd = Some(0);
             rejections = 0;
@@ -153,8 +140,8 @@ pub(crate) fn minimize(
                     rejections = 0;
                     improved = gain > budget.f_rtol;
                     let n = since_fd.map_or(0, |n| n + 1);
-                    since_fd =
-                        (budget.broyden_refresh > 0 && n < budget.broyden_refresh).then_some(n);
+                    since_fd = (budget.broyden_refresh > 0 && n < budget.broyden_refresh)
+                        .then_some(n);
                     break;
                 }
                 rejected if !fresh => {
@@ -188,22 +175,6 @@ pub(crate) fn minimize(
         evals,
         jac,
     }
-}
-
-/// Jacobian column `j` at `u` (residuals `r`) by a forward difference of `h` (backward at the
-/// upper bound); `None` where the model fails.
-fn difference_column(
-    residuals: &mut impl FnMut(&[f64]) -> Option<Vec<f64>>,
-    u: &[f64],
-    r: &[f64],
-    j: usize,
-    h: f64,
-) -> Option<Vec<f64>> {
-    let step = if u[j] + h <= 1.0 { h } else { -h };
-    let mut up = u.to_vec();
-    up[j] += step;
-    let rj = residuals(&up)?;
-    Some(rj.iter().zip(r).map(|(a, b)| (a - b) / step).collect())
 }
 
 /// Broyden's rank-1 update of the Jacobian columns `jac` for the step `u → v` that moved the

@@ -77,16 +77,6 @@ pub(super) fn refine(
     skin: SkinParams,
     params: &[Parameter],
 ) -> Result<(SkinParams, f64), FitError> {
-    refine_with_jacobian(target, skin, params).map(|(s, r, _)| (s, r))
-}
-
-/// [`refine`], also returning the last Jacobian of the descent that ended at the returned skin
-/// (empty when none did).
-fn refine_with_jacobian(
-    target: &mut impl Target,
-    skin: SkinParams,
-    params: &[Parameter],
-) -> Result<(SkinParams, f64, Vec<Vec<f64>>), FitError> {
     let mut best = (skin, target.reshift(&skin)?);
     // The re-shift adds a constant to the residuals, so a descent's last Jacobian serves the next
     // round's start (the Broyden scheme of module `least_squares` only).
@@ -106,25 +96,21 @@ fn refine_with_jacobian(
             break;
         }
     }
-    Ok((best.0, best.1, warm))
+    Ok(best)
 }
 
 /// A quick trial of `params` from `skin` on the current shift (no re-shift): the selection's
 /// ranking of candidates. Returns the trial skin and its shifted-model residual figure.
-///
-/// `warm` holds Jacobian columns at `skin` for the leading parameters (those of the last refinement,
-/// which every trial of a round shares); the descent differences only the rest.
 fn trial(
     target: &mut impl Target,
     skin: SkinParams,
     params: &[Parameter],
-    warm: Vec<Vec<f64>>,
 ) -> Result<(SkinParams, f64), FitError> {
     let budget = LmBudget {
         max_iterations: 15,
         ..target.budget()
     };
-    let (s, _) = run(target, skin, params, budget, warm)?;
+    let (s, _) = run(target, skin, params, budget, Vec::new())?;
     let r = target.shifted_residuals(&s)?;
     Ok((s, r.iter().map(|v| v * v).sum::<f64>().sqrt()))
 }
@@ -170,8 +156,6 @@ fn auto(
     let mut params = seed_params.to_vec();
     let mut steps = Vec::new();
     let mut chosen = 0;
-    // The Jacobian at `skin` over `params` from the refinement that found it (empty at first).
-    let mut jac: Vec<Vec<f64>> = Vec::new();
     loop {
         let remaining: Vec<Parameter> = Parameter::CANDIDATES
             .into_iter()
@@ -181,7 +165,7 @@ fn auto(
         for p in remaining {
             let mut trial_params = params.clone();
             trial_params.push(p);
-            let (s, r) = trial(target, skin, &trial_params, jac.clone())?;
+            let (s, r) = trial(target, skin, &trial_params)?;
             if best.as_ref().is_none_or(|b| r < b.2) {
                 best = Some((p, s, r));
             }
@@ -194,9 +178,9 @@ fn auto(
         // in a long valley).
         let [lo, hi] = p.range();
         let mid = p.set(s, 0.5 * (lo + hi))?;
-        let (s, r, next_jac) = {
-            let a = refine_with_jacobian(target, s, &with)?;
-            let b = refine_with_jacobian(target, mid, &with)?;
+        let (s, r) = {
+            let a = refine(target, s, &with)?;
+            let b = refine(target, mid, &with)?;
             if b.1 < a.1 { b } else { a }
         };
         let delta = criterion(r, with.len(), chosen + 1) - criterion(rms, params.len(), chosen);
@@ -211,7 +195,7 @@ fn auto(
         if !accepted {
             break;
         }
-        (params, skin, rms, chosen, jac) = (with, s, r, chosen + 1, next_jac);
+        (params, skin, rms, chosen) = (with, s, r, chosen + 1);
     }
     Ok((params, skin, rms, steps))
 }
