@@ -22,9 +22,9 @@
 
 use super::forward::Forward;
 use super::geometry::{Geometry, unit_surface_reflectance};
+use super::least_squares::{LM, LmBudget};
 use super::model::{ModelChoice, Parameter};
 use super::{FitError, FitOptions, MeasuredSpectrum, SpectrumFit, fit_spectrum};
-use super::least_squares::{LM, LmBudget};
 use select::ln_binomial;
 use skin_optics::{SkinParams, Wavelength};
 

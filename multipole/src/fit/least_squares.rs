@@ -80,7 +80,8 @@ pub(crate) fn minimize(
     };
     let mut cost = sum_sq(&r);
     let mut lambda = 1e-3;
-    let use_warm = budget.broyden_refresh > 0 && warm.len() == k && warm.iter().all(|c| c.len() == r.len());
+    let use_warm =
+        budget.broyden_refresh > 0 && warm.len() == k && warm.iter().all(|c| c.len() == r.len());
     let mut jac: Vec<Vec<f64>> = if use_warm { warm } else { Vec::new() };
     // Accepted steps since the last finite-difference Jacobian (None: take one now).
     let mut since_fd: Option<usize> = use_warm.then_some(0);
@@ -140,8 +141,8 @@ pub(crate) fn minimize(
                     rejections = 0;
                     improved = gain > budget.f_rtol;
                     let n = since_fd.map_or(0, |n| n + 1);
-                    since_fd = (budget.broyden_refresh > 0 && n < budget.broyden_refresh)
-                        .then_some(n);
+                    since_fd =
+                        (budget.broyden_refresh > 0 && n < budget.broyden_refresh).then_some(n);
                     break;
                 }
                 rejected if !fresh => {
