@@ -6,11 +6,11 @@
 //! set), so parameters whose best value is "off" (a blood fraction of 0) rest on their bound.
 //!
 //! Between finite-difference Jacobians (k residual evaluations each) the Jacobian is carried by
-//! Broyden's rank-1 update J ← J + (Δr − J δ) δᵀ / δᵀδ after each accepted step (Madsen, Nielsen
-//! & Tingleff 2004, *Methods for non-linear least squares problems*, §3.4): an iteration then
-//! costs one evaluation instead of k + 1. A fresh finite-difference Jacobian is taken every
-//! [`LmBudget::broyden_refresh`] accepted steps, after any rejected step on an updated Jacobian,
-//! and before stopping, so the stopping test is always made with a true Jacobian and the descent
+//! Broyden's rank-1 update J ← J + (Δr − J δ) δᵀ / δᵀδ after each step, accepted or rejected
+//! (Madsen, Nielsen & Tingleff 2004, *Methods for non-linear least squares problems*, §3.4): an
+//! iteration then costs one evaluation instead of k + 1. A fresh finite-difference Jacobian is
+//! taken every [`LmBudget::broyden_refresh`] accepted steps, after two rejected steps in a row on
+//! an updated Jacobian, and before stopping, so the stopping test is always made with a true Jacobian and the descent
 //! ends where the reference scheme's does (test `broyden_lands_on_the_reference_optimum`).
 //! k ≤ 12, so the k × k system is solved by Gaussian elimination with partial pivoting here rather
 //! than through a linear-algebra crate.
