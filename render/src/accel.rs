@@ -71,11 +71,7 @@ impl Accel {
                 v2: t[2].into(),
             })
             .collect();
-        let bvh = build_cwbvh_from_tris(
-            &tris,
-            BVH_BUILD,
-            &mut Duration::default(),
-        );
+        let bvh = build_cwbvh_from_tris(&tris, BVH_BUILD, &mut Duration::default());
         let leaf_tris = bvh
             .primitive_indices
             .iter()

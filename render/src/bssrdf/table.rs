@@ -365,7 +365,11 @@ mod tests {
                 let r = r_mm.max(0.5 * R_MIN_MM);
                 let dens = |row: &Row| sampling::density(&radii[..row.len], &row.p[..row.len], r);
                 let want = (wa * dens(a) + wb * dens(b)) / (2.0 * PI * r);
-                assert_eq!(t.eval(nm, r_mm).to_bits(), want.to_bits(), "{nm} nm, {r_mm} mm");
+                assert_eq!(
+                    t.eval(nm, r_mm).to_bits(),
+                    want.to_bits(),
+                    "{nm} nm, {r_mm} mm"
+                );
             }
         }
     }
