@@ -275,21 +275,30 @@ impl ProfileTable {
             .fold(0.0, f32::max)
     }
 
-    /// Density p(r) = 2πr R(r) of one row at `r_mm`, mm⁻¹ (0 beyond the row).
-    fn row_p(&self, row: &Row, r_mm: f32) -> f32 {
-        sampling::density(&self.radii_mm[..row.len], &row.p[..row.len], r_mm)
-    }
-
     /// R(r) at `nm` and distance `r_mm`, mm⁻² (integrates to [`ProfileTable::total`] over the plane).
     #[must_use]
     pub fn eval(&self, nm: f32, r_mm: f32) -> f32 {
         let r = r_mm.max(0.5 * R_MIN_MM);
-        let p: f32 = self
-            .mix(nm)
-            .iter()
-            .map(|(row, w)| w * self.row_p(row, r))
-            .sum();
-        p / (2.0 * PI * r)
+        let [(a, wa), (b, wb)] = self.mix(nm);
+        // Both rows share the radius grid, so one search serves both (the profile lookups are a
+        // large share of a skin sample's time).
+        let i = self.radii_mm.partition_point(|&x| x < r);
+        (wa * self.row_p_at(a, i, r) + wb * self.row_p_at(b, i, r)) / (2.0 * PI * r)
+    }
+
+    /// Density p(r) = 2πr R(r) of one row at `r_mm`, mm⁻¹ (0 beyond the row), as
+    /// `multipole::sampling::density` on the row, with the grid index `i` (the first grid
+    /// radius ≥ `r_mm`) given.
+    fn row_p_at(&self, row: &Row, i: usize, r_mm: f32) -> f32 {
+        let radii = &self.radii_mm;
+        if r_mm.is_nan() || r_mm < 0.0 || r_mm > radii[row.len - 1] {
+            return 0.0;
+        }
+        if i == 0 {
+            return row.p[0] * r_mm / radii[0];
+        }
+        let t = (r_mm - radii[i - 1]) / (radii[i] - radii[i - 1]);
+        row.p[i - 1] + t * (row.p[i] - row.p[i - 1])
     }
 
     /// Density of [`ProfileTable::sample_radius`] at `nm` per unit *area* of the plane at distance
@@ -338,6 +347,31 @@ mod tests {
             &TableOptions::default(),
         )
         .unwrap()
+    }
+
+    /// One grid search for both mixed rows gives R(r) bit for bit as the piecewise-linear density
+    /// of each row on its own (`multipole::sampling::density`), at radii on, between and beyond
+    /// the grid nodes and below the first one.
+    #[test]
+    fn eval_is_the_mix_of_each_rows_density() {
+        let t = light_table();
+        let radii = t.radii_mm().to_vec();
+        let mut rs: Vec<f32> = radii.clone();
+        rs.extend(radii.windows(2).map(|w| 0.3 * w[0] + 0.7 * w[1]));
+        rs.extend([0.0, 0.25 * R_MIN_MM, 1.5 * radii[radii.len() - 1], 1e3]);
+        for nm in [380.0f32, 455.0, 560.0, 633.3, 780.0] {
+            let [(a, wa), (b, wb)] = t.mix(nm);
+            for &r_mm in &rs {
+                let r = r_mm.max(0.5 * R_MIN_MM);
+                let dens = |row: &Row| sampling::density(&radii[..row.len], &row.p[..row.len], r);
+                let want = (wa * dens(a) + wb * dens(b)) / (2.0 * PI * r);
+                assert_eq!(
+                    t.eval(nm, r_mm).to_bits(),
+                    want.to_bits(),
+                    "{nm} nm, {r_mm} mm"
+                );
+            }
+        }
     }
 
     /// The table integrates to the model's R_tot at every tabulation wavelength and in between.
