@@ -95,7 +95,10 @@ fn parse_case_spp(s: &str) -> Result<(String, u32), String> {
         .rsplit_once('=')
         .ok_or_else(|| format!("`{s}`: expected TEXT=N"))?;
     let n = parse_whole(n, 1, 65_536, "[1, 65536]")?;
-    Ok((text.to_string(), u32::try_from(n).map_err(|e| e.to_string())?))
+    Ok((
+        text.to_string(),
+        u32::try_from(n).map_err(|e| e.to_string())?,
+    ))
 }
 
 fn parse_reference_photons(s: &str) -> Result<u64, String> {

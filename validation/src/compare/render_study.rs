@@ -286,7 +286,12 @@ fn read_cached(f: &Path, w: usize, h: usize, spp: u32) -> anyhow::Result<(Film, 
             .split_whitespace()
             .map(str::parse)
             .collect::<Result<_, _>>()?;
-        anyhow::ensure!(v.len() == 4, "{}: a line of {} values", f.display(), v.len());
+        anyhow::ensure!(
+            v.len() == 4,
+            "{}: a line of {} values",
+            f.display(),
+            v.len()
+        );
         means.push([v[0], v[1], v[2]]);
         var.push(v[3]);
     }
@@ -442,14 +447,7 @@ pub fn run_render(study: RenderStudy, run: &StudyRun, out: &Path) -> anyhow::Res
         }
         eprintln!("[{}/{}] {label}", k + 1, cases.len());
         let bssrdf = load(&c.toml, false)?;
-        let (test, t_b) = timed(
-            &bssrdf,
-            c.width,
-            c.height,
-            study.bssrdf_spp,
-            1,
-            run.threads,
-        )?;
+        let (test, t_b) = timed(&bssrdf, c.width, c.height, study.bssrdf_spp, 1, run.threads)?;
         let ref_spp = run.reference_spp(&label).unwrap_or(if c.builtin {
             study.builtin_reference_spp
         } else {
@@ -457,14 +455,7 @@ pub fn run_render(study: RenderStudy, run: &StudyRun, out: &Path) -> anyhow::Res
         });
         let key_text = c.toml.replace(&mesh_dir, "<meshes>");
         let (reference, t_v) = reference(c, &key_text, ref_spp, 2, run)?;
-        let (pilot, _) = timed(
-            &bssrdf,
-            c.width,
-            c.height,
-            study.bssrdf_spp,
-            3,
-            run.threads,
-        )?;
+        let (pilot, _) = timed(&bssrdf, c.width, c.height, study.bssrdf_spp, 3, run.threads)?;
         let skin = Passes::first_hit(&bssrdf, c.width, c.height).skin;
         let pixels = compared_pixels(&pilot, &skin);
         let map = error_map(&test, &reference, &pixels);
