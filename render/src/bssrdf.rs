@@ -208,7 +208,7 @@ impl Subsurface {
         rays: &mut u64,
     ) -> bool {
         let r = planar.length();
-        if !(r > 0.0) {
+        if r.is_nan() || r <= 0.0 {
             return false;
         }
         let t = planar / r;

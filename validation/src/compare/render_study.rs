@@ -471,7 +471,7 @@ pub fn run_render(study: RenderStudy, run: &StudyRun, out: &Path) -> anyhow::Res
         )?;
         let _ = writeln!(
             csv,
-            "{},{},{},{:.5},{:.5},{:.5},{},{:.2},{:.2},{ref_spp}",
+            "\"{}\",{},{},{:.5},{:.5},{:.5},{},{:.2},{:.2},{ref_spp}",
             c.name, c.tone, r.pixels, r.mean_signed, r.mean_abs, r.noise, fails, t_b, t_v
         );
         let _ = writeln!(
