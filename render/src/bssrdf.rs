@@ -19,13 +19,22 @@
 //! of the material means the planar profile's energy at (r, φ) has no surface to leave from (an
 //! edge, a thin curved rim). That energy is not dropped: the sample leaves at the entry point
 //! itself with the planar weight R(r) / (P_normal · pdf_area(r)) (the local diffuse fallback), so a
-//! finite or strongly curved piece of skin still returns its total R_tot locally. It can return
-//! more: on a sphere of radius R smaller than the profile the probes find the sphere's points out
-//! to chord distance 2R (energy R_tot F(2R), F the profile's energy fraction within a radius) and
-//! the fallback adds the planar energy beyond R, so the band R < r < 2R counts twice (light skin
-//! at R = 2 mm: 5–6% brighter in X and Y; `render/tests/subsurface.rs`, docs/tests.md). Thin geometry
-//! needs nothing special: the normal probe crosses it and finds the far side, so backlit ears
-//! transmit (red) light.
+//! finite piece of skin still returns its total R_tot locally.
+//!
+//! The fallback returns only energy the probes cannot reach elsewhere. A missed normal probe says
+//! the surface does not pass *under the planar point* (r, φ), not that no surface lies at distance
+//! r: on a sphere of radius R smaller than the profile the normal probes miss beyond planar radius
+//! R (the sphere's shadow on its tangent plane), yet the probes find the sphere's points out to
+//! chord distance 2R, and over a sphere dA = 2πd dd (Archimedes' hat-box theorem), so they already
+//! return R_tot F(2R) (F the profile's energy fraction within a radius). A fallback on every miss
+//! added R_tot (1 − F(R)) and counted the band R < r < 2R twice (light skin at R = 2 mm: 5–6%
+//! brighter in X and Y). So on a miss the fallback first traces the quarter circle of radius r
+//! from the planar point down to p_o − r n (in the plane of n and the probe's azimuth, as
+//! [`ARC_SEGMENTS`] chords, same end points): when it crosses the material, skin lies at distance r
+//! and the probes account for that energy; the fallback fires only when it does not. On the
+//! sphere that is exactly r > 2R (total R_tot; `render/tests/subsurface.rs`), on a flat patch
+//! every miss (its total stays R_tot). Thin geometry needs nothing special: the normal probe
+//! crosses it and finds the far side, so backlit ears transmit (red) light.
 
 pub mod sampling;
 pub mod separable;
@@ -43,6 +52,12 @@ use std::sync::Arc;
 
 /// Most hits kept along one probe segment (more are ignored: only very folded geometry has them).
 pub const MAX_PROBE_HITS: usize = 32;
+
+/// Chords of the quarter circle a missed normal probe traces before the local fallback (module
+/// doc, "Where probes find no surface"). Its end points are exact, so a closed surface that
+/// separates them is always found; the chords stray inside the arc by at most
+/// r (1 − cos(π / 32)) ≈ 0.5% of r.
+pub const ARC_SEGMENTS: usize = 8;
 
 /// The subsurface model of one skin material.
 #[derive(Debug, Clone)]
@@ -138,7 +153,14 @@ impl Subsurface {
             }
         }
         if m == 0 {
-            return (axis == 0).then(|| self.local_fallback(p_o, frame, axes, r, wl));
+            if axis != 0 {
+                return None;
+            }
+            let planar = pr.origin + pr.dir * (0.5 * pr.length) - p_o;
+            if self.skin_at_distance(geometry, material, p_o, frame.n, planar, rays) {
+                return None;
+            }
+            return Some(self.local_fallback(p_o, frame, axes, r, wl));
         }
         let pick = ((u[3] * m as f32) as usize).min(m - 1);
         let (t, triangle, bary) = hits[pick];
@@ -170,6 +192,41 @@ impl Subsurface {
             ns,
             hit: Some(s),
             weight,
+        })
+    }
+
+    /// Whether material `material` crosses the quarter circle from `p_o + planar` down to
+    /// `p_o − |planar| n` (around `p_o`, as [`ARC_SEGMENTS`] chords): skin at distance |planar| from
+    /// `p_o` in the probe's azimuth, whose energy the probes find. Counts its rays in `rays`.
+    fn skin_at_distance(
+        &self,
+        geometry: &Geometry,
+        material: u32,
+        p_o: Vec3,
+        n: Vec3,
+        planar: Vec3,
+        rays: &mut u64,
+    ) -> bool {
+        let r = planar.length();
+        if r.is_nan() || r <= 0.0 {
+            return false;
+        }
+        let t = planar / r;
+        let point = |k: usize| {
+            let beta = std::f32::consts::FRAC_PI_2 * k as f32 / ARC_SEGMENTS as f32;
+            p_o + (t * beta.cos() - n * beta.sin()) * r
+        };
+        (0..ARC_SEGMENTS).any(|k| {
+            let (a, b) = (point(k), point(k + 1));
+            let len = (b - a).length();
+            *rays += 1;
+            let mut found = false;
+            geometry
+                .accel()
+                .for_each_hit(&ray(a, (b - a) / len, 0.0, len), |h| {
+                    found |= geometry.material_of(h.triangle) == material;
+                });
+            found
         })
     }
 

@@ -245,10 +245,11 @@ fn pixel_standard_error(film: &render::film::Film, mean: [f64; 3]) -> [f64; 3] {
 /// - radius 2 mm, smaller than the profiles: the probes find the sphere's points at chord
 ///   distance d ≤ 2R, and over a sphere dA = 2πd dd (Archimedes' hat-box theorem), so they return
 ///   R_tot F(2R), F the profile's energy fraction within a radius; a normal probe misses where the
-///   planar radius exceeds R (the sphere's shadow on its tangent plane) and the local fallback
-///   (`render::bssrdf`) returns the planar energy there, R_tot (1 − F(R)). Together
-///   R_tot (1 + F(2R) − F(R)): the band R < r < 2R is counted twice, 5–6% of R_tot in X and Y
-///   here (measured, with F from the material's table).
+///   planar radius exceeds R (the sphere's shadow on its tangent plane), and the local fallback
+///   (`render::bssrdf`, "Where probes find no surface") returns the planar energy only where no
+///   skin lies at that distance, r > 2R: R_tot (1 − F(2R)). Together R_tot, as for the large
+///   sphere. (A fallback on every miss gave R_tot (1 + F(2R) − F(R)), the band R < r < 2R counted
+///   twice: 5–6% above R_tot in X and Y here, far outside the tolerance.)
 ///
 /// Tolerance per channel: 4 standard errors of the image mean (`pixel_standard_error`,
 /// conservative; 0.15–0.3% at radius 100, 0.45–0.6% at radius 2) plus 0.2% for the model side:
@@ -269,35 +270,13 @@ fn skin_sphere_in_a_white_furnace_renders_the_separable_closed_form() {
         let s = furnace(radius);
         let (w, h) = (24, 24);
         let (rho, t) = image_mean_albedo(&s, w, h);
-        let Material::Skin(skin) = &s.materials[0] else {
-            unreachable!("the furnace holds one skin")
-        };
-        let table = &skin.subsurface.as_ref().expect("BSSRDF on").table;
-        // F(r): the row's energy within r, by a 2,000-point midpoint rule of 2πr R(r).
-        let within = |nm: f32, r_mm: f32| -> f64 {
-            let n = 2000;
-            let dr = r_mm / n as f32;
-            let e: f64 = (0..n)
-                .map(|i| {
-                    let r = (i as f32 + 0.5) * dr;
-                    f64::from(2.0 * std::f32::consts::PI * r * table.eval(nm, r) * dr)
-                })
-                .sum();
-            e / f64::from(table.total(nm))
-        };
         let found = |nm: f64| {
-            let rd = multipole::skin::total_reflectance(
+            multipole::skin::total_reflectance(
                 &bloodless,
                 Wavelength::new(nm).unwrap(),
                 multipole::Method::default(),
             )
-            .unwrap();
-            if radius > 50.0 {
-                rd
-            } else {
-                let nm = nm as f32;
-                rd * (1.0 + within(nm, 2.0 * radius) - within(nm, radius))
-            }
+            .unwrap()
         };
         let body = xyz_of(|nm| found(nm) / y);
         let film = run(&s, w, h, 32, SEED);

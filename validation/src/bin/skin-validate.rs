@@ -73,6 +73,32 @@ struct RenderStudyArgs {
     /// Output folder.
     #[arg(long, value_name = "DIR", default_value = "out/render-study")]
     out: PathBuf,
+    /// Only the cases whose label "name (tone)" contains this text (repeatable; skips the
+    /// error-against-time chart), e.g. "backlit ear", "sphere r=10 mm (light)".
+    #[arg(long, value_name = "TEXT")]
+    only: Vec<String>,
+    /// Volumetric spp of the cases whose label contains TEXT, as TEXT=N with N in [1, 65536]
+    /// (repeatable, first match wins), e.g. "backlit ear=256".
+    #[arg(long, value_name = "TEXT=N", value_parser = Checked(parse_case_spp))]
+    reference_spp: Vec<(String, u32)>,
+    /// Folder where volumetric references are kept and reused by later runs (same scene, size,
+    /// spp and seed; empty it when the volumetric walk changes).
+    #[arg(long, value_name = "DIR")]
+    reference_cache: Option<PathBuf>,
+    /// Worker threads of every render, [1, 1024] (default: all cores).
+    #[arg(long, value_name = "N", value_parser = Checked(parse_threads))]
+    threads: Option<u32>,
+}
+
+fn parse_case_spp(s: &str) -> Result<(String, u32), String> {
+    let (text, n) = s
+        .rsplit_once('=')
+        .ok_or_else(|| format!("`{s}`: expected TEXT=N"))?;
+    let n = parse_whole(n, 1, 65_536, "[1, 65536]")?;
+    Ok((
+        text.to_string(),
+        u32::try_from(n).map_err(|e| e.to_string())?,
+    ))
 }
 
 fn parse_reference_photons(s: &str) -> Result<u64, String> {
@@ -341,7 +367,13 @@ fn main() {
             } else {
                 RenderStudy::FULL
             };
-            run_render(study, &args.out)
+            let run = validation::compare::render_study::StudyRun {
+                only: args.only.clone(),
+                reference_spp_for: args.reference_spp.clone(),
+                reference_cache: args.reference_cache.clone(),
+                threads: args.threads.map(|t| t as usize),
+            };
+            run_render(study, &run, &args.out)
         }
         None => validation::compare::run_comparison(cli.quick, &cli.out),
     };

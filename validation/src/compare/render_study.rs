@@ -30,7 +30,7 @@ use render::renderer::{RenderOptions, render};
 use render::scene::{Scene, SceneOptions};
 use render::volumetric::shapes::box_obj;
 use std::fmt::Write as _;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// How much each render of the study samples.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -65,6 +65,35 @@ impl RenderStudy {
         builtin_reference_spp: 16,
         ladder: &[1, 4, 16, 32],
     };
+}
+
+/// Which cases one run of the study renders, and how, beyond the counts of [`RenderStudy`].
+#[derive(Debug, Clone, Default)]
+pub struct StudyRun {
+    /// Only the cases whose label `name (tone)` contains one of these (every case when empty);
+    /// the error-against-time chart is skipped when set.
+    pub only: Vec<String>,
+    /// Volumetric spp of the cases whose label contains the pattern (first match wins), in place
+    /// of the study's counts: the ear, the head and the curved cases need more to reach a verdict.
+    pub reference_spp_for: Vec<(String, u32)>,
+    /// Folder where volumetric references are written and reused, keyed by the scene text, the
+    /// image size, spp and seed (not by the code: empty it when the walk changes).
+    pub reference_cache: Option<PathBuf>,
+    /// Worker threads of every render (None = all cores).
+    pub threads: Option<usize>,
+}
+
+impl StudyRun {
+    fn wants(&self, label: &str) -> bool {
+        self.only.is_empty() || self.only.iter().any(|p| label.contains(p.as_str()))
+    }
+
+    fn reference_spp(&self, label: &str) -> Option<u32> {
+        self.reference_spp_for
+            .iter()
+            .find(|(p, _)| label.contains(p.as_str()))
+            .map(|&(_, n)| n)
+    }
 }
 
 /// One scene of the study and where its error is measured.
@@ -182,18 +211,105 @@ fn untextured(toml: &str) -> String {
 }
 
 /// A render of `scene` and the CPU seconds it took.
-fn timed(scene: &Scene, w: usize, h: usize, spp: u32, seed: u64) -> anyhow::Result<(Film, f64)> {
+fn timed(
+    scene: &Scene,
+    w: usize,
+    h: usize,
+    spp: u32,
+    seed: u64,
+    threads: Option<usize>,
+) -> anyhow::Result<(Film, f64)> {
     let opts = RenderOptions {
         width: w,
         height: h,
         spp,
         seed,
+        threads,
         ..Default::default()
     };
     let settings = opts.validate()?;
     let t0 = cpu_time::ProcessTime::now();
     let (film, _) = render(scene, &settings)?;
     Ok((film, t0.elapsed().as_secs_f64()))
+}
+
+/// The volumetric reference of `case` at `spp`, from `cache` when it holds one of the same scene
+/// text (`key_text`), size, spp and seed; rendered (and written there) otherwise. The CPU
+/// seconds are those of the render that made it.
+fn reference(
+    case: &Case,
+    key_text: &str,
+    spp: u32,
+    seed: u64,
+    run: &StudyRun,
+) -> anyhow::Result<(Film, f64)> {
+    use std::hash::{Hash, Hasher};
+    let mut hasher = std::collections::hash_map::DefaultHasher::new();
+    key_text.hash(&mut hasher);
+    let file = run.reference_cache.as_ref().map(|dir| {
+        dir.join(format!(
+            "{}-{}x{}-{spp}spp-seed{seed}-{:016x}.txt",
+            stem(case),
+            case.width,
+            case.height,
+            hasher.finish()
+        ))
+    });
+    if let Some(f) = file.as_ref().filter(|f| f.exists()) {
+        return read_cached(f, case.width, case.height, spp);
+    }
+    let vol = load(&case.toml, true)?;
+    let (film, t) = timed(&vol, case.width, case.height, spp, seed, run.threads)?;
+    if let Some(f) = file {
+        let mut text = format!("{t}\n");
+        for i in 0..case.width * case.height {
+            let (x, y) = (i % case.width, i / case.width);
+            let [a, b, c] = film.xyz(x, y);
+            let _ = writeln!(text, "{a:e} {b:e} {c:e} {:e}", film.variance(x, y));
+        }
+        if let Some(dir) = f.parent() {
+            std::fs::create_dir_all(dir)?;
+        }
+        render::atomic::write_bytes(&f, text.as_bytes())?;
+    }
+    Ok((film, t))
+}
+
+/// A reference written by [`reference`]: CPU seconds, then per pixel X Y Z and the variance of Y.
+fn read_cached(f: &Path, w: usize, h: usize, spp: u32) -> anyhow::Result<(Film, f64)> {
+    let text = std::fs::read_to_string(f).with_context(|| format!("reading {}", f.display()))?;
+    let mut lines = text.lines();
+    let t: f64 = lines.next().unwrap_or("").trim().parse()?;
+    let (mut means, mut var) = (Vec::with_capacity(w * h), Vec::with_capacity(w * h));
+    for line in lines {
+        let v: Vec<f64> = line
+            .split_whitespace()
+            .map(str::parse)
+            .collect::<Result<_, _>>()?;
+        anyhow::ensure!(
+            v.len() == 4,
+            "{}: a line of {} values",
+            f.display(),
+            v.len()
+        );
+        means.push([v[0], v[1], v[2]]);
+        var.push(v[3]);
+    }
+    anyhow::ensure!(
+        means.len() == w * h,
+        "{}: {} pixels, expected {}",
+        f.display(),
+        means.len(),
+        w * h
+    );
+    Ok((Film::from_means(w, h, means, var, spp), t))
+}
+
+fn stem(c: &Case) -> String {
+    format!("{}-{}", c.name, c.tone)
+        .chars()
+        .map(|ch| if ch.is_ascii_alphanumeric() { ch } else { '_' })
+        .collect()
 }
 
 fn load(toml: &str, volumetric: bool) -> anyhow::Result<Scene> {
@@ -307,42 +423,45 @@ fn heat(title: &str, film: &Film, map: Vec<f64>) -> Panel {
 
 /// Run the study into `out`: error maps, `render_cases.csv`, `render_time.csv`, `render_time.png`
 /// and `render.md` (the table).
-pub fn run_render(study: RenderStudy, out: &Path) -> anyhow::Result<()> {
+pub fn run_render(study: RenderStudy, run: &StudyRun, out: &Path) -> anyhow::Result<()> {
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let meshes = tempfile::tempdir()?;
+    let mesh_dir = meshes.path().display().to_string();
     let mut cases = analytic_cases(study.side, meshes.path())?;
     cases.extend(builtin_cases(study.side));
     let mut csv = String::from(
-        "case,tone,pixels,mean_signed_error,mean_abs_error,noise,fails,bssrdf_cpu_s,volumetric_cpu_s\n",
+        "case,tone,pixels,mean_signed_error,mean_abs_error,noise,fails,bssrdf_cpu_s,volumetric_cpu_s,volumetric_spp\n",
     );
     let mut table = String::from(
-        "| case | tone | pixels | mean error | mean abs error | noise (1σ) | BSSRDF fails? | CPU s (BSSRDF / volumetric) |\n|---|---|---|---|---|---|---|---|\n",
+        "| case | tone | volumetric spp | pixels | mean error | mean abs error | noise (1σ) | BSSRDF fails? | CPU s (BSSRDF / volumetric) |\n|---|---|---|---|---|---|---|---|---|\n",
     );
     let mut chart = String::new();
+    let skip_chart = !run.only.is_empty();
     for (k, c) in cases.iter().enumerate() {
-        if c.builtin && chart.is_empty() {
-            chart = time_chart(study, &cases[1], out)?;
+        let label = format!("{} ({})", c.name, c.tone);
+        if !run.wants(&label) {
+            continue;
         }
-        eprintln!("[{}/{}] {} ({})", k + 1, cases.len(), c.name, c.tone);
+        if c.builtin && chart.is_empty() && !skip_chart {
+            chart = time_chart(study, &cases[1], run.threads, out)?;
+        }
+        eprintln!("[{}/{}] {label}", k + 1, cases.len());
         let bssrdf = load(&c.toml, false)?;
-        let (test, t_b) = timed(&bssrdf, c.width, c.height, study.bssrdf_spp, 1)?;
-        let vol = load(&c.toml, true)?;
-        let ref_spp = if c.builtin {
+        let (test, t_b) = timed(&bssrdf, c.width, c.height, study.bssrdf_spp, 1, run.threads)?;
+        let ref_spp = run.reference_spp(&label).unwrap_or(if c.builtin {
             study.builtin_reference_spp
         } else {
             study.reference_spp
-        };
-        let (reference, t_v) = timed(&vol, c.width, c.height, ref_spp, 2)?;
-        let (pilot, _) = timed(&bssrdf, c.width, c.height, study.bssrdf_spp, 3)?;
+        });
+        let key_text = c.toml.replace(&mesh_dir, "<meshes>");
+        let (reference, t_v) = reference(c, &key_text, ref_spp, 2, run)?;
+        let (pilot, _) = timed(&bssrdf, c.width, c.height, study.bssrdf_spp, 3, run.threads)?;
         let skin = Passes::first_hit(&bssrdf, c.width, c.height).skin;
         let pixels = compared_pixels(&pilot, &skin);
         let map = error_map(&test, &reference, &pixels);
         let r = measure(&test, &reference, &pixels, &map);
         let fails = r.mean_signed.abs() > 0.05 && r.mean_signed.abs() > 3.0 * r.noise;
-        let stem: String = format!("{}-{}", c.name, c.tone)
-            .chars()
-            .map(|ch| if ch.is_ascii_alphanumeric() { ch } else { '_' })
-            .collect();
+        let stem = stem(c);
         let title = format!("{} ({}): BSSRDF vs volumetric", c.name, c.tone);
         save_png(
             &out.join(format!("error_{stem}.png")),
@@ -352,12 +471,12 @@ pub fn run_render(study: RenderStudy, out: &Path) -> anyhow::Result<()> {
         )?;
         let _ = writeln!(
             csv,
-            "{},{},{},{:.5},{:.5},{:.5},{},{:.2},{:.2}",
+            "\"{}\",{},{},{:.5},{:.5},{:.5},{},{:.2},{:.2},{ref_spp}",
             c.name, c.tone, r.pixels, r.mean_signed, r.mean_abs, r.noise, fails, t_b, t_v
         );
         let _ = writeln!(
             table,
-            "| {} | {} | {} | {:+.1}% | {:.1}% | {:.1}% | {} | {:.1} / {:.1} |",
+            "| {} | {} | {ref_spp} | {} | {:+.1}% | {:.1}% | {:.1}% | {} | {:.1} / {:.1} |",
             c.name,
             c.tone,
             r.pixels,
@@ -372,8 +491,8 @@ pub fn run_render(study: RenderStudy, out: &Path) -> anyhow::Result<()> {
         render::atomic::write_bytes(&out.join("render_cases.csv"), csv.as_bytes())?;
         write_md(study, out, &table, &chart)?;
     }
-    if chart.is_empty() {
-        chart = time_chart(study, &cases[1], out)?;
+    if chart.is_empty() && !skip_chart {
+        chart = time_chart(study, &cases[1], run.threads, out)?;
     }
     let md = write_md(study, out, &table, &chart)?;
     println!("{md}");
@@ -383,7 +502,7 @@ pub fn run_render(study: RenderStudy, out: &Path) -> anyhow::Result<()> {
 /// Write `render.md` (the case table so far and the chart's lines); returns its text.
 fn write_md(study: RenderStudy, out: &Path, table: &str, chart: &str) -> anyhow::Result<String> {
     let md = format!(
-        "# BSSRDF against the volumetric reference\n\nspp: BSSRDF {}, volumetric {} (ear and head {}); image side {} px.\n\n{table}\n{chart}\n",
+        "# BSSRDF against the volumetric reference\n\nspp: BSSRDF {}, volumetric {} (ear and head {}) unless the table says otherwise; image side {} px.\n\n{table}\n{chart}\n",
         study.bssrdf_spp, study.reference_spp, study.builtin_reference_spp, study.side
     );
     render::atomic::write_bytes(&out.join("render.md"), md.as_bytes())?;
@@ -398,12 +517,24 @@ fn rms_error(test: &Film, reference: &Film, pixels: &[usize]) -> f64 {
 }
 
 /// Error against CPU time for both integrators on `case`; returns the markdown lines.
-fn time_chart(study: RenderStudy, case: &Case, out: &Path) -> anyhow::Result<String> {
+fn time_chart(
+    study: RenderStudy,
+    case: &Case,
+    threads: Option<usize>,
+    out: &Path,
+) -> anyhow::Result<String> {
     let top = *study.ladder.last().unwrap_or(&16);
     let vol = load(&case.toml, true)?;
     let bssrdf = load(&case.toml, false)?;
-    let (reference, t_ref) = timed(&vol, case.width, case.height, 4 * top, 99)?;
-    let (pilot, _) = timed(&bssrdf, case.width, case.height, study.bssrdf_spp, 3)?;
+    let (reference, t_ref) = timed(&vol, case.width, case.height, 4 * top, 99, threads)?;
+    let (pilot, _) = timed(
+        &bssrdf,
+        case.width,
+        case.height,
+        study.bssrdf_spp,
+        3,
+        threads,
+    )?;
     let skin = Passes::first_hit(&bssrdf, case.width, case.height).skin;
     let pixels = compared_pixels(&pilot, &skin);
     let mut csv = String::from("integrator,spp,cpu_s,rms_relative_error,paths_per_cpu_s\n");
@@ -418,7 +549,7 @@ fn time_chart(study: RenderStudy, case: &Case, out: &Path) -> anyhow::Result<Str
     for (name, scene) in [("BSSRDF", &bssrdf), ("volumetric", &vol)] {
         let mut pts = Vec::new();
         for &spp in study.ladder {
-            let (film, t) = timed(scene, case.width, case.height, spp, 7)?;
+            let (film, t) = timed(scene, case.width, case.height, spp, 7, threads)?;
             let e = rms_error(&film, &reference, &pixels);
             let paths = (case.width * case.height) as f64 * f64::from(spp) / t.max(1e-9);
             let _ = writeln!(csv, "{name},{spp},{t:.3},{e:.5},{paths:.0}");
