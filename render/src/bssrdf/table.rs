@@ -298,7 +298,7 @@ impl ProfileTable {
         };
         let n = self.radii_mm.len();
         let target = f64::from(frac.clamp(0.0, 1.0)) * energy_at(n - 1);
-        if !(target > 0.0) {
+        if target.is_nan() || target <= 0.0 {
             return 0.0;
         }
         let mut below = 0.0;
@@ -464,17 +464,19 @@ mod tests {
             })
             .collect();
         let r_out = *t.radii_mm.last().unwrap();
-        let steps = 20_000;
+        let steps = 20_000u32;
         let dr = f64::from(r_out) / f64::from(steps);
-        let mut cum = vec![0.0f64; steps as usize + 1];
-        for k in 0..steps as usize {
-            let r = (k as f64 + 0.5) * dr;
-            let y: f64 = (0..rows)
-                .map(|j| w[j] * f64::from(t.eval(nm(j), r as f32)))
+        let mut cum = vec![0.0f64];
+        for k in 0..steps {
+            let r = (f64::from(k) + 0.5) * dr;
+            let y: f64 = w
+                .iter()
+                .enumerate()
+                .map(|(j, wj)| wj * f64::from(t.eval(nm(j), r as f32)))
                 .sum();
-            cum[k + 1] = cum[k] + 2.0 * std::f64::consts::PI * r * y * dr;
+            cum.push(cum[cum.len() - 1] + 2.0 * std::f64::consts::PI * r * y * dr);
         }
-        let target = 0.99 * cum[steps as usize];
+        let target = 0.99 * cum[cum.len() - 1];
         let k = cum.iter().position(|&c| c >= target).unwrap();
         let r_ref = k as f64 * dr;
         assert!(
