@@ -19,11 +19,16 @@
 //! configuration has its own seed, so no two renders share their noise.
 //!
 //! OUT/lod_ratios.csv: for each skin of the far view, the 99% energy radius at 450, 550 and 650 nm
-//! (blue, green, red) and the largest over the table's rows (what the level of detail uses), and the
+//! (blue, green, red), the largest over the table's rows and the luminance-weighted one (what the
+//! level of detail uses, docs/physics.md §16.3), and the
 //! ratio of the pixel footprint at the skin's mean camera distance to each.
 //!
-//! `cargo run --release -p render --example fidelity -- [OUT] [SPP_FAR] [SPP_EAR] [NOISE] [MAX_SPP]`
-//! (default out/fidelity, 64, 16, 0.1, 4096; MAX_SPP 0 skips the renders to the noise target)
+//! The default scene (`builtin:three-heads`, three cells, one head each) at SPP_DEFAULT: full,
+//! auto, and auto with the 500,000-photon shape table (SPP_DEFAULT 0 skips it).
+//!
+//! `cargo run --release -p render --example fidelity -- [OUT] [SPP_FAR] [SPP_EAR] [NOISE] [MAX_SPP]
+//! [SPP_DEFAULT]` (default out/fidelity, 64, 16, 0.1, 4096, 8; MAX_SPP 0 skips the renders to the
+//! noise target)
 
 use render::fidelity::{Fidelity, FidelityKnobs, LodBand, LodSetting};
 use render::film::Film;
@@ -259,6 +264,30 @@ fn ear_configs(spp: u32) -> Vec<Config> {
     ]
 }
 
+/// The default scene's configurations (all at `spp`, the reference at four times as many): full,
+/// auto, and auto with the full fidelity's 500,000-photon shape table instead of the one the
+/// footprint picks, so the table's share of auto's error shows alone.
+fn default_configs(spp: u32) -> Vec<Config> {
+    let full = knobs(Fidelity::Full, LodSetting::ByFidelity, false);
+    let auto = knobs(Fidelity::Auto, LodSetting::ByFidelity, false);
+    let mut photons_500k = knobs(Fidelity::Auto, LodSetting::ByFidelity, false);
+    photons_500k.fidelity.shape_photons = Some(500_000);
+    let config = |label, opts, seed, spp| Config {
+        label,
+        opts,
+        seed,
+        spp,
+        noise: None,
+        max_spp: spp,
+    };
+    vec![
+        config("full-reference", full, 1, 4 * spp),
+        config("full", full, 2, spp),
+        config("auto", auto, 3, spp),
+        config("auto-photons-500k", photons_500k, 4, spp),
+    ]
+}
+
 /// OUT/lod_ratios.csv: per skin of `spec`, the 99% radius per colour and the pixel footprint over it.
 fn lod_ratios(spec: &str, out: &Path) -> String {
     let full = knobs(Fidelity::Full, LodSetting::ByFidelity, false);
@@ -272,8 +301,8 @@ fn lod_ratios(spec: &str, out: &Path) -> String {
     let distance_mm = depths.iter().sum::<f32>() / depths.len().max(1) as f32;
     let footprint_mm = scene.camera.pixel_angle_rad(HEIGHT) * distance_mm;
     let mut csv = String::from(
-        "material,footprint_mm,r99_450_mm,r99_550_mm,r99_650_mm,r99_largest_mm,\
-         ratio_450,ratio_550,ratio_650,ratio_largest\n",
+        "material,footprint_mm,r99_450_mm,r99_550_mm,r99_650_mm,r99_largest_mm,r99_luminance_mm,\
+         ratio_450,ratio_550,ratio_650,ratio_largest,ratio_luminance\n",
     );
     for (name, m) in scene.material_names.iter().zip(&scene.materials) {
         let Material::Skin(skin) = m else { continue };
@@ -283,6 +312,9 @@ fn lod_ratios(spec: &str, out: &Path) -> String {
             .iter()
             .map(|&nm| ss.table.sample_radius(nm, 0.99))
             .chain(std::iter::once(ss.table.largest_radius_for_energy_mm(0.99)))
+            .chain(std::iter::once(
+                ss.table.luminance_radius_for_energy_mm(0.99),
+            ))
             .collect();
         let _ = write!(csv, "{name},{footprint_mm:.3}");
         for x in &r {
@@ -306,6 +338,7 @@ fn main() {
     };
     let (spp_far, spp_ear, noise) = (next(64.0) as u32, next(16.0) as u32, next(0.1));
     let max_spp = next(4096.0) as u32;
+    let spp_default = next(8.0) as u32;
     std::fs::create_dir_all(&out).expect("create OUT");
     print!("{}", lod_ratios("builtin:three-heads-far", &out));
     let mut csv = String::from(
@@ -327,7 +360,11 @@ fn main() {
             far_configs(spp_far, noise, max_spp),
         ),
         ("builtin:ear", 1, 1, ear_configs(spp_ear)),
-    ] {
+        ("builtin:three-heads", 3, 1, default_configs(spp_default)),
+    ]
+    .into_iter()
+    .filter(|(_, _, _, c)| c.iter().all(|c| c.spp > 0))
+    {
         let runs: Vec<Run> = configs.iter().map(|c| render_one(spec, c, &out)).collect();
         let scene = Scene::load(spec, &configs[0].opts).expect("built-in scenes load");
         let skin: Vec<bool> = Passes::first_hit(&scene, WIDTH, HEIGHT)

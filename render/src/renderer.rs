@@ -218,6 +218,9 @@ pub fn render(
     pool.install(|| render_passes(scene, settings))
 }
 
+/// How often the progress bar's image-wide noise estimate is refreshed.
+const PROGRESS_NOISE_EVERY: Duration = Duration::from_millis(500);
+
 fn render_passes(scene: &Scene, s: &RenderSettings) -> Result<(Film, RenderStats), RenderError> {
     let (w, h) = (s.width, s.height);
     let estimate = if s.path.sampler == SamplerKind::SobolPair {
@@ -246,6 +249,7 @@ fn render_passes(scene: &Scene, s: &RenderSettings) -> Result<(Film, RenderStats
     let start = Instant::now();
     let aspect = w as f32 / h as f32;
     let mut last = Duration::ZERO;
+    let (mut noise, mut noise_at) = (f64::INFINITY, Duration::ZERO);
     for sample in 0..s.spp {
         let results: Vec<TileResult> = tiles
             .par_iter()
@@ -299,11 +303,14 @@ fn render_passes(scene: &Scene, s: &RenderSettings) -> Result<(Film, RenderStats
             converged = acc.update_active(&mut active, target, s.min_spp);
         }
         let elapsed = start.elapsed();
-        let noise = if done >= 2 {
-            acc.noise_estimate()
-        } else {
-            f64::INFINITY
-        };
+        // The image-wide estimate costs a pass over every pixel and is only shown, so it is formed
+        // for a visible progress bar and at most every PROGRESS_NOISE_EVERY: a pass late in a
+        // noise-targeted render samples a few pixels, and work over the whole image at every
+        // pass would then set the frame's time.
+        if done >= 2 && s.progress && elapsed >= noise_at + PROGRESS_NOISE_EVERY {
+            noise = acc.noise_estimate();
+            noise_at = elapsed;
+        }
         if s.noise.is_some() {
             bar.set_position(converged as u64);
         } else {

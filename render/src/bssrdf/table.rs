@@ -275,6 +275,45 @@ impl ProfileTable {
             .fold(0.0, f32::max)
     }
 
+    /// The radius holding the fraction `frac` of the profile's *luminance* under D65, mm: the
+    /// rows' energies within r weighted by ȳ(λ)·D65(λ) and summed, E_Y(r) = Σ_λ ȳ D65 ∫₀^r p_λ,
+    /// and r where E_Y(r) = frac · E_Y(∞) (docs/physics.md §16.3). It is the blur radius that the
+    /// image's luminance — and so its error — sees, where [`ProfileTable::largest_radius_for_energy_mm`]
+    /// is the widest row's, set by the red end that the eye barely weighs. Between grid radii
+    /// E_Y is taken as linear (the rows' cumulative energies are tabulated on the shared grid).
+    #[must_use]
+    pub fn luminance_radius_for_energy_mm(&self, frac: f32) -> f32 {
+        let weights: Vec<f64> = (0..self.rows.len())
+            .map(|j| {
+                let nm = f64::from(self.from_nm + j as f32 * self.step_nm);
+                skin_optics::color::cie_xyz_bar(nm)[1] * skin_optics::color::d65(nm)
+            })
+            .collect();
+        let energy_at = |i: usize| -> f64 {
+            self.rows
+                .iter()
+                .zip(&weights)
+                .map(|(row, w)| w * f64::from(row.cdf[i.min(row.len - 1)]))
+                .sum()
+        };
+        let n = self.radii_mm.len();
+        let target = f64::from(frac.clamp(0.0, 1.0)) * energy_at(n - 1);
+        if target.is_nan() || target <= 0.0 {
+            return 0.0;
+        }
+        let mut below = 0.0;
+        for i in 0..n {
+            let e = energy_at(i);
+            if e >= target {
+                let r0 = if i == 0 { 0.0 } else { self.radii_mm[i - 1] };
+                let t = ((target - below) / (e - below).max(f64::MIN_POSITIVE)) as f32;
+                return r0 + t.clamp(0.0, 1.0) * (self.radii_mm[i] - r0);
+            }
+            below = e;
+        }
+        self.radii_mm[n - 1]
+    }
+
     /// R(r) at `nm` and distance `r_mm`, mm⁻² (integrates to [`ProfileTable::total`] over the plane).
     #[must_use]
     pub fn eval(&self, nm: f32, r_mm: f32) -> f32 {
@@ -440,6 +479,54 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// The luminance r99 against an independent quadrature of the same profiles: E_Y(r) =
+    /// Σ_λ ȳ D65 ∫₀^r 2πr' R_λ(r') dr' by the midpoint rule on 20,000 steps of [`ProfileTable::eval`],
+    /// within 1%; and it lies inside the rows' own r99 range, below the widest (red) row's, since
+    /// the light skin's profile widens with wavelength where ȳ falls.
+    #[test]
+    fn luminance_r99_matches_a_quadrature_of_the_rows() {
+        let t = light_table();
+        let r_y = t.luminance_radius_for_energy_mm(0.99);
+        let rows = t.rows.len();
+        let nm = |j: usize| t.from_nm + j as f32 * t.step_nm;
+        let w: Vec<f64> = (0..rows)
+            .map(|j| {
+                let l = f64::from(nm(j));
+                skin_optics::color::cie_xyz_bar(l)[1] * skin_optics::color::d65(l)
+            })
+            .collect();
+        let r_out = *t.radii_mm.last().unwrap();
+        let steps = 20_000u32;
+        let dr = f64::from(r_out) / f64::from(steps);
+        let mut cum = vec![0.0f64];
+        for k in 0..steps {
+            let r = (f64::from(k) + 0.5) * dr;
+            let y: f64 = w
+                .iter()
+                .enumerate()
+                .map(|(j, wj)| wj * f64::from(t.eval(nm(j), r as f32)))
+                .sum();
+            cum.push(cum[cum.len() - 1] + 2.0 * std::f64::consts::PI * r * y * dr);
+        }
+        let target = 0.99 * cum[cum.len() - 1];
+        let k = cum.iter().position(|&c| c >= target).unwrap();
+        let r_ref = k as f64 * dr;
+        assert!(
+            (f64::from(r_y) / r_ref - 1.0).abs() < 0.01,
+            "luminance r99 {r_y} mm against quadrature {r_ref} mm"
+        );
+        let largest = t.largest_radius_for_energy_mm(0.99);
+        let smallest = t
+            .rows
+            .iter()
+            .map(|row| t.invert(row, 0.99 * row.total))
+            .fold(f32::INFINITY, f32::min);
+        assert!(
+            smallest < r_y && r_y < 0.6 * largest,
+            "{smallest} < {r_y} < 0.6 × {largest}"
+        );
     }
 
     #[test]

@@ -204,8 +204,8 @@ pub fn explain_table(skins: &[(&str, &SkinChoices)]) -> String {
                 let (a, b) = l.band_mm();
                 format!(
                     "BSSRDF below a {a:.2} mm pixel footprint, diffuse above {b:.2} mm \
-                     ({}–{} × r99), blended between",
-                    l.band.full_below, l.band.diffuse_above
+                     ({}–{} × the luminance r99 {:.2} mm), blended between",
+                    l.band.full_below, l.band.diffuse_above, l.r99_mm
                 )
             }
             None => "off (BSSRDF at every hit)".into(),

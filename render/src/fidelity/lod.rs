@@ -71,7 +71,9 @@ impl LodBand {
 /// The level of detail of one skin material: its r₉₉ and the band.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Lod {
-    /// The largest 99% energy radius over the table's wavelengths, mm.
+    /// The 99% radius of the profile's luminance under D65 (ȳ·D65-weighted rows), mm
+    /// ([`crate::bssrdf::ProfileTable::luminance_radius_for_energy_mm`]): the blur the image's
+    /// luminance sees, not the widest (red) row's.
     pub r99_mm: f32,
     /// The band.
     pub band: LodBand,

@@ -144,7 +144,12 @@ pub fn skin_table(
         radii: table.radii_mm().len(),
         shape: shape_source(method, &probe),
         photons: photon_choice,
-        lod: resolved.lod.map(|band| Lod { r99_mm, band }),
+        // The band is placed on the radius the image's luminance sees (§16.3); the thin-part
+        // walk keeps the widest row's, since transmission through a thin part is a red effect.
+        lod: resolved.lod.map(|band| Lod {
+            r99_mm: table.luminance_radius_for_energy_mm(0.99),
+            band,
+        }),
         transport: TransportChoice::bssrdf(
             params,
             resolved.thin_walk_r99.map(|k| k as f32 * r99_mm),
