@@ -55,6 +55,20 @@ struct Config {
     max_spp: u32,
 }
 
+impl Config {
+    /// `spp` samples in every pixel (no noise target).
+    fn fixed(label: &'static str, opts: SceneOptions, seed: u64, spp: u32) -> Self {
+        Self {
+            label,
+            opts,
+            seed,
+            spp,
+            noise: None,
+            max_spp: spp,
+        }
+    }
+}
+
 /// One rendered configuration.
 struct Run {
     label: &'static str,
@@ -238,14 +252,7 @@ fn far_configs(spp: u32, noise: f64, max_spp: u32) -> Vec<Config> {
 /// The close-up's configurations (all at `spp`, the reference at four times as many).
 fn ear_configs(spp: u32) -> Vec<Config> {
     let full = knobs(Fidelity::Full, LodSetting::ByFidelity, false);
-    let config = |label, opts, seed, spp| Config {
-        label,
-        opts,
-        seed,
-        spp,
-        noise: None,
-        max_spp: spp,
-    };
+    let config = Config::fixed;
     vec![
         config("full-reference", full, 1, 4 * spp),
         config("full", full, 2, spp),
@@ -272,14 +279,7 @@ fn default_configs(spp: u32) -> Vec<Config> {
     let auto = knobs(Fidelity::Auto, LodSetting::ByFidelity, false);
     let mut photons_500k = knobs(Fidelity::Auto, LodSetting::ByFidelity, false);
     photons_500k.fidelity.shape_photons = Some(500_000);
-    let config = |label, opts, seed, spp| Config {
-        label,
-        opts,
-        seed,
-        spp,
-        noise: None,
-        max_spp: spp,
-    };
+    let config = Config::fixed;
     vec![
         config("full-reference", full, 1, 4 * spp),
         config("full", full, 2, spp),
