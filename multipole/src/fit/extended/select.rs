@@ -232,13 +232,27 @@ fn auto(
         with.push(p);
         // Two starts for the new parameter: where the trial left it, and mid-range (a parameter
         // that trades off against the seed's, like blood near the surface against C_h, can sit
-        // in a long valley).
+        // in a long valley). With screening on, the mid-range start is refined only if a trial
+        // from it already beats the first refinement (the `full` starts' rule).
         let [lo, hi] = p.range();
         let mid = p.set(s, 0.5 * (lo + hi))?;
         let (s, r) = {
             let a = refine(target, s, &with)?;
-            let b = refine(target, mid, &with)?;
-            if b.1 < a.1 { b } else { a }
+            let b = if screened == 0 {
+                Some(refine(target, mid, &with)?)
+            } else {
+                // The refinement leaves the shift at its best point.
+                let t = trial(target, mid, &with)?;
+                if t.1 < a.1 {
+                    Some(refine(target, t.0, &with)?)
+                } else {
+                    None
+                }
+            };
+            match b {
+                Some(b) if b.1 < a.1 => b,
+                _ => a,
+            }
         };
         let delta = criterion(r, with.len(), chosen + 1) - criterion(rms, params.len(), chosen);
         let accepted = delta < 0.0;
