@@ -45,6 +45,16 @@ pub struct MeasuredOptions {
     /// `select`). Each start costs about as much as the first; fewer starts may stop in a worse
     /// valley (measured in BENCHMARKS.md `## Fit`).
     pub full_starts: usize,
+    /// Of the extra `full` starts, how many are refined after a short trial descent from each ranks
+    /// them, in [0, [`FULL_STARTS_MAX`] − 1] (default [`FULL_REFINED_STARTS`]); a start is refined
+    /// only if its trial already beats the first refinement (module `select`). The maximum, 3,
+    /// refines every start without trials (the exhaustive multi-start).
+    pub full_refined_starts: usize,
+    /// Candidates per `auto` round that get a trial fit, the best by the score test's predicted
+    /// drop of the residual (module `score`), in [0, 7] (default [`SCREENED_TRIALS`]); a round
+    /// whose best predicted drop cannot lower the criterion ends the selection untried. 0 turns
+    /// the screening off: every remaining candidate gets a trial fit, the exhaustive selection.
+    pub screened_trials: usize,
     /// The seed fit's knobs (forward model, search, base skin).
     pub fit: FitOptions,
 }
@@ -57,6 +67,8 @@ impl Default for MeasuredOptions {
             noise: 0.005,
             fit_oiliness: true,
             full_starts: FULL_STARTS_MAX,
+            screened_trials: SCREENED_TRIALS,
+            full_refined_starts: FULL_REFINED_STARTS,
             fit: FitOptions::default(),
         }
     }
@@ -80,6 +92,20 @@ impl MeasuredOptions {
                 range: "[1, 4]",
             });
         }
+        if self.full_refined_starts >= FULL_STARTS_MAX {
+            return Err(FitError::Option {
+                name: "full_refined_starts",
+                value: self.full_refined_starts as f64,
+                range: "[0, 3]",
+            });
+        }
+        if self.screened_trials > Parameter::CANDIDATES.len() {
+            return Err(FitError::Option {
+                name: "screened_trials",
+                value: self.screened_trials as f64,
+                range: "[0, 7]",
+            });
+        }
         Ok(())
     }
 }
@@ -97,6 +123,9 @@ pub struct SelectionStep {
     pub delta_criterion: f64,
     /// Whether it was kept.
     pub accepted: bool,
+    /// Whether `rms_after` and `delta_criterion` are the score test's prediction (a round that
+    /// ended before its trial fit) rather than a refined fit's.
+    pub predicted: bool,
 }
 
 /// Result of [`fit_measured`].
@@ -186,6 +215,12 @@ pub fn fit_measured(
 
 /// Most starts of the `full` refinement ([`MeasuredOptions::full_starts`]).
 pub const FULL_STARTS_MAX: usize = 4;
+
+/// Default [`MeasuredOptions::full_refined_starts`].
+pub const FULL_REFINED_STARTS: usize = 1;
+
+/// Default [`MeasuredOptions::screened_trials`].
+pub const SCREENED_TRIALS: usize = 2;
 
 /// A fitted value closer than this fraction of its range to a bound counts as on the bound.
 pub const AT_BOUND_FRACTION: f64 = 1e-3;
@@ -341,6 +376,7 @@ impl select::Target for Problem<'_> {
 }
 
 mod colour;
+mod score;
 mod select;
 
 pub use colour::{MeasuredColourFit, fit_measured_colour};

@@ -131,7 +131,7 @@ fn steps_json(steps: &[SelectionStep]) -> Vec<serde_json::Value> {
             serde_json::json!({
                 "parameter": s.parameter.name(), "rms_before": s.rms_before,
                 "rms_after": s.rms_after, "delta_criterion": s.delta_criterion,
-                "accepted": s.accepted,
+                "accepted": s.accepted, "predicted": s.predicted,
             })
         })
         .collect()
@@ -141,12 +141,13 @@ fn steps_json(steps: &[SelectionStep]) -> Vec<serde_json::Value> {
 fn print_steps(steps: &[SelectionStep], unit: &str, digits: usize, noise: f64) {
     for s in steps {
         println!(
-            "{:<9}{} {}: {unit} {:.digits$} → {:.digits$}, Δcriterion {:+.1} at σ = {noise}",
+            "{:<9}{} {}: {unit} {:.digits$} → {:.digits$}{}, Δcriterion {:+.1} at σ = {noise}",
             "",
             if s.accepted { "added" } else { "not added" },
             s.parameter,
             s.rms_before,
             s.rms_after,
+            if s.predicted { " (score test)" } else { "" },
             s.delta_criterion,
         );
     }

@@ -183,6 +183,14 @@ struct MeasuredArgs {
     /// Starts of the `full` refinement, [1, 4] (fewer: faster, may stop in a worse valley).
     #[arg(long, default_value_t = multipole::fit::FULL_STARTS_MAX)]
     full_starts: usize,
+    /// Extra `full` starts refined after short trials rank them, [0, 3] (3: every start refined,
+    /// no trials).
+    #[arg(long, default_value_t = multipole::fit::FULL_REFINED_STARTS)]
+    full_refined_starts: usize,
+    /// Candidates per `auto` round trial-fitted after the score test ranks them, [0, 7] (0: every
+    /// candidate, the exhaustive selection).
+    #[arg(long, default_value_t = multipole::fit::SCREENED_TRIALS)]
+    screened_trials: usize,
     /// Output folder.
     #[arg(long, value_name = "DIR", default_value = "out/measured")]
     out: PathBuf,
@@ -250,6 +258,8 @@ fn run_measured(args: &MeasuredArgs) -> anyhow::Result<()> {
         model: args.model,
         noise: args.noise,
         full_starts: args.full_starts,
+        screened_trials: args.screened_trials,
+        full_refined_starts: args.full_refined_starts,
         fit: multipole::fit::FitOptions {
             method: args.method,
             beta_scan: 0,

@@ -4,7 +4,7 @@
 //! greedy `auto` selection. A target supplies the residual vector and its shift through [`Target`];
 //! the residual figure is the RMS reflectance for a spectrum and ΔE00 for a colour.
 
-use super::{MeasuredOptions, SelectionStep, with_candidates};
+use super::{MeasuredOptions, SelectionStep, score, with_candidates};
 use crate::fit::FitError;
 use crate::fit::least_squares::{LM, LmBudget, minimize};
 use crate::fit::model::{ModelChoice, Parameter};
@@ -122,34 +122,65 @@ fn trial(
 /// at mid-range, and at a quarter and three quarters of its range. With seven parameters that
 /// trade against each other (blood near the surface against C_h, ρ_s against the scattering
 /// scales), one local descent can stop in a valley.
+///
+/// Screening (`refined` < `starts − 1`): each extra start gets a short trial descent on the
+/// first refinement's shift instead of a refinement; only the `refined` best of them are refined,
+/// and only those whose trial already ends below the first refinement's residual (a start that
+/// does not reach the first valley's depth in the trial is taken to sit in a shallower one).
 fn full(
     target: &mut impl Target,
     skin: SkinParams,
     params: &[Parameter],
     starts: usize,
+    refined: usize,
 ) -> Result<(SkinParams, f64), FitError> {
     let mut best = refine(target, skin, params)?;
-    for &t in FULL_STARTS.iter().take(starts.saturating_sub(1)) {
-        let start = Parameter::CANDIDATES.iter().try_fold(best.0, |s, p| {
+    let extra = starts.saturating_sub(1);
+    let start_at = |s: SkinParams, t: f64| {
+        Parameter::CANDIDATES.iter().try_fold(s, |s, p| {
             let [lo, hi] = p.range();
             p.set(s, lo + t * (hi - lo))
-        })?;
-        let trial = refine(target, start, params)?;
-        if trial.1 < best.1 {
-            best = trial;
+        })
+    };
+    if refined >= extra {
+        for &t in FULL_STARTS.iter().take(extra) {
+            let trial = refine(target, start_at(best.0, t)?, params)?;
+            if trial.1 < best.1 {
+                best = trial;
+            }
+        }
+        return Ok(best);
+    }
+    let first = best;
+    let mut trials = Vec::with_capacity(extra);
+    for &t in FULL_STARTS.iter().take(extra) {
+        // The refinement leaves the shift at its best point.
+        trials.push(trial(target, start_at(first.0, t)?, params)?);
+    }
+    trials.sort_by(|a, b| a.1.total_cmp(&b.1));
+    for (s, r) in trials.into_iter().take(refined) {
+        if r >= first.1 {
+            break;
+        }
+        let candidate = refine(target, s, params)?;
+        if candidate.1 < best.1 {
+            best = candidate;
         }
     }
     Ok(best)
 }
 
-/// The `auto` selection from the seed's fit (`skin`, residual `rms`, `params`): each round tries
-/// every candidate not yet in, refines the best and keeps it while `criterion(residual, k, j)`
-/// falls (k free parameters, j candidates chosen). Returns the final parameters, skin, residual
-/// and the rounds.
+/// The `auto` selection from the seed's fit (`skin`, residual `rms`, `params`): each round ranks
+/// the candidates not yet in, trial-fits the best `screened` of them (all when `screened` is 0),
+/// refines the best trial and keeps it while `criterion(residual, k, j)` falls (k free parameters,
+/// j candidates chosen). With screening on, the ranking is the score test's predicted drop (module
+/// `score`), and a round whose best predicted drop cannot lower the criterion ends the selection
+/// without a trial. Returns the final parameters, skin, residual and the rounds.
 fn auto(
     target: &mut impl Target,
     start: (SkinParams, f64),
     seed_params: &[Parameter],
+    screened: usize,
     criterion: impl Fn(f64, usize, usize) -> f64,
 ) -> Result<(Vec<Parameter>, SkinParams, f64, Vec<SelectionStep>), FitError> {
     let (mut skin, mut rms) = start;
@@ -157,10 +188,36 @@ fn auto(
     let mut steps = Vec::new();
     let mut chosen = 0;
     loop {
-        let remaining: Vec<Parameter> = Parameter::CANDIDATES
+        let mut remaining: Vec<Parameter> = Parameter::CANDIDATES
             .into_iter()
             .filter(|p| !params.contains(p))
             .collect();
+        if remaining.is_empty() {
+            break;
+        }
+        if screened > 0 {
+            // The shift at `skin` (the last refinement may have left it at its other start).
+            rms = target.reshift(&skin)?;
+            let drops = score::predicted_drops(target, skin, &params, &remaining)?;
+            let mut ranked: Vec<(Parameter, f64)> = remaining.into_iter().zip(drops).collect();
+            ranked.sort_by(|a, b| b.1.total_cmp(&a.1));
+            let (p, drop) = ranked[0];
+            let predicted = (rms * rms - drop).max(0.0).sqrt();
+            let delta = criterion(predicted, params.len() + 1, chosen + 1)
+                - criterion(rms, params.len(), chosen);
+            if delta >= 0.0 {
+                steps.push(SelectionStep {
+                    parameter: p,
+                    rms_before: rms,
+                    rms_after: predicted,
+                    delta_criterion: delta,
+                    accepted: false,
+                    predicted: true,
+                });
+                break;
+            }
+            remaining = ranked.into_iter().take(screened).map(|(p, _)| p).collect();
+        }
         let mut best: Option<(Parameter, SkinParams, f64)> = None;
         for p in remaining {
             let mut trial_params = params.clone();
@@ -175,13 +232,27 @@ fn auto(
         with.push(p);
         // Two starts for the new parameter: where the trial left it, and mid-range (a parameter
         // that trades off against the seed's, like blood near the surface against C_h, can sit
-        // in a long valley).
+        // in a long valley). With screening on, the mid-range start is refined only if a trial
+        // from it already beats the first refinement (the `full` starts' rule).
         let [lo, hi] = p.range();
         let mid = p.set(s, 0.5 * (lo + hi))?;
         let (s, r) = {
             let a = refine(target, s, &with)?;
-            let b = refine(target, mid, &with)?;
-            if b.1 < a.1 { b } else { a }
+            let b = if screened == 0 {
+                Some(refine(target, mid, &with)?)
+            } else {
+                // The refinement leaves the shift at its best point.
+                let t = trial(target, mid, &with)?;
+                if t.1 < a.1 {
+                    Some(refine(target, t.0, &with)?)
+                } else {
+                    None
+                }
+            };
+            match b {
+                Some(b) if b.1 < a.1 => b,
+                _ => a,
+            }
         };
         let delta = criterion(r, with.len(), chosen + 1) - criterion(rms, params.len(), chosen);
         let accepted = delta < 0.0;
@@ -191,6 +262,7 @@ fn auto(
             rms_after: r,
             delta_criterion: delta,
             accepted,
+            predicted: false,
         });
         if !accepted {
             break;
@@ -214,10 +286,16 @@ pub(super) fn fit_model(
         ModelChoice::Seed => Ok((seed_params.to_vec(), seed.0, seed.1, Vec::new())),
         ModelChoice::Full => {
             let all = with_candidates(seed_params);
-            let (skin, r) = full(target, seed.0, &all, opts.full_starts)?;
+            let (skin, r) = full(
+                target,
+                seed.0,
+                &all,
+                opts.full_starts,
+                opts.full_refined_starts,
+            )?;
             Ok((all, skin, r, Vec::new()))
         }
-        ModelChoice::Auto => auto(target, seed, seed_params, criterion),
+        ModelChoice::Auto => auto(target, seed, seed_params, opts.screened_trials, criterion),
     }
 }
 
