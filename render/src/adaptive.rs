@@ -399,7 +399,11 @@ mod tests {
         // Left block: samples 1, 3, 3, 1 (halves agree: h = 0 ⇒ ρ = 0); right block: 1, 3, 1, 3
         // (h = 1, v = 1/3 ⇒ ρ = 3).
         for x in 0..w {
-            let ys = if x < CALIBRATION_TILE { [1.0, 3.0, 3.0, 1.0] } else { [1.0, 3.0, 1.0, 3.0] };
+            let ys = if x < CALIBRATION_TILE {
+                [1.0, 3.0, 3.0, 1.0]
+            } else {
+                [1.0, 3.0, 1.0, 3.0]
+            };
             for (k, y) in ys.into_iter().enumerate() {
                 acc.add(x, k as u32, [0.0, y, 0.0]);
             }

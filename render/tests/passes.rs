@@ -72,14 +72,15 @@ fn sphere_normals_and_mask() {
     assert!(hits > 9, "{hits} pixels on the sphere");
 }
 
-/// An adaptive render of a lit grey plane in the dark, where the bright pixels stop at the
-/// target well before the cap and the dim ones do not: the EXR's `samples.count` layer holds
+/// An adaptive render of a grey plane under a small light, whose pixels stop at the target at
+/// different counts: the EXR's `samples.count` layer holds
 /// each pixel's sample count (the film's, i.e. the accumulator's), at least `min_spp` and at
 /// most the cap, its mean is the mean spp the render reports, and some pixels stopped early.
 #[test]
 fn samples_pass_holds_each_pixels_sample_count() {
     use render::renderer::{RenderOptions, render};
     let s = SceneText::camera([0.0, 0.0, 500.0], 30.0)
+        .environment("d65", 0.05)
         .diffuse("grey", 0.5)
         .mesh("quad", "grey", 1000.0)
         .sphere_light([150.0, 150.0, 200.0], 20.0, 40.0)
@@ -89,7 +90,7 @@ fn samples_pass_holds_each_pixels_sample_count() {
         width: w,
         height: h,
         spp: cap,
-        noise: Some(0.05),
+        noise: Some(0.03),
         threads: Some(1),
         ..Default::default()
     };
@@ -118,8 +119,13 @@ fn samples_pass_holds_each_pixels_sample_count() {
         }
     }
     let mean = layer.iter().map(|&n| f64::from(n)).sum::<f64>() / (w * h) as f64;
-    assert!((mean - stats.mean_spp).abs() < 1e-9, "{mean} vs {}", stats.mean_spp);
+    assert!(
+        (mean - stats.mean_spp).abs() < 1e-9,
+        "{mean} vs {}",
+        stats.mean_spp
+    );
     assert_eq!(layer.iter().copied().fold(0.0, f32::max), stats.spp as f32);
-    let early = layer.iter().filter(|&&n| n < cap as f32).count();
-    assert!(early > 0 && early < w * h, "{early} of {} stopped early", w * h);
+    // Pixels stopped at different counts.
+    let least = layer.iter().copied().fold(f32::INFINITY, f32::min);
+    assert!(least < stats.spp as f32, "{least}..{}", stats.spp);
 }
