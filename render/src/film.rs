@@ -31,6 +31,9 @@ pub struct Film {
     dropped_upstream: u64,
     /// Estimated variance of each pixel's mean luminance Y (zero when not estimated).
     variance_y: Vec<f64>,
+    /// Samples kept at each pixel, for films whose pixels took different counts (None: every
+    /// pixel took `spp`, less its dropped samples).
+    samples: Option<Vec<u32>>,
 }
 
 impl Film {
@@ -45,6 +48,7 @@ impl Film {
             dropped: BTreeMap::new(),
             dropped_upstream: 0,
             variance_y: vec![0.0; width * height],
+            samples: None,
         }
     }
 
@@ -69,6 +73,25 @@ impl Film {
             variance_y,
             dropped: BTreeMap::new(),
             dropped_upstream: 0,
+            samples: None,
+        }
+    }
+
+    /// The film, holding `counts[i]` samples at pixel i (row-major; the `samples` pass).
+    #[must_use]
+    pub fn with_samples(mut self, counts: Vec<u32>) -> Self {
+        debug_assert_eq!(counts.len(), self.width * self.height);
+        self.samples = Some(counts);
+        self
+    }
+
+    /// Samples averaged into pixel (x, y) (the `samples` pass): the count the pixel kept.
+    #[must_use]
+    pub fn samples(&self, x: usize, y: usize) -> u32 {
+        let i = y * self.width + x;
+        match &self.samples {
+            Some(counts) => counts[i],
+            None => self.spp - self.dropped.get(&i).copied().unwrap_or(0),
         }
     }
 

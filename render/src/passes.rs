@@ -1,6 +1,7 @@
 //! Render passes for compositing and denoising, written beside the beauty image in one OpenEXR:
 //! `albedo.{R,G,B}`, `normal.{X,Y,Z}`, `depth.Z`, `mask.skin` and `variance.Y`, as Cycles and
-//! Arnold name their AOVs.
+//! Arnold name their AOVs, and `samples.count`, each pixel's sample count (Cycles' "Debug
+//! Sample Count" pass), where an adaptive render spent its samples.
 //!
 //! The geometric passes come from one primary ray through each pixel's centre and the lens
 //! centre, so they are noise-free and exact at the pixel centre (no anti-aliasing).
@@ -103,8 +104,8 @@ impl Passes {
         p
     }
 
-    /// Write `film` (linear sRGB `R`, `G`, `B`), its `variance.Y` and these passes as one
-    /// 32-bit float OpenEXR.
+    /// Write `film` (linear sRGB `R`, `G`, `B`), its `variance.Y`, its per-pixel sample counts
+    /// `samples.count` (as f32: exact up to 2²⁴) and these passes as one 32-bit float OpenEXR.
     pub fn write_exr(&self, film: &Film, path: &Path) -> Result<(), RenderError> {
         Ok(atomic::commit(vec![self.stage_exr(film, path)?])?)
     }
@@ -124,6 +125,9 @@ impl Passes {
         let variance: Vec<f32> = (0..h)
             .flat_map(|y| (0..w).map(move |x| film.variance(x, y) as f32))
             .collect();
+        let samples: Vec<f32> = (0..h)
+            .flat_map(|y| (0..w).map(move |x| film.samples(x, y) as f32))
+            .collect();
         let ch = |name: &str, data: Vec<f32>| AnyChannel::new(name, FlatSamples::F32(data));
         let split = |v: &[[f32; 3]], c: usize| v.iter().map(|p| p[c]).collect::<Vec<f32>>();
         let mut channels = Vec::new();
@@ -137,6 +141,7 @@ impl Passes {
         channels.push(ch("depth.Z", self.depth.clone()));
         channels.push(ch("mask.skin", self.skin.clone()));
         channels.push(ch("variance.Y", variance));
+        channels.push(ch("samples.count", samples));
         let layer = Layer::new(
             (w, h),
             LayerAttributes::default(),

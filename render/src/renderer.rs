@@ -54,6 +54,10 @@ pub struct RenderOptions {
     pub noise: Option<f64>,
     /// Fewest samples a pixel takes before the noise target may stop it, ≥ 2.
     pub min_spp: u32,
+    /// How each pixel's error is estimated for the noise target and the reported noise (None:
+    /// [`ErrorEstimate::for_sampler`]); the half-based ones need a sampler whose even and odd
+    /// samples are independent (not [`SamplerKind::Sobol`]).
+    pub error_estimate: Option<ErrorEstimate>,
     /// Wall-clock budget: no pass is started that would end past it (None = no limit; at least
     /// one pass is always rendered).
     pub time_limit: Option<Duration>,
@@ -78,6 +82,7 @@ impl Default for RenderOptions {
             spp: 64,
             noise: None,
             min_spp: MIN_SPP,
+            error_estimate: None,
             time_limit: None,
             seed: 1,
             threads: None,
@@ -120,6 +125,16 @@ impl RenderOptions {
         }
         if self.min_spp < 2 {
             return Err(bad("min_spp", self.min_spp.to_string(), "[2, 2^32)"));
+        }
+        if let Some(e) = self.error_estimate
+            && e.needs_independent_halves()
+            && self.path.sampler == SamplerKind::Sobol
+        {
+            return Err(bad(
+                "error_estimate",
+                format!("{e:?}"),
+                "SampleVariance with the one-sequence Sobol sampler (its halves are not independent)",
+            ));
         }
         if let Some(t) = self.threads
             && !(1..=MAX_THREADS).contains(&t)
@@ -223,11 +238,9 @@ const PROGRESS_NOISE_EVERY: Duration = Duration::from_millis(500);
 
 fn render_passes(scene: &Scene, s: &RenderSettings) -> Result<(Film, RenderStats), RenderError> {
     let (w, h) = (s.width, s.height);
-    let estimate = if s.path.sampler == SamplerKind::SobolPair {
-        ErrorEstimate::HalfDifference
-    } else {
-        ErrorEstimate::SampleVariance
-    };
+    let estimate = s
+        .error_estimate
+        .unwrap_or_else(|| ErrorEstimate::for_sampler(s.path.sampler));
     let mut acc = Accumulator::new(w, h, estimate);
     let mut active = vec![true; w * h];
     let mut converged = 0usize;

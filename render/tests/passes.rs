@@ -71,3 +71,61 @@ fn sphere_normals_and_mask() {
     }
     assert!(hits > 9, "{hits} pixels on the sphere");
 }
+
+/// An adaptive render of a grey plane under a small light, whose pixels stop at the target at
+/// different counts: the EXR's `samples.count` layer holds
+/// each pixel's sample count (the film's, i.e. the accumulator's), at least `min_spp` and at
+/// most the cap, its mean is the mean spp the render reports, and some pixels stopped early.
+#[test]
+fn samples_pass_holds_each_pixels_sample_count() {
+    use render::renderer::{RenderOptions, render};
+    let s = SceneText::camera([0.0, 0.0, 500.0], 30.0)
+        .environment("d65", 0.05)
+        .diffuse("grey", 0.5)
+        .mesh("quad", "grey", 1000.0)
+        .sphere_light([150.0, 150.0, 200.0], 20.0, 40.0)
+        .load();
+    let (w, h, cap) = (16, 12, 96);
+    let o = RenderOptions {
+        width: w,
+        height: h,
+        spp: cap,
+        noise: Some(0.03),
+        threads: Some(1),
+        ..Default::default()
+    };
+    let settings = o.validate().unwrap();
+    let (film, stats) = render(&s, &settings).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("render.exr");
+    Passes::first_hit(&s, w, h).write_exr(&film, &path).unwrap();
+    let img = exr::prelude::read_first_flat_layer_from_file(&path).unwrap();
+    let layer: Vec<f32> = img
+        .layer_data
+        .channel_data
+        .list
+        .iter()
+        .find(|c| c.name.eq("samples.count"))
+        .expect("samples.count channel")
+        .sample_data
+        .values_as_f32()
+        .collect();
+    assert_eq!(layer.len(), w * h);
+    for y in 0..h {
+        for x in 0..w {
+            let n = layer[y * w + x];
+            assert_eq!(n, film.samples(x, y) as f32, "pixel ({x}, {y})");
+            assert!(n >= settings.min_spp as f32 && n <= cap as f32, "{n}");
+        }
+    }
+    let mean = layer.iter().map(|&n| f64::from(n)).sum::<f64>() / (w * h) as f64;
+    assert!(
+        (mean - stats.mean_spp).abs() < 1e-9,
+        "{mean} vs {}",
+        stats.mean_spp
+    );
+    assert_eq!(layer.iter().copied().fold(0.0, f32::max), stats.spp as f32);
+    // Pixels stopped at different counts.
+    let least = layer.iter().copied().fold(f32::INFINITY, f32::min);
+    assert!(least < stats.spp as f32, "{least}..{}", stats.spp);
+}

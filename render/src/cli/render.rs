@@ -4,6 +4,7 @@
 //! Its clap fields share the shape of the skin flags in `cli::args` (doc, `#[arg]` with a `Checked`
 //! parser, `Option<f64>`): each flag's help and range differ, the parsers are shared.
 
+use crate::adaptive::ErrorEstimate;
 use crate::cli::args::{Checked, parse_number, parse_whole};
 use crate::fidelity::{Fidelity, FidelityKnobs, LodBand, LodSetting};
 use crate::renderer::{RenderOptions, SettingError, render};
@@ -31,6 +32,12 @@ pub struct RenderArgs {
     /// its own samples is below it. 0 = off: every pixel takes --spp samples.
     #[arg(long, value_name = "REL", default_value_t = 0.02, value_parser = Checked(parse_noise), allow_hyphen_values = true)]
     pub noise: f64,
+    /// How each pixel's noise is estimated for --noise and the printed figure: calibrated (the
+    /// sample variance scaled per 16×16 block by the two half-sequences' agreement; default),
+    /// half-difference (the two half-sequences' means alone: few degrees of freedom, so pixels
+    /// stop on a low estimate) or sample-variance (an overstatement for Sobol points).
+    #[arg(long, value_name = "E", value_enum, default_value_t = ErrorEstimate::Calibrated)]
+    pub error_estimate: ErrorEstimate,
     /// Image width, pixels.
     #[arg(long, value_name = "W", default_value_t = 768, value_parser = Checked(parse_pixels), allow_hyphen_values = true)]
     pub width: u32,
@@ -154,6 +161,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         height: args.height as usize,
         spp: args.spp,
         noise: (args.noise > 0.0).then_some(args.noise),
+        error_estimate: Some(args.error_estimate),
         time_limit: (args.time_limit > 0.0).then(|| Duration::from_secs_f64(args.time_limit)),
         seed: args.seed,
         threads: args.threads.map(|t| t as usize),
@@ -271,6 +279,7 @@ fn flag_error(e: SettingError) -> anyhow::Error {
         "height" => "--height",
         "spp" => "--spp",
         "noise" => "--noise",
+        "error_estimate" => "--error-estimate",
         "threads" => "--threads",
         "path.max_depth" => "--max-depth",
         "wavelength_nm" => "--wavelength",
