@@ -94,7 +94,10 @@ pub(super) fn predicted_drops(
             let col = column(target, skin, c, &r0, h)?;
             let c_perp = project_out(&basis, &col);
             let curvature = dot(&c_perp, &c_perp);
-            if !(curvature > 1e-16 * dot(&col, &col)) {
+            // Not above the floor, or not comparable (NaN): the column adds nothing.
+            if curvature.partial_cmp(&(1e-16 * dot(&col, &col)))
+                != Some(std::cmp::Ordering::Greater)
+            {
                 return Ok(0.0);
             }
             let g = dot(&c_perp, &r_perp);
