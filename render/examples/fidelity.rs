@@ -434,8 +434,9 @@ fn main() {
             chart = chart.with_series(Series::scatter(format!("{name}, to noise"), targeted));
         }
     }
-    // From 0, with headroom, so no point sits on the frame.
-    chart = chart.with_y_range(0.0, 1.2 * worst.max(1e-3));
+    // From 0, with headroom above the worst point for the legend (upper right), so no point sits
+    // on the frame or under the legend.
+    chart = chart.with_y_range(0.0, 1.7 * worst.max(1e-3));
     render::atomic::write_bytes(&out.join("fidelity.csv"), csv.as_bytes()).expect("write csv");
     save_png(&out.join("fidelity.png"), &[Panel::Line(chart)], 900, 500).expect("write chart");
     print!("{csv}");
