@@ -1,8 +1,9 @@
 //! Spectrum fit with the instrument modelled (SCE/SCI) and the model chosen by the data
 //! (docs/physics.md §13).
 //!
-//! 1. **Start**: today's seed fit ([`fit_spectrum`]: global search over C_m, β_m, C_h) of the
-//!    measurement minus the surface reflection of the base skin's ρ_s for the geometry.
+//! 1. **Start**: the seed model's residual on a coarse grid over C_m, β_m, C_h (the search
+//!    coordinates of [`fit_spectrum`]), then step 2 for the seed's parameters from the best nodes
+//!    in distinct basins. `--model seed` under SCE is [`fit_spectrum`] itself, today's fit.
 //! 2. **Refine** the free parameters together by bounded Levenberg–Marquardt (module
 //!    `least_squares`) on the model the instrument sees: diffuse reflectance plus, for SCI,
 //!    ρ_s a(cos 8°). An exact fit refines on the cheap search quadrature shifted to the full model
@@ -24,7 +25,7 @@ use super::forward::Forward;
 use super::geometry::{Geometry, unit_surface_reflectance};
 use super::least_squares::{LM, LmBudget};
 use super::model::{ModelChoice, Parameter};
-use super::{FitError, FitOptions, MeasuredSpectrum, SpectrumFit, fit_spectrum};
+use super::{FitError, FitOptions, MeasuredSpectrum, fit_spectrum};
 use select::ln_binomial;
 use skin_optics::{SkinParams, Wavelength};
 
@@ -147,11 +148,9 @@ pub struct MeasuredFit {
     pub criterion: f64,
     /// The rounds of the `auto` selection (empty for `seed` and `full`).
     pub steps: Vec<SelectionStep>,
-    /// The start: today's seed fit of the measurement minus the base surface reflection.
-    pub start: SpectrumFit,
-    /// Full-model spectrum evaluations spent after the start.
+    /// Full-model spectrum evaluations spent.
     pub full_evaluations: usize,
-    /// Search-model spectrum evaluations spent after the start.
+    /// Search-model spectrum evaluations spent.
     pub search_evaluations: usize,
 }
 
@@ -162,23 +161,10 @@ pub fn fit_measured(
 ) -> Result<MeasuredFit, FitError> {
     opts.fit.validate()?;
     opts.validate()?;
-    let base = opts.fit.base;
     let unit_surface = match opts.geometry {
         Geometry::Sce => 0.0,
-        Geometry::Sci => unit_surface_reflectance(base.eta())?,
+        Geometry::Sci => unit_surface_reflectance(opts.fit.base.eta())?,
     };
-    let offset = base.oiliness() * unit_surface;
-    let shifted: Vec<f64> = measured
-        .reflectance()
-        .iter()
-        .map(|r| (r - offset).max(0.0))
-        .collect();
-    let start_data = MeasuredSpectrum::new(
-        measured.lambda_nm().to_vec(),
-        shifted,
-        Some(measured.weights().to_vec()),
-    )?;
-    let start = fit_spectrum(&start_data, &opts.fit)?;
     let seed_params = seed_parameters(opts);
     let mut problem = Problem::new(measured, opts, unit_surface)?;
     let n = measured.len() as f64;
@@ -186,12 +172,22 @@ pub fn fit_measured(
     let criterion = |rms: f64, k: usize, j: usize| {
         n * (rms / opts.noise).powi(2) + k as f64 * n.ln() + 2.0 * ln_binomial(m, j)
     };
-    let plain_seed = opts.geometry == Geometry::Sce && opts.model == ModelChoice::Seed;
-    let seed = if plain_seed {
-        // Today's fit, unchanged.
+    let seed = if opts.geometry == Geometry::Sce && opts.model == ModelChoice::Seed {
+        // Today's fit, unchanged (on the data as it has always received them: no negative values).
+        let data = MeasuredSpectrum::new(
+            measured.lambda_nm().to_vec(),
+            measured.reflectance().iter().map(|r| r.max(0.0)).collect(),
+            Some(measured.weights().to_vec()),
+        )?;
+        let start = fit_spectrum(&data, &opts.fit)?;
+        // `evaluations` counts each full evaluation with its search pair, and the final model.
+        problem.search_evals += start
+            .evaluations
+            .saturating_sub(2 * start.full_evaluations + 1);
+        problem.full_evals += start.full_evaluations + 1;
         (start.skin, start.rms)
     } else {
-        select::refine(&mut problem, start.skin, &seed_params)?
+        select::grid_start(&mut problem, &seed_params, &opts.fit)?
     };
     let seed_rms = seed.1;
     let (params, skin, rms, steps) =
@@ -207,7 +203,6 @@ pub fn fit_measured(
         rms,
         seed_rms,
         steps,
-        start,
         full_evaluations: problem.full_evals,
         search_evaluations: problem.search_evals,
     })

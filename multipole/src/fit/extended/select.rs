@@ -5,7 +5,8 @@
 //! the residual figure is the RMS reflectance for a spectrum and ΔE00 for a colour.
 
 use super::{MeasuredOptions, SelectionStep, score, with_candidates};
-use crate::fit::FitError;
+use crate::fit::nelder_mead::{distinct_starts, grid_search};
+use crate::fit::{FitError, FitOptions, infeasibility, search_to_params, with_chromophores};
 use crate::fit::least_squares::{LM, LmBudget, minimize};
 use crate::fit::model::{ModelChoice, Parameter};
 use skin_optics::SkinParams;
@@ -96,6 +97,55 @@ pub(super) fn refine(
             break;
         }
     }
+    Ok(best)
+}
+
+/// The seed model's fit from nothing but the target: the residual of the cheap model (on the
+/// current shift, zero for a new target) at every node of the `opts.grid` grid over the search
+/// coordinates of C_m, β_m and C_h (those of `fit_spectrum`, §12; the rest of the skin is
+/// `opts.base`), then [`refine`] of `params` from each of the best `opts.starts` nodes in distinct
+/// basins. Returns the skin with the lowest full-model residual figure and that figure, the shift
+/// left there.
+///
+/// Levenberg–Marquardt from the grid, where `fit_spectrum` runs Nelder–Mead descents: a
+/// least-squares descent follows the residual vector, not only its norm, and reaches the same
+/// optimum in far fewer spectra (BENCHMARKS.md `## Fit`).
+pub(super) fn grid_start(
+    target: &mut impl Target,
+    params: &[Parameter],
+    opts: &FitOptions,
+) -> Result<(SkinParams, f64), FitError> {
+    let skin_of =
+        |x: &[f64; 3]| with_chromophores(&opts.base, search_to_params(x, opts.beta_prior));
+    let mut failure = None;
+    let mut objective = |x: &[f64; 3]| -> f64 {
+        let r = skin_of(x)
+            .map_err(FitError::from)
+            .and_then(|s| target.shifted_residuals(&s));
+        match r {
+            // The penalty keeps nodes outside C_em + C_pm ≤ 0.5 (all mapped onto its edge) last.
+            Ok(r) => r.iter().map(|v| v * v).sum::<f64>() + (10.0 * infeasibility(x)).powi(2),
+            Err(e) => {
+                failure.get_or_insert(e);
+                f64::INFINITY
+            }
+        }
+    };
+    let grid = grid_search(&mut objective, opts.grid);
+    let mut best: Option<(SkinParams, f64)> = None;
+    for x in distinct_starts(&grid, opts.starts) {
+        let refined = refine(target, skin_of(&x)?, params)?;
+        if best.as_ref().is_none_or(|b| refined.1 < b.1) {
+            best = Some(refined);
+        }
+    }
+    let best = best.ok_or_else(|| {
+        failure.unwrap_or_else(|| {
+            FitError::NotEnoughData("no grid node gave a finite residual".to_string())
+        })
+    })?;
+    // The last refinement left the shift at its own optimum.
+    target.reshift(&best.0)?;
     Ok(best)
 }
 
