@@ -5,10 +5,10 @@
 //! the residual figure is the RMS reflectance for a spectrum and ΔE00 for a colour.
 
 use super::{MeasuredOptions, SelectionStep, score, with_candidates};
-use crate::fit::nelder_mead::{distinct_starts, grid_search};
-use crate::fit::{FitError, FitOptions, infeasibility, search_to_params, with_chromophores};
 use crate::fit::least_squares::{LM, LmBudget, minimize};
 use crate::fit::model::{ModelChoice, Parameter};
+use crate::fit::nelder_mead::{distinct_starts, grid_search};
+use crate::fit::{FitError, FitOptions, infeasibility, search_to_params, with_chromophores};
 use skin_optics::SkinParams;
 
 /// Space-mapping rounds of a refinement at most (each one full-model evaluation and one LM run).

@@ -330,7 +330,10 @@ fn grid_start_reaches_the_nelder_mead_starts_optimum() {
         let offset = opts.fit.base.oiliness() * unit;
         let data = MeasuredSpectrum::new(
             lambdas(),
-            m.reflectance().iter().map(|r| (r - offset).max(0.0)).collect(),
+            m.reflectance()
+                .iter()
+                .map(|r| (r - offset).max(0.0))
+                .collect(),
             Some(m.weights().to_vec()),
         )
         .unwrap();
@@ -341,8 +344,16 @@ fn grid_start_reaches_the_nelder_mead_starts_optimum() {
             grid.search_evals + grid.full_evals,
             nm.evaluations + old.search_evals + old.full_evals,
         );
-        eprintln!("{truth:?}: grid RMS {grid_rms:.6} in {grid_spectra}, Nelder–Mead {old_rms:.6} in {old_spectra}");
-        assert!(grid_rms <= old_rms * 1.001, "{truth:?}: {grid_rms} against {old_rms}");
-        assert!(grid_spectra < old_spectra, "{grid_spectra} against {old_spectra}");
+        eprintln!(
+            "{truth:?}: grid RMS {grid_rms:.6} in {grid_spectra}, Nelder–Mead {old_rms:.6} in {old_spectra}"
+        );
+        assert!(
+            grid_rms <= old_rms * 1.001,
+            "{truth:?}: {grid_rms} against {old_rms}"
+        );
+        assert!(
+            grid_spectra < old_spectra,
+            "{grid_spectra} against {old_spectra}"
+        );
     }
 }
