@@ -39,6 +39,14 @@ pub struct MeasuredOptions {
     /// Noise σ of one measured reflectance for the criterion, in (0, 1) (default 0.005: an assumed
     /// repeatability of a d/8 measurement on skin, probe placement included; a knob, not a fact).
     pub noise: f64,
+    /// Convergence tolerance of the refinement in χ² units at `noise`, in [0, 1] (default
+    /// [`CHI2_TOLERANCE`]): a descent step or a space-mapping round that lowers
+    /// χ² = n · rms² / σ² by less than this ends it (0: only the relative tests, the descent to
+    /// the optimiser's precision). The default is 1000× below the χ² change that bounds a
+    /// parameter's 1σ interval (Δχ² = 1) and 3000× below the criterion's charge per parameter
+    /// (ln n); what a descent that crawls along a valley leaves behind at it is measured in
+    /// BENCHMARKS.md `## Fit` (chosen on the explore subjects).
+    pub chi2_tolerance: f64,
     /// Fit ρ_s under SCI (default true); false keeps the base skin's ρ_s.
     pub fit_oiliness: bool,
     /// Starts of the `full` refinement, in [1, [`FULL_STARTS_MAX`]] (default 4): the seed fit's
@@ -66,6 +74,7 @@ impl Default for MeasuredOptions {
             geometry: Geometry::Sce,
             model: ModelChoice::Seed,
             noise: 0.005,
+            chi2_tolerance: CHI2_TOLERANCE,
             fit_oiliness: true,
             full_starts: FULL_STARTS_MAX,
             screened_trials: SCREENED_TRIALS,
@@ -84,6 +93,13 @@ impl MeasuredOptions {
                 name: "noise",
                 value: self.noise,
                 range: "(0, 1)",
+            });
+        }
+        if !(0.0..=1.0).contains(&self.chi2_tolerance) {
+            return Err(FitError::Option {
+                name: "chi2_tolerance",
+                value: self.chi2_tolerance,
+                range: "[0, 1]",
             });
         }
         if !(1..=FULL_STARTS_MAX).contains(&self.full_starts) {
@@ -211,6 +227,9 @@ pub fn fit_measured(
 /// Most starts of the `full` refinement ([`MeasuredOptions::full_starts`]).
 pub const FULL_STARTS_MAX: usize = 4;
 
+/// Default [`MeasuredOptions::chi2_tolerance`].
+pub const CHI2_TOLERANCE: f64 = 1e-3;
+
 /// Default [`MeasuredOptions::full_refined_starts`].
 pub const FULL_REFINED_STARTS: usize = 1;
 
@@ -285,6 +304,7 @@ impl<'a> Problem<'a> {
             .iter()
             .map(|&nm| Wavelength::new(nm))
             .collect::<Result<Vec<_>, _>>()?;
+        let lambdas_len = lambdas.len();
         Ok(Self {
             measured,
             shift: vec![0.0; lambdas.len()],
@@ -296,7 +316,11 @@ impl<'a> Problem<'a> {
             weight_sum: measured.weights().iter().sum(),
             full_evals: 0,
             search_evals: 0,
-            budget: LM,
+            // The cost is the weighted mean square, χ² σ² / n.
+            budget: LmBudget {
+                f_atol: opts.chi2_tolerance * opts.noise * opts.noise / lambdas_len as f64,
+                ..LM
+            },
         })
     }
 

@@ -58,8 +58,9 @@ mod spectrum;
 pub use colour::{ColourFit, ColourModel, fit_colour};
 pub use error::FitError;
 pub use extended::{
-    AT_BOUND_FRACTION, FULL_REFINED_STARTS, FULL_STARTS_MAX, MeasuredColourFit, MeasuredFit,
-    MeasuredOptions, SCREENED_TRIALS, SelectionStep, fit_measured, fit_measured_colour,
+    AT_BOUND_FRACTION, CHI2_TOLERANCE, FULL_REFINED_STARTS, FULL_STARTS_MAX, MeasuredColourFit,
+    MeasuredFit, MeasuredOptions, SCREENED_TRIALS, SelectionStep, fit_measured,
+    fit_measured_colour,
 };
 pub use geometry::Geometry;
 pub use measured::{MAX_NM, MIN_NM, MIN_POINTS, MeasuredSpectrum};

@@ -54,6 +54,10 @@ pub struct FitArgs {
     /// Noise σ of one measured reflectance, for `--model auto`'s criterion, in (0, 1).
     #[arg(long, value_name = "SIGMA", default_value_t = 0.005)]
     pub noise: f64,
+    /// Convergence tolerance of a spectrum fit's refinement, in χ² units at --noise, in [0, 1]
+    /// (0: refine to the optimiser's precision).
+    #[arg(long = "chi2-tolerance", value_name = "CHI2", default_value_t = multipole::fit::CHI2_TOLERANCE)]
+    pub chi2_tolerance: f64,
     /// Wavelength step of the model spectrum behind a colour, nm, in [0.01, 100].
     #[arg(long = "step-nm", value_name = "NM", default_value_t = 10.0, value_parser = Checked(parse_step), allow_hyphen_values = true)]
     pub step_nm: f64,
@@ -237,6 +241,7 @@ fn measured_options(args: &FitArgs, fit: FitOptions) -> MeasuredOptions {
         geometry: args.geometry,
         model: args.model,
         noise: args.noise,
+        chi2_tolerance: args.chi2_tolerance,
         fit,
         ..MeasuredOptions::default()
     }

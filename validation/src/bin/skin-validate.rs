@@ -177,6 +177,10 @@ struct MeasuredArgs {
     /// Noise σ of one reflectance for the criterion, (0, 1).
     #[arg(long, default_value_t = 0.005)]
     noise: f64,
+    /// Convergence tolerance of the refinement, χ² units at --noise, [0, 1] (0: to the optimiser's
+    /// precision).
+    #[arg(long, default_value_t = multipole::fit::CHI2_TOLERANCE)]
+    chi2_tolerance: f64,
     /// Fit at most this many records, spread evenly over the subset.
     #[arg(long)]
     limit: Option<usize>,
@@ -257,6 +261,7 @@ fn run_measured(args: &MeasuredArgs) -> anyhow::Result<()> {
         geometry: args.geometry,
         model: args.model,
         noise: args.noise,
+        chi2_tolerance: args.chi2_tolerance,
         full_starts: args.full_starts,
         screened_trials: args.screened_trials,
         full_refined_starts: args.full_refined_starts,

@@ -87,13 +87,16 @@ pub(super) fn refine(
         let (next, jac) = run(target, best.0, params, budget, std::mem::take(&mut warm))?;
         let r = target.reshift(&next)?;
         let gain = best.1 - r;
+        let cost_gain = best.1 * best.1 - r * r;
         if r < best.1 {
             best = (next, r);
             warm = jac;
         } else {
             target.reshift(&best.0)?;
         }
-        if !target.has_search() || gain <= 1e-3 * best.1 {
+        // A round that lowers the figure by less than 0.1 %, or its square (the descent's cost)
+        // by less than the descent's absolute floor, ends the mapping.
+        if !target.has_search() || gain <= 1e-3 * best.1 || cost_gain <= budget.f_atol {
             break;
         }
     }
