@@ -39,6 +39,18 @@ fn epidermal_blood_skin() -> SkinParams {
         .with_physiology(x)
 }
 
+/// The largest difference between the full-model spectra that `problem` sees for `a` and `b`.
+fn worst_difference(problem: &mut Problem, a: &SkinParams, b: &SkinParams) -> f64 {
+    let (ma, mb) = (
+        problem.full_model(a).unwrap(),
+        problem.full_model(b).unwrap(),
+    );
+    ma.iter()
+        .zip(&mb)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max)
+}
+
 fn options(model: ModelChoice, noise: f64) -> MeasuredOptions {
     MeasuredOptions {
         geometry: Geometry::Sci,
@@ -302,15 +314,7 @@ fn broyden_lands_on_the_reference_optimum() {
     let mut reference = Problem::new(&m, &opts, unit).unwrap();
     reference.budget = crate::fit::least_squares::LM_REFERENCE;
     let b = select::refine(&mut reference, start, &params).unwrap();
-    let (ma, mb) = (
-        reference.full_model(&a.0).unwrap(),
-        reference.full_model(&b.0).unwrap(),
-    );
-    let worst = ma
-        .iter()
-        .zip(&mb)
-        .map(|(x, y)| (x - y).abs())
-        .fold(0.0, f64::max);
+    let worst = worst_difference(&mut reference, &a.0, &b.0);
     let msg = format!(
         "rms {} vs {}, worst spectral difference {worst:.2e}, search evaluations {} vs {}",
         a.1, b.1, fast.search_evals, reference.search_evals
@@ -397,15 +401,7 @@ fn chi2_tolerance_ends_near_the_precise_optimum_in_fewer_spectra() {
     let b = select::refine(&mut reference, start, &params).unwrap();
     let n = m.len() as f64;
     let delta_chi2 = n * (a.1 * a.1 - b.1 * b.1) / (sigma * sigma);
-    let (ma, mb) = (
-        reference.full_model(&a.0).unwrap(),
-        reference.full_model(&b.0).unwrap(),
-    );
-    let worst = ma
-        .iter()
-        .zip(&mb)
-        .map(|(x, y)| (x - y).abs())
-        .fold(0.0, f64::max);
+    let worst = worst_difference(&mut reference, &a.0, &b.0);
     let msg = format!(
         "rms {} vs {} (Δχ² {delta_chi2:.3}), worst spectral difference {worst:.2e}, search \
          evaluations {} vs {}",
