@@ -51,6 +51,32 @@ fn worst_difference(problem: &mut Problem, a: &SkinParams, b: &SkinParams) -> f6
         .fold(0.0, f64::max)
 }
 
+/// Noise σ of the eleven-parameter refinement tests' spectrum.
+const REFINE_SIGMA: f64 = 0.002;
+
+/// The eleven-parameter refinement tests' case: the epidermal-blood skin's SCI spectrum with
+/// noise [`REFINE_SIGMA`], `full` options at `chi2_tolerance`, the unit surface reflectance, every
+/// parameter, and the usual start.
+fn refine_case(
+    chi2_tolerance: f64,
+) -> (
+    MeasuredSpectrum,
+    MeasuredOptions,
+    f64,
+    Vec<Parameter>,
+    SkinParams,
+) {
+    let m = synthetic_sci(&epidermal_blood_skin(), REFINE_SIGMA, 7);
+    let opts = MeasuredOptions {
+        chi2_tolerance,
+        ..options(ModelChoice::Full, REFINE_SIGMA)
+    };
+    let unit = unit_surface_reflectance(opts.fit.base.eta()).unwrap();
+    let params = with_candidates(&seed_parameters(&opts));
+    let start = SkinParams::new(0.03, 0.5, 0.01, 0.3).unwrap();
+    (m, opts, unit, params, start)
+}
+
 fn options(model: ModelChoice, noise: f64) -> MeasuredOptions {
     MeasuredOptions {
         geometry: Geometry::Sci,
@@ -298,17 +324,9 @@ fn full_is_no_worse_than_seed_and_bounds_are_flagged() {
 /// message), while the accelerated descent spends fewer than 70 % of the evaluations.
 #[test]
 fn broyden_lands_on_the_reference_optimum() {
-    let sigma = 0.002;
-    let skin = epidermal_blood_skin();
-    let m = synthetic_sci(&skin, sigma, 7);
+    let sigma = REFINE_SIGMA;
     // Both descents to the optimiser's precision.
-    let opts = MeasuredOptions {
-        chi2_tolerance: 0.0,
-        ..options(ModelChoice::Full, sigma)
-    };
-    let unit = unit_surface_reflectance(opts.fit.base.eta()).unwrap();
-    let params = with_candidates(&seed_parameters(&opts));
-    let start = SkinParams::new(0.03, 0.5, 0.01, 0.3).unwrap();
+    let (m, opts, unit, params, start) = refine_case(0.0);
     let mut fast = Problem::new(&m, &opts, unit).unwrap();
     let a = select::refine(&mut fast, start, &params).unwrap();
     let mut reference = Problem::new(&m, &opts, unit).unwrap();
@@ -385,16 +403,12 @@ fn grid_start_reaches_the_nelder_mead_starts_optimum() {
 /// (measured: see the message).
 #[test]
 fn chi2_tolerance_ends_near_the_precise_optimum_in_fewer_spectra() {
-    let sigma = 0.002;
-    let m = synthetic_sci(&epidermal_blood_skin(), sigma, 7);
-    let opts = options(ModelChoice::Full, sigma);
+    let sigma = REFINE_SIGMA;
+    let (m, opts, unit, params, start) = refine_case(CHI2_TOLERANCE);
     let precise = MeasuredOptions {
         chi2_tolerance: 0.0,
         ..opts
     };
-    let unit = unit_surface_reflectance(opts.fit.base.eta()).unwrap();
-    let params = with_candidates(&seed_parameters(&opts));
-    let start = SkinParams::new(0.03, 0.5, 0.01, 0.3).unwrap();
     let mut stopped = Problem::new(&m, &opts, unit).unwrap();
     let a = select::refine(&mut stopped, start, &params).unwrap();
     let mut reference = Problem::new(&m, &precise, unit).unwrap();
@@ -419,14 +433,7 @@ fn chi2_tolerance_ends_near_the_precise_optimum_in_fewer_spectra() {
 /// (measured: see the message).
 #[test]
 fn extended_steps_reach_plain_descents_optimum_in_fewer_spectra() {
-    let sigma = 0.002;
-    let m = synthetic_sci(&epidermal_blood_skin(), sigma, 7);
-    let opts = MeasuredOptions {
-        chi2_tolerance: 0.0,
-        ..options(ModelChoice::Full, sigma)
-    };
-    let unit = unit_surface_reflectance(opts.fit.base.eta()).unwrap();
-    let params = with_candidates(&seed_parameters(&opts));
+    let (m, opts, unit, params, _) = refine_case(0.0);
     for (i, start) in [[0.03, 0.5, 0.01, 0.3], [0.1, 0.2, 0.05, 0.8]]
         .into_iter()
         .enumerate()
