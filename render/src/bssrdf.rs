@@ -9,9 +9,9 @@
 //! keeps every hit on the entry point's material along the segment, picks one uniformly (and
 //! multiplies by the hit count) and returns the spatial weight R(r) · N / pdf per wavelength, with
 //! spectral MIS (one-sample balance heuristic over the path's wavelengths, [Wilkie et al. 2014],
-//! pbrt-v4): each wavelength's density is computed with its own profile and the weight divides by
-//! their mean, which is unbiased because the hero is any of the stratified wavelengths with equal
-//! probability.
+//! pbrt-v4): each wavelength's density is computed with its own profile, the radius's wavelength is
+//! chosen mostly by the lanes' shares of the luminance ([`RadiusWavelength`]) and the weight
+//! divides by the mixture of the lanes' densities with those probabilities.
 //!
 //! # Where probes find no surface
 //! On a flat surface only normal-axis probes find points (the tangent probes' MIS density there
@@ -40,13 +40,13 @@ pub mod sampling;
 pub mod separable;
 pub mod table;
 
-pub use sampling::{ProbeAxes, ProbeFrame, pdf_exit, probe};
+pub use sampling::{ProbeAxes, ProbeFrame, RadiusWavelength, pdf_exit, probe};
 pub use separable::{Directional, EnergySplit, texture_modulation};
-pub use table::{ProfileTable, RENDER_SHAPE_ESCAPES, RENDER_SHAPE_STEP_NM, TableOptions};
+pub use table::{ProfileTable, RENDER_SHAPE_ESCAPES, RENDER_SHAPE_STEP_NM, RowsAt, TableOptions};
 
 use crate::accel::ray;
 use crate::geometry::{Geometry, SurfaceHit};
-use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use crate::spectrum::{N_WAVELENGTHS, SampledSpectrum, SampledWavelengths};
 use glam::Vec3;
 use std::sync::Arc;
 
@@ -58,6 +58,9 @@ pub const MAX_PROBE_HITS: usize = 32;
 /// separates them is always found; the chords stray inside the arc by at most
 /// r (1 − cos(π / 32)) ≈ 0.5% of r.
 pub const ARC_SEGMENTS: usize = 8;
+
+/// The profile table resolved at a path's wavelengths, one entry per lane.
+type Lanes<'a> = [Option<RowsAt<'a>>; N_WAVELENGTHS];
 
 /// The subsurface model of one skin material.
 #[derive(Debug, Clone)]
@@ -90,21 +93,43 @@ impl Subsurface {
         Self { table, directional }
     }
 
-    /// The mean of the active wavelengths' values of `f(nm)` (the spectral MIS density).
-    fn mean_over_wavelengths(wl: &SampledWavelengths, f: impl Fn(f32) -> f32) -> f32 {
-        let pdf = wl.pdf();
-        let (mut sum, mut n) = (0.0, 0);
-        for (k, &p) in pdf.iter().enumerate() {
-            if p > 0.0 {
-                sum += f(wl.nm(k));
-                n += 1;
-            }
-        }
-        if n == 0 { 0.0 } else { sum / n as f32 }
+    /// The table resolved at each active lane's wavelength (`None` for a terminated lane).
+    fn lanes(&self, wl: &SampledWavelengths) -> Lanes<'_> {
+        std::array::from_fn(|k| (wl.pdf()[k] > 0.0).then(|| self.table.at(wl.nm(k))))
+    }
+
+    /// The lane probabilities of the radius wavelength under `radius` (luminance weight
+    /// ȳ/p · R_tot per active lane).
+    fn lane_probabilities(
+        wl: &SampledWavelengths,
+        lanes: &Lanes<'_>,
+        radius: RadiusWavelength,
+    ) -> [f32; N_WAVELENGTHS] {
+        let y = wl.luminance_weights();
+        radius.probabilities(std::array::from_fn(|k| {
+            y[k].zip(lanes[k]).map(|(w, at)| w * at.total())
+        }))
+    }
+
+    /// Σ_j c_j pdf_area_j(r_mm): the mixture of the lanes' planar densities, mm⁻² (spectral MIS).
+    fn mixture(&self, lanes: &Lanes<'_>, c: &[f32; N_WAVELENGTHS], r_mm: f32) -> f32 {
+        let r = self.table.eval_each(lanes, r_mm);
+        (0..N_WAVELENGTHS)
+            .filter_map(|k| {
+                let total = lanes[k]?.total();
+                (c[k] > 0.0 && total > 0.0).then(|| c[k] * r[k] / total)
+            })
+            .sum()
+    }
+
+    /// The spatial weight R_k(r_mm) · `scale` per active lane.
+    fn weight(&self, lanes: &Lanes<'_>, r_mm: f32, scale: f32) -> SampledSpectrum {
+        SampledSpectrum(self.table.eval_each(lanes, r_mm).map(|r| r * scale))
     }
 
     /// Sample where light that leaves at `p_o` (outward frame `frame`, on material `material`)
-    /// entered, from four uniforms, choosing probe axes by `axes`; `flipped` tells that the entry frame faces against the mesh's
+    /// entered, from four uniforms, choosing probe axes by `axes` and the radius's wavelength by
+    /// `radius`; `flipped` tells that the entry frame faces against the mesh's
     /// vertex normals (a viewer inside the mesh), so exit normals are flipped alike; `rays` counts
     /// probe rays. None when the probe found nothing
     /// usable (a tangent probe missing is expected and unbiased, see the module doc).
@@ -117,13 +142,22 @@ impl Subsurface {
         p_o: Vec3,
         frame: &ProbeFrame,
         axes: &ProbeAxes,
+        radius: RadiusWavelength,
         flipped: bool,
         wl: &SampledWavelengths,
         u: [f32; 4],
         rays: &mut u64,
     ) -> Option<Exit> {
-        let hero = wl.nm(0);
-        let (axis, _) = axes.choose(u[0]);
+        let (axis, u_lane) = axes.choose(u[0]);
+        let lanes = self.lanes(wl);
+        let c = Self::lane_probabilities(wl, &lanes, radius);
+        // The uniform choice keeps the hero (lane 0), which is already uniform over the lanes.
+        let lane = if radius == RadiusWavelength::HERO {
+            0
+        } else {
+            RadiusWavelength::choose(&c, u_lane)
+        };
+        let hero = wl.nm(lane);
         let r_max = self.table.r_max_mm(hero);
         let r = self.table.sample_radius(hero, u[1]);
         if r_max.is_nan() || r_max <= 0.0 {
@@ -160,7 +194,7 @@ impl Subsurface {
             if self.skin_at_distance(geometry, material, p_o, frame.n, planar, rays) {
                 return None;
             }
-            return Some(self.local_fallback(p_o, frame, axes, r, wl));
+            return Some(self.local_fallback(p_o, frame, axes, &lanes, &c, r));
         }
         let pick = ((u[3] * m as f32) as usize).min(m - 1);
         let (t, triangle, bary) = hits[pick];
@@ -172,20 +206,11 @@ impl Subsurface {
             (s.ng, s.ns)
         };
         let dist = (s.p - p_o).length();
-        let pdf = Self::mean_over_wavelengths(wl, |nm| {
-            pdf_exit(axes, frame, p_o, s.p, ng, |ra| self.table.pdf_area(nm, ra))
-        });
+        let pdf = pdf_exit(axes, frame, p_o, s.p, ng, |ra| self.mixture(&lanes, &c, ra));
         if pdf.is_nan() || pdf <= 0.0 {
             return None;
         }
-        let scale = m as f32 / pdf;
-        let weight = SampledSpectrum(std::array::from_fn(|k| {
-            if wl.pdf()[k] > 0.0 {
-                self.table.eval(wl.nm(k), dist) * scale
-            } else {
-                0.0
-            }
-        }));
+        let weight = self.weight(&lanes, dist, m as f32 / pdf);
         Some(Exit {
             p: s.p,
             ng,
@@ -236,19 +261,13 @@ impl Subsurface {
         p_o: Vec3,
         frame: &ProbeFrame,
         axes: &ProbeAxes,
+        lanes: &Lanes<'_>,
+        c: &[f32; N_WAVELENGTHS],
         r: f32,
-        wl: &SampledWavelengths,
     ) -> Exit {
-        let pdf =
-            axes.p_normal() * Self::mean_over_wavelengths(wl, |nm| self.table.pdf_area(nm, r));
+        let pdf = axes.p_normal() * self.mixture(lanes, c, r);
         let weight = if pdf > 0.0 {
-            SampledSpectrum(std::array::from_fn(|k| {
-                if wl.pdf()[k] > 0.0 {
-                    self.table.eval(wl.nm(k), r) / pdf
-                } else {
-                    0.0
-                }
-            }))
+            self.weight(lanes, r, 1.0 / pdf)
         } else {
             SampledSpectrum::zero()
         };
@@ -303,6 +322,17 @@ mod tests {
     /// The default axis choice (normal ½).
     const AXES: ProbeAxes = ProbeAxes::DEFAULT;
 
+    /// Radius-wavelength choices every unbiasedness check runs with: each lane alike, the
+    /// renderer's, and a nearly pure luminance choice (the rarest lanes chosen 0.5% of the time).
+    const RADIUS_CHOICES: [RadiusWavelength; 3] = [
+        RadiusWavelength::HERO,
+        RadiusWavelength::RENDER,
+        match RadiusWavelength::new(0.02) {
+            Some(r) => r,
+            None => RadiusWavelength::HERO,
+        },
+    ];
+
     /// χ² of the sampled exit distance on a flat slab against the multipole profile's own radial
     /// density 2πr R(r) / R_table (20 equiprobable bins from `multipole::Profile::sample_radius`,
     /// 19 degrees of freedom: 45.3 is the p = 0.0005 critical value). Also: normal probes on a
@@ -332,9 +362,18 @@ mod tests {
         let (mut hits, mut rays) = (0u32, 0u64);
         for _ in 0..120_000 {
             let u = [rng.random(), rng.random(), rng.random(), rng.random()];
-            if let Some(e) =
-                ss.sample_exit(&geo, 0, Vec3::ZERO, &FRAME, &AXES, false, &wl, u, &mut rays)
-            {
+            if let Some(e) = ss.sample_exit(
+                &geo,
+                0,
+                Vec3::ZERO,
+                &FRAME,
+                &AXES,
+                RadiusWavelength::HERO,
+                false,
+                &wl,
+                u,
+                &mut rays,
+            ) {
                 assert!(e.hit.is_some(), "fallback on an infinite plane");
                 let r = f64::from(e.p.length());
                 counts[edges.partition_point(|&x| x < r)] += 1;
@@ -363,6 +402,7 @@ mod tests {
         u0: f32,
         n: u32,
         seed: u64,
+        radius: RadiusWavelength,
     ) -> Vec<(f32, f64, f64)> {
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
         let base = SampledWavelengths::sample_visible(u0);
@@ -372,9 +412,18 @@ mod tests {
         for s in 0..n {
             let wl = SampledWavelengths::sample_visible((u0 + (s % 4) as f32 * 0.25).fract());
             let u = [rng.random(), rng.random(), rng.random(), rng.random()];
-            if let Some(e) =
-                ss.sample_exit(geo, 0, Vec3::ZERO, &FRAME, &AXES, false, &wl, u, &mut rays)
-            {
+            if let Some(e) = ss.sample_exit(
+                geo,
+                0,
+                Vec3::ZERO,
+                &FRAME,
+                &AXES,
+                radius,
+                false,
+                &wl,
+                u,
+                &mut rays,
+            ) {
                 for c in 0..4 {
                     let slot = acc
                         .iter_mut()
@@ -405,12 +454,14 @@ mod tests {
         let geo = slab();
         for preset in [Preset::Light, Preset::Dark] {
             let ss = subsurface(preset);
-            for (nm, mean, se) in mean_weights(&ss, &geo, 0.37, 40_000, 5) {
-                let want = f64::from(ss.table.total(nm));
-                assert!(
-                    (mean - want).abs() < 4.0 * se + 1e-3 * want,
-                    "{preset:?} {nm} nm: {mean:.4} ± {se:.4} vs R_tot {want:.4}"
-                );
+            for radius in RADIUS_CHOICES {
+                for (nm, mean, se) in mean_weights(&ss, &geo, 0.37, 40_000, 5, radius) {
+                    let want = f64::from(ss.table.total(nm));
+                    assert!(
+                        (mean - want).abs() < 4.0 * se + 1e-3 * want,
+                        "{preset:?} {radius:?} {nm} nm: {mean:.4} ± {se:.4} vs R_tot {want:.4}"
+                    );
+                }
             }
         }
     }
@@ -423,12 +474,14 @@ mod tests {
         let mut q = TriangleMesh::quad();
         q.transform(&Affine3A::from_scale(Vec3::splat(0.05)));
         let geo = Geometry::new(vec![(q, 0)]);
-        for (nm, mean, se) in mean_weights(&ss, &geo, 0.6, 40_000, 9) {
-            let want = f64::from(ss.table.total(nm));
-            assert!(
-                (mean - want).abs() < 4.0 * se + 1e-3 * want,
-                "{nm} nm: {mean:.4} ± {se:.4} vs {want:.4}"
-            );
+        for radius in RADIUS_CHOICES {
+            for (nm, mean, se) in mean_weights(&ss, &geo, 0.6, 40_000, 9, radius) {
+                let want = f64::from(ss.table.total(nm));
+                assert!(
+                    (mean - want).abs() < 4.0 * se + 1e-3 * want,
+                    "{radius:?} {nm} nm: {mean:.4} ± {se:.4} vs {want:.4}"
+                );
+            }
         }
     }
 }

@@ -19,7 +19,9 @@
 //! The sampler's dimension table and the knobs are plain lists of named constants and documented
 //! fields; their shape repeats other such lists (the surface lobe's parameters) by nature.
 
-use crate::bssrdf::{Exit, ProbeAxes, ProbeFrame, Subsurface, texture_modulation};
+use crate::bssrdf::{
+    Exit, ProbeAxes, ProbeFrame, RadiusWavelength, Subsurface, texture_modulation,
+};
 use crate::geometry::SurfaceHit;
 
 use crate::geometry::offset_origin;
@@ -74,6 +76,9 @@ pub struct PathSettings {
     /// Stratify the light choice of the light samples at one exit point (u₀ + j/n) instead of
     /// drawing each from its own uniform.
     pub stratified_exit_lights: bool,
+    /// How the wavelength whose profile draws a probe's radius is chosen (default
+    /// [`RadiusWavelength::RENDER`]: mostly by the lanes' luminance).
+    pub radius_wavelength: RadiusWavelength,
 }
 
 impl Default for PathSettings {
@@ -89,6 +94,7 @@ impl Default for PathSettings {
             split_subsurface: true,
             subsurface_probes: 2,
             stratified_exit_lights: false,
+            radius_wavelength: RadiusWavelength::RENDER,
         }
     }
 }
@@ -242,6 +248,7 @@ fn subsurface_exit(
         si.p,
         &frame,
         &settings.probe_axes,
+        settings.radius_wavelength,
         flipped,
         wl,
         u,

@@ -242,6 +242,16 @@ impl SampledWavelengths {
         self.pdf[0] /= N_WAVELENGTHS as f32;
     }
 
+    /// Each active lane's weight in the luminance estimate, ȳ(λ_i) / p(λ_i) (nm; `None` once
+    /// terminated): what [`Self::to_xyz`] multiplies the lane's radiance by for Y, up to a constant.
+    #[must_use]
+    pub fn luminance_weights(&self) -> [Option<f32>; N_WAVELENGTHS] {
+        let table = cmf_table();
+        std::array::from_fn(|i| {
+            (self.pdf[i] > 0.0).then(|| table.at(self.lambda_nm[i])[1] / self.pdf[i])
+        })
+    }
+
     /// Monte Carlo estimate of CIE XYZ from radiance `l` at these wavelengths, normalised so a
     /// constant spectral radiance 1 has Y = 1: XYZ = ∫ L {x̄,ȳ,z̄} dλ / ∫ ȳ dλ.
     #[must_use]

@@ -9,7 +9,7 @@
 //! better) and the ratio of two variants' figures squared is their speed-up at equal noise.
 
 use cpu_time::ProcessTime;
-use render::bssrdf::ProbeAxes;
+use render::bssrdf::{ProbeAxes, RadiusWavelength};
 use render::integrator::PathSettings;
 use render::noise::relative_noise_where;
 use render::passes::Passes;
@@ -17,7 +17,7 @@ use render::plot::{LineChart, Panel, Series, SeriesStyle, save_png};
 use render::renderer::{RenderOptions, render};
 use render::sampler::SamplerKind;
 use render::scene::Scene;
-use render::spectrum::WavelengthSampling;
+use render::spectrum::{WavelengthSampling, xyz_to_linear_srgb};
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -32,8 +32,9 @@ pub struct Variant {
 
 /// The steps in the order they were added, each on top of the one before (the first is the
 /// renderer before any of them), then two other normal-probe probabilities on top of the fourth,
-/// then the splitting candidates on top of the seventh: the tenth (two probes per skin hit) is
-/// today's default.
+/// then the splitting candidates on top of the seventh, then the radius wavelength's choice on
+/// top of the tenth (two probes per skin hit): the seventeenth (by luminance, uniform share 0.1)
+/// is today's default.
 #[must_use]
 pub fn variants() -> Vec<Variant> {
     let before = PathSettings {
@@ -44,6 +45,7 @@ pub fn variants() -> Vec<Variant> {
         split_subsurface: false,
         subsurface_probes: 1,
         stratified_exit_lights: false,
+        radius_wavelength: RadiusWavelength::HERO,
         ..PathSettings::default()
     };
     let sobol = PathSettings {
@@ -69,6 +71,14 @@ pub fn variants() -> Vec<Variant> {
     let pair = PathSettings {
         sampler: SamplerKind::SobolPair,
         ..two_lights
+    };
+    let two_probes = PathSettings {
+        subsurface_probes: 2,
+        ..pair
+    };
+    let share = |s: f32| PathSettings {
+        radius_wavelength: RadiusWavelength::new(s).unwrap_or_default(),
+        ..two_probes
     };
     [
         ("before (independent + uniform λ)", before),
@@ -144,6 +154,31 @@ pub fn variants() -> Vec<Variant> {
                 ..pair
             },
         ),
+        ("+ radius wavelength by luminance", share(0.1)),
+        ("radius wavelength, uniform share 0.5", share(0.5)),
+        ("radius wavelength, uniform share 0.25", share(0.25)),
+        ("radius wavelength, uniform share 0.02", share(0.02)),
+        (
+            "luminance radius, 3 probes",
+            PathSettings {
+                subsurface_probes: 3,
+                ..share(0.1)
+            },
+        ),
+        (
+            "luminance radius, 1 probe",
+            PathSettings {
+                subsurface_probes: 1,
+                ..share(0.1)
+            },
+        ),
+        (
+            "luminance radius, stratified exit light choice",
+            PathSettings {
+                stratified_exit_lights: true,
+                ..share(0.1)
+            },
+        ),
     ]
     .into_iter()
     .map(|(name, path)| Variant { name, path })
@@ -165,6 +200,9 @@ pub struct Point {
     pub noise_skin: f64,
     /// The same over lit non-skin pixels.
     pub noise_other: f64,
+    /// The same metric on the linear sRGB red and blue channels over the skin pixels lit in
+    /// that channel (the colour speckle the luminance figure does not see).
+    pub noise_skin_rb: [f64; 2],
 }
 
 impl Point {
@@ -190,6 +228,7 @@ pub fn measure(
     skin: &[f32],
 ) -> anyhow::Result<Point> {
     let mut lum = Vec::new();
+    let mut red_blue: Vec<[Vec<f64>; 2]> = Vec::new();
     let (mut cpu, mut wall) = (0.0, 0.0);
     for seed in [1, 2] {
         let settings = RenderOptions {
@@ -211,7 +250,13 @@ pub fn measure(
                 .map(|i| f64::from(film.xyz(i % width, i / width)[1]))
                 .collect::<Vec<f64>>(),
         );
+        red_blue.push([0, 2].map(|c| {
+            (0..width * height)
+                .map(|i| f64::from(xyz_to_linear_srgb(film.xyz(i % width, i / width))[c]))
+                .collect()
+        }));
     }
+    let skin_channel = |c: usize| masked_noise(&red_blue[0][c], &red_blue[1][c], |i| skin[i] > 0.5);
     Ok(Point {
         spp,
         cpu_s: 0.5 * cpu,
@@ -219,6 +264,7 @@ pub fn measure(
         noise: masked_noise(&lum[0], &lum[1], |_| true),
         noise_skin: masked_noise(&lum[0], &lum[1], |i| skin[i] > 0.5),
         noise_other: masked_noise(&lum[0], &lum[1], |i| skin[i] <= 0.5),
+        noise_skin_rb: [skin_channel(0), skin_channel(1)],
     })
 }
 
@@ -299,12 +345,14 @@ pub fn run(
         for &spp in spps {
             let p = measure(scene, size, spp, threads, v.path, &skin)?;
             eprintln!(
-                "{:<34} {spp:>5} spp: {:7.1} CPU s, noise {:6.2}% (skin {:.2}%, other {:.2}%), noise·√CPU-s {:.4}",
+                "{:<34} {spp:>5} spp: {:7.1} CPU s, noise {:6.2}% (skin {:.2}%, other {:.2}%; skin red {:.2}%, blue {:.2}%), noise·√CPU-s {:.4}",
                 v.name,
                 p.cpu_s,
                 100.0 * p.noise,
                 100.0 * p.noise_skin,
                 100.0 * p.noise_other,
+                100.0 * p.noise_skin_rb[0],
+                100.0 * p.noise_skin_rb[1],
                 p.efficiency()
             );
             rows.push((v.name, p));
@@ -332,19 +380,22 @@ pub fn run(
 }
 
 fn write_csv(path: &Path, rows: &[(&'static str, Point)]) -> anyhow::Result<()> {
-    let mut s =
-        String::from("variant,spp,cpu_s,wall_s,noise,noise_skin,noise_other,noise_sqrt_cpu_s\n");
+    let mut s = String::from(
+        "variant,spp,cpu_s,wall_s,noise,noise_skin,noise_other,noise_sqrt_cpu_s,noise_skin_red,noise_skin_blue\n",
+    );
     for (name, p) in rows {
         writeln!(
             s,
-            "{name},{},{:.3},{:.3},{:.6},{:.6},{:.6},{:.6}",
+            "{name},{},{:.3},{:.3},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6}",
             p.spp,
             p.cpu_s,
             p.wall_s,
             p.noise,
             p.noise_skin,
             p.noise_other,
-            p.efficiency()
+            p.efficiency(),
+            p.noise_skin_rb[0],
+            p.noise_skin_rb[1]
         )?;
     }
     render::atomic::write_bytes(path, s.as_bytes())?;

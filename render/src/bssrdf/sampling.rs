@@ -83,6 +83,94 @@ impl ProbeAxes {
     }
 }
 
+/// How the wavelength whose profile draws a probe's radius is chosen among a path's wavelengths:
+/// lane j with probability c_j = s / n + (1 − s) w_j / Σ w, n the active lanes, w_j the lane's
+/// share of the pixel's luminance (ȳ(λ_j) / p(λ_j) · R_tot(λ_j)) and s the uniform share. The exit
+/// density is then the mixture Σ c_j pdf_j (one-sample MIS, balance heuristic; docs/physics.md §8):
+/// at s = 0 the luminance of the spatial weight, Σ_k w_k R_k(r) / Σ_j c_j pdf_j(r), is the same
+/// constant at every radius, so a pixel's luminance keeps only the variance of the light at the
+/// exit points. Any s > 0 keeps every lane's profile reachable.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RadiusWavelength {
+    uniform_share: f32,
+}
+
+impl Default for RadiusWavelength {
+    fn default() -> Self {
+        Self::RENDER
+    }
+}
+
+impl RadiusWavelength {
+    /// Every lane alike (the hero's profile, as in pbrt-v4: the hero is any lane with equal chance).
+    pub const HERO: Self = Self { uniform_share: 1.0 };
+    /// The renderer's default uniform share, [`RENDER_UNIFORM_SHARE`].
+    pub const RENDER: Self = Self {
+        uniform_share: RENDER_UNIFORM_SHARE,
+    };
+
+    /// The choice with uniform share `s` in (0, 1] (None outside).
+    #[must_use]
+    pub const fn new(s: f32) -> Option<Self> {
+        if s > 0.0 && s <= 1.0 {
+            Some(Self { uniform_share: s })
+        } else {
+            None
+        }
+    }
+
+    /// The uniform share s.
+    #[must_use]
+    pub fn uniform_share(&self) -> f32 {
+        self.uniform_share
+    }
+
+    /// The lane probabilities c_j from the lanes' luminance weights (`None` for an inactive lane):
+    /// uniform over the active lanes when the weights sum to 0 or are not finite.
+    #[must_use]
+    pub fn probabilities<const N: usize>(&self, weights: [Option<f32>; N]) -> [f32; N] {
+        let n = weights.iter().flatten().count();
+        if n == 0 {
+            return [0.0; N];
+        }
+        let total: f32 = weights.iter().flatten().sum();
+        let s = if total > 0.0 && total.is_finite() {
+            self.uniform_share
+        } else {
+            1.0
+        };
+        weights.map(|w| {
+            w.map_or(0.0, |w| {
+                let lum = if s < 1.0 { w / total } else { 0.0 };
+                s / n as f32 + (1.0 - s) * lum
+            })
+        })
+    }
+
+    /// The lane chosen by `u` in [0, 1) from probabilities `c` (the last active lane for u → 1).
+    #[must_use]
+    pub fn choose<const N: usize>(c: &[f32; N], u: f32) -> usize {
+        let mut acc = 0.0;
+        let mut last = 0;
+        for (j, &p) in c.iter().enumerate() {
+            if p > 0.0 {
+                acc += p;
+                last = j;
+                if u < acc {
+                    return j;
+                }
+            }
+        }
+        last
+    }
+}
+
+/// Uniform share of the renderer's radius-wavelength choice ([`RadiusWavelength`]): of 1, 0.5,
+/// 0.25, 0.1 and 0.02 on the default scene at 16 spp, 0.1 gave the least luminance noise on skin
+/// at equal CPU time (1.45× the variance ratio of 1) with the blue channel 7% noisier and the red
+/// 13% less (BENCHMARKS.md, "Image noise: the radius wavelength").
+pub const RENDER_UNIFORM_SHARE: f32 = 0.1;
+
 /// An orthonormal shading frame at the entry point (world space; `n` = outward normal).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ProbeFrame {

@@ -104,6 +104,22 @@ pub struct ProfileTable {
     rows: Vec<Row>,
 }
 
+/// A table resolved at one wavelength: its two rows, their weights and the mixed total R_tot, for
+/// lookups at several radii without repeating the wavelength's interpolation.
+#[derive(Debug, Clone, Copy)]
+pub struct RowsAt<'a> {
+    rows: [(&'a Row, f32); 2],
+    total: f32,
+}
+
+impl RowsAt<'_> {
+    /// The total diffuse reflectance R_tot at this wavelength, dimensionless.
+    #[must_use]
+    pub fn total(&self) -> f32 {
+        self.total
+    }
+}
+
 /// A wavelength between two rows: lower row index and weight of the upper one.
 #[derive(Debug, Clone, Copy)]
 struct Lerp {
@@ -253,7 +269,17 @@ impl ProfileTable {
     /// The model's total diffuse reflectance R_tot at `nm` (per unit flux entering), dimensionless.
     #[must_use]
     pub fn total(&self, nm: f32) -> f32 {
-        self.mix(nm).iter().map(|(row, w)| w * row.total).sum()
+        self.at(nm).total
+    }
+
+    /// The table resolved at `nm` (for [`ProfileTable::eval_each`]).
+    #[must_use]
+    pub fn at(&self, nm: f32) -> RowsAt<'_> {
+        let rows = self.mix(nm);
+        RowsAt {
+            rows,
+            total: rows.iter().map(|(row, w)| w * row.total).sum(),
+        }
     }
 
     /// Outer radius of the profile at `nm` (its 99.9% energy radius on the grid), mm.
@@ -317,12 +343,22 @@ impl ProfileTable {
     /// R(r) at `nm` and distance `r_mm`, mm⁻² (integrates to [`ProfileTable::total`] over the plane).
     #[must_use]
     pub fn eval(&self, nm: f32, r_mm: f32) -> f32 {
+        self.eval_each(&[Some(self.at(nm))], r_mm)[0]
+    }
+
+    /// R(r) at `r_mm` of each resolved wavelength in `at` (0 for `None`), mm⁻²: at each the value
+    /// of [`ProfileTable::eval`]. All rows share the radius grid, so one search serves them all
+    /// (the profile lookups are a large share of a skin sample's time).
+    #[must_use]
+    pub fn eval_each<const N: usize>(&self, at: &[Option<RowsAt<'_>>; N], r_mm: f32) -> [f32; N] {
         let r = r_mm.max(0.5 * R_MIN_MM);
-        let [(a, wa), (b, wb)] = self.mix(nm);
-        // Both rows share the radius grid, so one search serves both (the profile lookups are a
-        // large share of a skin sample's time).
         let i = self.radii_mm.partition_point(|&x| x < r);
-        (wa * self.row_p_at(a, i, r) + wb * self.row_p_at(b, i, r)) / (2.0 * PI * r)
+        at.map(|at| {
+            at.map_or(0.0, |at| {
+                let [(a, wa), (b, wb)] = at.rows;
+                (wa * self.row_p_at(a, i, r) + wb * self.row_p_at(b, i, r)) / (2.0 * PI * r)
+            })
+        })
     }
 
     /// Density p(r) = 2πr R(r) of one row at `r_mm`, mm⁻¹ (0 beyond the row), as
