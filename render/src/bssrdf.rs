@@ -447,6 +447,26 @@ mod tests {
             .collect()
     }
 
+    /// Under every radius-wavelength choice, each lane's mean spatial weight over 40,000 probes
+    /// is its R_tot within 4 standard errors (plus 0.1% for the table's f32 rounding).
+    fn assert_mean_weights_are_totals(
+        ss: &Subsurface,
+        geo: &Geometry,
+        u0: f32,
+        seed: u64,
+        label: &str,
+    ) {
+        for radius in RADIUS_CHOICES {
+            for (nm, mean, se) in mean_weights(ss, geo, u0, 40_000, seed, radius) {
+                let want = f64::from(ss.table.total(nm));
+                assert!(
+                    (mean - want).abs() < 4.0 * se + 1e-3 * want,
+                    "{label} {radius:?} {nm} nm: {mean:.4} ± {se:.4} vs R_tot {want:.4}"
+                );
+            }
+        }
+    }
+
     /// The spatial weight's mean over probes is R_tot at each of the four wavelengths (spectral MIS
     /// unbiased for the non-hero wavelengths too), within 4 standard errors.
     #[test]
@@ -454,15 +474,7 @@ mod tests {
         let geo = slab();
         for preset in [Preset::Light, Preset::Dark] {
             let ss = subsurface(preset);
-            for radius in RADIUS_CHOICES {
-                for (nm, mean, se) in mean_weights(&ss, &geo, 0.37, 40_000, 5, radius) {
-                    let want = f64::from(ss.table.total(nm));
-                    assert!(
-                        (mean - want).abs() < 4.0 * se + 1e-3 * want,
-                        "{preset:?} {radius:?} {nm} nm: {mean:.4} ± {se:.4} vs R_tot {want:.4}"
-                    );
-                }
-            }
+            assert_mean_weights_are_totals(&ss, &geo, 0.37, 5, &format!("{preset:?}"));
         }
     }
 
@@ -474,14 +486,6 @@ mod tests {
         let mut q = TriangleMesh::quad();
         q.transform(&Affine3A::from_scale(Vec3::splat(0.05)));
         let geo = Geometry::new(vec![(q, 0)]);
-        for radius in RADIUS_CHOICES {
-            for (nm, mean, se) in mean_weights(&ss, &geo, 0.6, 40_000, 9, radius) {
-                let want = f64::from(ss.table.total(nm));
-                assert!(
-                    (mean - want).abs() < 4.0 * se + 1e-3 * want,
-                    "{radius:?} {nm} nm: {mean:.4} ± {se:.4} vs {want:.4}"
-                );
-            }
-        }
+        assert_mean_weights_are_totals(&ss, &geo, 0.6, 9, "patch");
     }
 }
