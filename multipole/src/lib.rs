@@ -3,7 +3,6 @@
 pub mod diffusion;
 pub mod error;
 pub mod exact;
-pub mod fit;
 pub mod layered;
 pub mod sampling;
 pub mod skin;

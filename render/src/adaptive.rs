@@ -39,7 +39,7 @@ pub const MIN_SPP: u32 = 16;
 pub const CALIBRATION_TILE: usize = 16;
 
 /// How the error of a pixel's mean is estimated from its samples (docs/physics.md §17).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum ErrorEstimate {
     /// σ̂²/n from the sample variance (samples independent).
     SampleVariance,

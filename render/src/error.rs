@@ -70,9 +70,9 @@ pub enum RenderError {
         /// The valid range.
         range: &'static str,
     },
-    /// An output could not be written whole (see [`crate::atomic`]).
+    /// An output could not be written whole (see [`skin_io::atomic`]).
     #[error(transparent)]
-    Write(#[from] crate::atomic::AtomicWriteError),
+    Write(#[from] skin_io::atomic::AtomicWriteError),
     /// A render option outside its range (see [`crate::renderer::RenderOptions::validate`]).
     #[error(transparent)]
     Settings(#[from] crate::renderer::SettingError),
@@ -95,6 +95,26 @@ pub enum RenderError {
         /// What went wrong.
         message: String,
     },
+}
+
+impl From<skin_io::input::InputError> for RenderError {
+    fn from(e: skin_io::input::InputError) -> Self {
+        use skin_io::input::InputError;
+        match e {
+            InputError::Unreadable { what, path, source } => {
+                Self::MissingFile { what, path, source }
+            }
+            InputError::Refused {
+                what,
+                path,
+                message,
+            } => Self::Input {
+                what,
+                path,
+                message,
+            },
+        }
+    }
 }
 
 impl RenderError {

@@ -1,8 +1,8 @@
 //! The film: per-pixel CIE XYZ sums, written as linear-sRGB OpenEXR (f32) and as a tone-mapped
-//! sRGB PNG, both through `render::atomic` (unique temporary name, then rename).
+//! sRGB PNG, both through `skin_io::atomic` (unique temporary name, then rename).
 
-use crate::atomic;
 use crate::error::RenderError;
+use skin_io::atomic;
 use std::collections::BTreeMap;
 use std::path::Path;
 

@@ -6,13 +6,13 @@
 //! The geometric passes come from one primary ray through each pixel's centre and the lens
 //! centre, so they are noise-free and exact at the pixel centre (no anti-aliasing).
 
-use crate::atomic;
 use crate::error::RenderError;
 use crate::film::Film;
 use crate::material::Material;
 use crate::scene::{Hit, Scene};
 use crate::spectrum::{linear_srgb_at_nm, xyz_to_linear_srgb};
 use glam::Vec2;
+use skin_io::atomic;
 use std::path::Path;
 
 /// Depth of a pixel that sees nothing, mm.

@@ -1,7 +1,7 @@
 //! Noise-targeted adaptive sampling: unbiased against fixed sampling, a noise estimate that
 //! agrees with the two-seed measurement, and thread-count independence.
 
-mod common;
+use render::testing as common;
 
 use common::SceneText;
 use render::film::Film;

@@ -1,7 +1,7 @@
 //! The render passes on scenes whose answers are known: the albedo of a diffuse plane, the
 //! normals and depth of a sphere, the skin mask.
 
-mod common;
+use render::testing as common;
 
 use common::{SceneText, plane};
 use glam::{Vec2, Vec3};

@@ -5,7 +5,7 @@
 //! dim environment renders to the same mean within the noise, and the new settings are less
 //! noisy at equal sample count.
 
-mod common;
+use render::testing as common;
 
 use common::scene;
 use render::bssrdf::ProbeAxes;

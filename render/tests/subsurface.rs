@@ -4,7 +4,7 @@
 //! and skin parameters at the edges of their ranges render finite, non-negative images.
 
 use render::bssrdf::{Directional, EnergySplit};
-mod common;
+use render::testing as common;
 
 use common::{SceneText, assert_finite_non_negative, mean_xyz, run, xyz_of};
 use glam::{Vec2, Vec3};

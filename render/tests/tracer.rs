@@ -2,7 +2,7 @@
 //! plane under a distant light, D65 round trip to sRGB white, bad scenes, the default scene,
 //! and thread-count independence.
 
-mod common;
+use render::testing as common;
 
 use common::{SceneText, assert_close, film_mean, mean_xyz, plane, run, white_furnace, xyz_of};
 use render::renderer::{RenderOptions, TILE, render};

@@ -9,7 +9,7 @@
 //!
 //! Exploration records only (the held-out ones are for reporting), spread evenly (default 24).
 
-use multipole::fit::{FitOptions, Geometry, MeasuredOptions, ModelChoice, Parameter};
+use skin_fit::{FitOptions, Geometry, MeasuredOptions, ModelChoice, Parameter};
 use skin_optics::{Extension, SkinParams};
 use validation::measured::{EXPLORE_CSV, fit_records, parse_records, quantile};
 

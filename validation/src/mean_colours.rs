@@ -1,7 +1,7 @@
 //! `skin-validate mean-colours`: the model fitted to the mean skin colours of the measured subset
 //! (docs/physics.md §13.4). Per group and site, the mean CIELAB (D65, CIE 1931 2°) of its SCI
 //! spectra — the figure a study of skin colour publishes — is fitted as a colour target with each
-//! model under the SCI geometry (`multipole::fit::fit_measured_colour`), which measures whether
+//! model under the SCI geometry (`skin_fit::fit_measured_colour`), which measures whether
 //! the model's gamut reaches the measured colours.
 //!
 //! The summary line is a `writeln!` of figures in the shape of `measured_report`'s, with other
@@ -11,8 +11,8 @@ use crate::measured::{EXPLORE_CSV, HELDOUT_CSV, Record, parse_records, progress,
 use crate::measured_colour::{lab_of, mean_lab};
 use crate::measured_report::Subset;
 use anyhow::Context;
-use multipole::fit::{MeasuredColourFit, MeasuredOptions, ModelChoice, fit_measured_colour};
 use rayon::prelude::*;
+use skin_fit::{MeasuredColourFit, MeasuredOptions, ModelChoice, fit_measured_colour};
 use skin_optics::lab::Lab;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -136,7 +136,7 @@ pub fn run_mean_colours(
         (format!("summary_mean_colours_{tag}.txt"), &summary),
     ] {
         let path = out.join(file);
-        render::atomic::write_bytes(&path, body.as_bytes())
+        skin_io::atomic::write_bytes(&path, body.as_bytes())
             .with_context(|| format!("writing {}", path.display()))?;
     }
     Ok(())

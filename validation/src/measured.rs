@@ -6,8 +6,8 @@
 //! reader should quote are the held-out ones.
 
 use indicatif::{ProgressBar, ProgressStyle};
-use multipole::fit::{FitError, MeasuredFit, MeasuredOptions, MeasuredSpectrum, fit_measured};
 use rayon::prelude::*;
+use skin_fit::{FitError, MeasuredFit, MeasuredOptions, MeasuredSpectrum, fit_measured};
 
 /// The exploration subset (a quarter of the subjects), CSV text.
 pub const EXPLORE_CSV: &str = include_str!("../data/issa_explore.csv");

@@ -3,7 +3,7 @@
 //! the fitted parameters that sit on a bound of their range.
 
 use crate::measured::{RecordFit, quantile};
-use multipole::fit::Parameter;
+use skin_fit::Parameter;
 use skin_optics::color::reflectance_to_xyz;
 use skin_optics::lab::Lab;
 use skin_optics::{GridSpectrum, WavelengthGrid};

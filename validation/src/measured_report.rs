@@ -6,8 +6,8 @@ use crate::measured::{
 };
 use crate::measured_colour::{bounds_summary, bounds_text, colour_summary, colours_csv};
 use anyhow::Context;
-use multipole::fit::{MeasuredOptions, ModelChoice, Parameter};
-use render::plot::{LineChart, Panel, Series, palette_color, save_png};
+use skin_fit::{MeasuredOptions, ModelChoice, Parameter};
+use skin_plot::{LineChart, Panel, Series, palette_color, save_png};
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -123,7 +123,7 @@ pub fn run_measured(
 
 fn write(out: &Path, file: &str, text: &str) -> anyhow::Result<()> {
     let path = out.join(file);
-    render::atomic::write_bytes(&path, text.as_bytes())
+    skin_io::atomic::write_bytes(&path, text.as_bytes())
         .with_context(|| format!("writing {}", path.display()))
 }
 

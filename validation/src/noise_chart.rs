@@ -13,11 +13,11 @@ use render::bssrdf::{ProbeAxes, RadiusWavelength};
 use render::integrator::PathSettings;
 use render::noise::relative_noise_where;
 use render::passes::Passes;
-use render::plot::{LineChart, Panel, Series, SeriesStyle, save_png};
 use render::renderer::{RenderOptions, render};
 use render::sampler::SamplerKind;
 use render::scene::Scene;
 use render::spectrum::{WavelengthSampling, xyz_to_linear_srgb};
+use skin_plot::{LineChart, Panel, Series, SeriesStyle, save_png};
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -398,6 +398,6 @@ fn write_csv(path: &Path, rows: &[(&'static str, Point)]) -> anyhow::Result<()> 
             p.noise_skin_rb[1]
         )?;
     }
-    render::atomic::write_bytes(path, s.as_bytes())?;
+    skin_io::atomic::write_bytes(path, s.as_bytes())?;
     Ok(())
 }

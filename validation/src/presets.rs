@@ -3,10 +3,10 @@
 
 use crate::measured_colour::lab_of;
 use anyhow::Context;
-use multipole::fit::{
+use rayon::prelude::*;
+use skin_fit::{
     ColourModel, Geometry, MeasuredOptions, MeasuredSpectrum, ModelChoice, fit_measured,
 };
-use rayon::prelude::*;
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -121,6 +121,6 @@ pub fn run_presets(noise: f64, path: &Path) -> anyhow::Result<()> {
             if bounds.is_empty() { "none" } else { &bounds }
         );
     }
-    render::atomic::write_bytes(path, csv.as_bytes())
+    skin_io::atomic::write_bytes(path, csv.as_bytes())
         .with_context(|| format!("writing {}", path.display()))
 }

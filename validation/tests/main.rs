@@ -16,5 +16,6 @@ macro_rules! release_cases {
 }
 
 mod exact;
+mod memory_bound;
 mod montecarlo;
 mod properties;

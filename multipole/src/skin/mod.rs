@@ -27,7 +27,7 @@ pub use shape::{
 };
 pub use shape_table::{
     ShapeTable, ShapeTableOptions, TABLE_MAX_PATH, TABLE_MIN_ALPHA, TABLE_TAU_MAX, TABLE_TAU_MIN,
-    cache_dir, cached_table,
+    cached_table,
 };
 
 /// How the skin's diffuse reflectance is computed.

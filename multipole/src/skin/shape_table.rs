@@ -21,7 +21,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 mod axis;
 mod cache;
-pub use cache::{cache_dir, cached_table};
+pub use cache::cached_table;
 
 use axis::LogAxis;
 

@@ -4,11 +4,11 @@
 //! [`SkinChoices`] is a plain record, one documented field per choice: its shape repeats the
 //! workspace's other result records (fits, spectra) by design.
 
-use super::cache::CacheOutcome;
 use super::photons::PhotonChoice;
 use super::{Fidelity, Lod, WavelengthChoice};
 use multipole::skin::DIFFUSION_OK;
 use multipole::{DEFAULT_G, LayeredMedium, Method};
+use skin_io::cache::CacheOutcome;
 use skin_optics::{SkinParams, Wavelength};
 use std::fmt::Write;
 

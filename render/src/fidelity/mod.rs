@@ -26,7 +26,6 @@
 //! items for the workspace's other enums and settings: each is kept with its type so that its
 //! error names its own knob and valid values.
 
-pub mod cache;
 pub mod explain;
 pub mod extent;
 pub mod lod;

@@ -1,7 +1,6 @@
 //! A skin's BSSRDF tables with every fidelity choice applied, through the disk cache, and the
 //! record of what was chosen ([`SkinChoices`]).
 
-use super::cache;
 use super::explain::{SkinChoices, TransportChoice, diffusion_failures};
 use super::photons::{self, PhotonChoice};
 use super::wavelengths::{self, WavelengthChoice};
@@ -10,6 +9,7 @@ use crate::bssrdf::{ProfileTable, TableOptions};
 use multipole::skin::{ExactShape, ShapeTableOptions};
 use multipole::{Method, MultipoleError};
 use serde::{Deserialize, Serialize};
+use skin_io::cache;
 use skin_optics::SkinParams;
 use std::time::Instant;
 
@@ -78,10 +78,14 @@ pub fn skin_table(
     })?;
     let dir = knobs
         .cache
-        .then(multipole::skin::cache_dir)
+        .then(skin_io::cache::cache_dir)
         .flatten()
         .map(|d| d.join("tables"));
-    let max_bytes = cache::max_bytes()?;
+    let max_bytes = cache::max_bytes().map_err(|e| MultipoleError::InvalidOption {
+        name: "SKIN_CACHE_MAX_MIB",
+        value: e.value.parse().unwrap_or(f64::NAN),
+        range: "a whole number of MiB in [1, 1048576]",
+    })?;
     let get = |shapes: Shapes| {
         // The key holds the options before the wavelength choice (the choice is part of the value).
         let probe = table_options(&resolved, shapes, phase_g, 10.0);
@@ -180,9 +184,9 @@ fn shape_source(method: Method, opts: &TableOptions) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::cache::CacheOutcome;
     use super::*;
     use crate::fidelity::Fidelity;
+    use skin_io::cache::CacheOutcome;
     use skin_optics::Preset;
 
     /// A cache hit gives the table a rebuild gives, bit for bit, and a corrupted or truncated

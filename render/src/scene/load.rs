@@ -10,7 +10,6 @@ use crate::builtin;
 use crate::camera::Camera;
 use crate::error::RenderError;
 use crate::geometry::{Geometry, MAX_COORD_MM, unit_vector, within_scene};
-use crate::input::{self, InputKind};
 use crate::light::{
     DistantLight, EmissionShape, Environment, Light, MAX_INTENSITY, PointLight, QuadLight,
     SphereLight, SpotLight,
@@ -21,6 +20,7 @@ use crate::scene_file::{EnvironmentDesc, LightDesc, MeshDesc, SceneDesc, ShapeKi
 use crate::spectrum::SpectrumTable;
 use crate::texture::Texture;
 use glam::Vec3;
+use skin_io::input::{self, InputKind};
 use skin_optics::echo::Num;
 use std::borrow::Cow;
 use std::collections::HashMap;

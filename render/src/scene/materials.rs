@@ -40,7 +40,7 @@ impl Loader<'_> {
                 let index = match texture_ids.get(spec) {
                     Some(&i) => i,
                     None => {
-                        let (bytes, path) = self.read(crate::input::TEXTURE, spec)?;
+                        let (bytes, path) = self.read(skin_io::input::TEXTURE, spec)?;
                         textures.push(Texture::from_srgb_bytes(&bytes, &path)?);
                         texture_ids.insert(spec.clone(), textures.len() - 1);
                         textures.len() - 1

@@ -81,7 +81,7 @@ impl Scene {
             return Scene::from_toml(text, spec, None, opts);
         }
         let path = Path::new(spec);
-        let text = crate::input::SCENE.read_text(path)?;
+        let text = skin_io::input::SCENE.read_text(path)?;
         Scene::from_toml(&text, spec, path.parent(), opts)
     }
 

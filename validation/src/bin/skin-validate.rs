@@ -3,7 +3,7 @@
 use anyhow::Context;
 use clap::{Args, Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
-use render::cli::args::{Checked, SkinArgs, parse_whole};
+use skin_cli::args::{Checked, SkinArgs, parse_whole};
 use skin_optics::Wavelength;
 use skin_optics::echo::{Num, Text};
 use std::path::PathBuf;
@@ -167,10 +167,10 @@ struct MeasuredArgs {
     set: String,
     /// Instrument geometry: `sci` (what ISSA measured) or `sce`.
     #[arg(long, default_value = "sci", value_parser = parse_geometry)]
-    geometry: multipole::fit::Geometry,
+    geometry: skin_fit::Geometry,
     /// Model compared with the seed: `seed`, `full` or `auto`.
     #[arg(long, default_value = "auto", value_parser = parse_model)]
-    model: multipole::fit::ModelChoice,
+    model: skin_fit::ModelChoice,
     /// Forward model: `exact` or `multipole`.
     #[arg(long, default_value = "exact", value_parser = parse_method)]
     method: multipole::Method,
@@ -179,21 +179,21 @@ struct MeasuredArgs {
     noise: f64,
     /// Convergence tolerance of the refinement, χ² units at --noise, [0, 1] (0: to the optimiser's
     /// precision).
-    #[arg(long, default_value_t = multipole::fit::CHI2_TOLERANCE)]
+    #[arg(long, default_value_t = skin_fit::CHI2_TOLERANCE)]
     chi2_tolerance: f64,
     /// Fit at most this many records, spread evenly over the subset.
     #[arg(long)]
     limit: Option<usize>,
     /// Starts of the `full` refinement, [1, 4] (fewer: faster, may stop in a worse valley).
-    #[arg(long, default_value_t = multipole::fit::FULL_STARTS_MAX)]
+    #[arg(long, default_value_t = skin_fit::FULL_STARTS_MAX)]
     full_starts: usize,
     /// Extra `full` starts refined after short trials rank them, [0, 3] (3: every start refined,
     /// no trials).
-    #[arg(long, default_value_t = multipole::fit::FULL_REFINED_STARTS)]
+    #[arg(long, default_value_t = skin_fit::FULL_REFINED_STARTS)]
     full_refined_starts: usize,
     /// Candidates per `auto` round trial-fitted after the score test ranks them, [0, 7] (0: every
     /// candidate, the exhaustive selection).
-    #[arg(long, default_value_t = multipole::fit::SCREENED_TRIALS)]
+    #[arg(long, default_value_t = skin_fit::SCREENED_TRIALS)]
     screened_trials: usize,
     /// Output folder.
     #[arg(long, value_name = "DIR", default_value = "out/measured")]
@@ -207,7 +207,7 @@ struct MeanColourArgs {
     set: String,
     /// Models to fit, comma-separated (`seed`, `full`, `auto`).
     #[arg(long, value_delimiter = ',', default_value = "seed,auto,full", value_parser = parse_model)]
-    models: Vec<multipole::fit::ModelChoice>,
+    models: Vec<skin_fit::ModelChoice>,
     /// Noise σ of one reflectance, (0, 1): the criterion's colour noise follows from it.
     #[arg(long, default_value_t = 0.005)]
     noise: f64,
@@ -228,26 +228,24 @@ fn subset_of(set: &str) -> validation::measured_report::Subset {
 
 fn run_mean_colours(args: &MeanColourArgs) -> anyhow::Result<()> {
     let subset = subset_of(&args.set);
-    let opts = multipole::fit::MeasuredOptions {
-        geometry: multipole::fit::Geometry::Sci,
+    let opts = skin_fit::MeasuredOptions {
+        geometry: skin_fit::Geometry::Sci,
         noise: args.noise,
-        fit: multipole::fit::FitOptions {
+        fit: skin_fit::FitOptions {
             beta_scan: 0,
-            ..multipole::fit::FitOptions::default()
+            ..skin_fit::FitOptions::default()
         },
-        ..multipole::fit::MeasuredOptions::default()
+        ..skin_fit::MeasuredOptions::default()
     };
     validation::mean_colours::run_mean_colours(subset, &args.models, &opts, &args.out)
 }
 
-fn parse_geometry(s: &str) -> Result<multipole::fit::Geometry, String> {
-    s.parse()
-        .map_err(|e: multipole::fit::FitError| e.to_string())
+fn parse_geometry(s: &str) -> Result<skin_fit::Geometry, String> {
+    s.parse().map_err(|e: skin_fit::FitError| e.to_string())
 }
 
-fn parse_model(s: &str) -> Result<multipole::fit::ModelChoice, String> {
-    s.parse()
-        .map_err(|e: multipole::fit::FitError| e.to_string())
+fn parse_model(s: &str) -> Result<skin_fit::ModelChoice, String> {
+    s.parse().map_err(|e: skin_fit::FitError| e.to_string())
 }
 
 fn parse_method(s: &str) -> Result<multipole::Method, String> {
@@ -257,7 +255,7 @@ fn parse_method(s: &str) -> Result<multipole::Method, String> {
 
 fn run_measured(args: &MeasuredArgs) -> anyhow::Result<()> {
     let subset = subset_of(&args.set);
-    let opts = multipole::fit::MeasuredOptions {
+    let opts = skin_fit::MeasuredOptions {
         geometry: args.geometry,
         model: args.model,
         noise: args.noise,
@@ -265,12 +263,12 @@ fn run_measured(args: &MeasuredArgs) -> anyhow::Result<()> {
         full_starts: args.full_starts,
         screened_trials: args.screened_trials,
         full_refined_starts: args.full_refined_starts,
-        fit: multipole::fit::FitOptions {
+        fit: skin_fit::FitOptions {
             method: args.method,
             beta_scan: 0,
-            ..multipole::fit::FitOptions::default()
+            ..skin_fit::FitOptions::default()
         },
-        ..multipole::fit::MeasuredOptions::default()
+        ..skin_fit::MeasuredOptions::default()
     };
     validation::measured_report::run_measured(subset, args.limit, &opts, &args.out)
 }
@@ -362,7 +360,9 @@ struct McArgs {
 }
 
 fn main() {
-    render::atomic::remove_temporaries_on_interrupt();
+    skin_io::atomic::remove_temporaries_on_interrupt(|n| {
+        eprintln!("interrupted: removed {n} temporary file(s); nothing half-written is left");
+    });
     let cli = Cli::parse();
     let result = match &cli.command {
         Some(Command::Mc(args)) => run_mc(args),
@@ -393,7 +393,7 @@ fn main() {
         None => validation::compare::run_comparison(cli.quick, &cli.out),
     };
     if let Err(e) = result {
-        eprintln!("skin-validate: {}", render::cli::one_line(&e));
+        eprintln!("skin-validate: {}", skin_cli::one_line(&e));
         std::process::exit(1);
     }
 }
@@ -523,6 +523,6 @@ fn write_profile(path: &std::path::Path, result: &McResult) -> anyhow::Result<()
             p.stderr[i]
         ));
     }
-    render::atomic::write_bytes(path, csv.as_bytes())
+    skin_io::atomic::write_bytes(path, csv.as_bytes())
         .with_context(|| format!("writing the profile {}", path.display()))
 }

@@ -7,8 +7,8 @@ use super::profiles::{PROFILE_WAVELENGTHS_NM, annulus_mean};
 use super::{Settings, Summary, progress, write_csv, write_study};
 use crate::montecarlo::{self, DEFAULT_G, LayeredMedium, McOptions, RadialGrid};
 use multipole::{Method, ProfileOptions};
-use render::plot::{LineChart, Panel, Series, SeriesStyle};
 use skin_optics::{Preset, SkinParams, Wavelength, WavelengthGrid};
+use skin_plot::{LineChart, Panel, Series, SeriesStyle};
 use std::path::Path;
 
 /// Melanin fractions C_m of the spectral study.
@@ -80,7 +80,7 @@ fn spectra(settings: &Settings, out: &Path, summary: &mut Summary) -> anyhow::Re
             ));
             bar.inc(1);
         }
-        let color = render::plot::palette_color(k);
+        let color = skin_plot::palette_color(k);
         for (j, method) in METHODS.into_iter().enumerate() {
             let pts = std::mem::take(&mut curves[j]);
             charts[j] = std::mem::take(&mut charts[j]).with_series(

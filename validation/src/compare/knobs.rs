@@ -17,8 +17,8 @@ use super::{Settings, Summary, progress, timed_mc, write_study};
 use crate::montecarlo::{self, DEFAULT_G, LayeredMedium, McOptions, RadialGrid};
 use multipole::skin::ExactShape;
 use multipole::{Method, Poles, ProfileOptions};
-use render::plot::{LineChart, Panel, Series, SeriesStyle};
 use skin_optics::{Preset, SkinParams, Wavelength};
+use skin_plot::{LineChart, Panel, Series, SeriesStyle};
 use std::path::Path;
 use std::time::Instant;
 

@@ -146,7 +146,7 @@ pub(crate) fn write_csv(path: &Path, header: &str, rows: &[String]) -> anyhow::R
         s.push_str(r);
         s.push('\n');
     }
-    render::atomic::write_bytes(path, s.as_bytes())
+    skin_io::atomic::write_bytes(path, s.as_bytes())
         .with_context(|| format!("writing {}", path.display()))
 }
 
@@ -156,11 +156,11 @@ pub(crate) fn write_study(
     out: &Path,
     name: &str,
     (header, rows): (&str, &[String]),
-    panels: &[render::plot::Panel],
+    panels: &[skin_plot::Panel],
     (width, height): (u32, u32),
 ) -> anyhow::Result<()> {
     write_csv(&out.join(format!("{name}.csv")), header, rows)?;
-    render::plot::save_png(&out.join(format!("{name}.png")), panels, width, height)
+    skin_plot::save_png(&out.join(format!("{name}.png")), panels, width, height)
         .with_context(|| format!("writing {name}.png"))
 }
 
@@ -205,7 +205,7 @@ fn run_studies(quick: bool, out: &Path, subcommand: &str, studies: &[Study]) -> 
         out.display()
     );
     let md = summary.to_markdown(&command, seconds);
-    render::atomic::write_bytes(&out.join("summary.md"), md.as_bytes())?;
+    skin_io::atomic::write_bytes(&out.join("summary.md"), md.as_bytes())?;
     println!("{md}");
     eprintln!("skin-validate: wrote {} in {seconds:.1} s", out.display());
     Ok(())

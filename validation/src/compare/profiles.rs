@@ -4,8 +4,8 @@ use super::{Settings, Summary, progress, write_study};
 use crate::montecarlo::{self, DEFAULT_G, LayeredMedium, McOptions, RadialGrid};
 use multipole::boundary::observable_reflectance;
 use multipole::{Method, ProfileOptions};
-use render::plot::{LineChart, Panel, Series};
 use skin_optics::{Preset, SkinParams, Wavelength};
+use skin_plot::{LineChart, Panel, Series};
 use std::path::Path;
 
 /// Wavelengths of the profile study, nm.

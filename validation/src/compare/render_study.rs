@@ -25,10 +25,10 @@
 use anyhow::Context;
 use render::film::Film;
 use render::passes::Passes;
-use render::plot::{HeatMap, LineChart, Panel, Series, SeriesStyle, save_png};
 use render::renderer::{RenderOptions, render};
 use render::scene::{Scene, SceneOptions};
 use render::volumetric::shapes::box_obj;
+use skin_plot::{HeatMap, LineChart, Panel, Series, SeriesStyle, save_png};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -270,7 +270,7 @@ fn reference(
         if let Some(dir) = f.parent() {
             std::fs::create_dir_all(dir)?;
         }
-        render::atomic::write_bytes(&f, text.as_bytes())?;
+        skin_io::atomic::write_bytes(&f, text.as_bytes())?;
     }
     Ok((film, t))
 }
@@ -488,7 +488,7 @@ pub fn run_render(study: RenderStudy, run: &StudyRun, out: &Path) -> anyhow::Res
             t_v
         );
         // Written after every case, so a long run that is stopped keeps what it measured.
-        render::atomic::write_bytes(&out.join("render_cases.csv"), csv.as_bytes())?;
+        skin_io::atomic::write_bytes(&out.join("render_cases.csv"), csv.as_bytes())?;
         write_md(study, out, &table, &chart)?;
     }
     if chart.is_empty() && !skip_chart {
@@ -505,7 +505,7 @@ fn write_md(study: RenderStudy, out: &Path, table: &str, chart: &str) -> anyhow:
         "# BSSRDF against the volumetric reference\n\nspp: BSSRDF {}, volumetric {} (ear and head {}) unless the table says otherwise; image side {} px.\n\n{table}\n{chart}\n",
         study.bssrdf_spp, study.reference_spp, study.builtin_reference_spp, study.side
     );
-    render::atomic::write_bytes(&out.join("render.md"), md.as_bytes())?;
+    skin_io::atomic::write_bytes(&out.join("render.md"), md.as_bytes())?;
     Ok(md)
 }
 
@@ -562,7 +562,7 @@ fn time_chart(
         }
         series.push(Series::line(name, pts).with_style(SeriesStyle::LinePoints));
     }
-    render::atomic::write_bytes(&out.join("render_time.csv"), csv.as_bytes())?;
+    skin_io::atomic::write_bytes(&out.join("render_time.csv"), csv.as_bytes())?;
     let mut chart = LineChart::new(
         "Image error against render time",
         "CPU seconds",

@@ -3,8 +3,8 @@
 use super::{Settings, Summary, progress, timed_mc, write_study};
 use crate::montecarlo::{DEFAULT_G, LayeredMedium, McOptions};
 use multipole::Method;
-use render::plot::{LineChart, Panel, Series};
 use skin_optics::{Preset, SkinParams, Wavelength, WavelengthGrid};
+use skin_plot::{LineChart, Panel, Series};
 use std::path::Path;
 
 /// Write `spectra.csv` and `spectra.png` and add the worst error per preset to `summary`.
@@ -55,7 +55,7 @@ pub fn run(settings: &Settings, out: &Path, summary: &mut Summary) -> anyhow::Re
             .with_series(Series::scatter(format!("{preset} MC"), mc).with_color(c));
         err = err.with_series(
             Series::line(format!("{preset}"), re)
-                .with_style(render::plot::SeriesStyle::LinePoints)
+                .with_style(skin_plot::SeriesStyle::LinePoints)
                 .with_color(c),
         );
         summary.push(

@@ -10,7 +10,7 @@ use super::{Settings, Summary, progress, write_csv};
 use crate::montecarlo::{self, Layer, LayeredMedium, McOptions};
 use multipole::boundary::observable_reflectance;
 use multipole::{Medium, Poles, Slab};
-use render::plot::{HeatMap, Panel, Series, save_png};
+use skin_plot::{HeatMap, Panel, Series, save_png};
 use std::path::Path;
 
 /// Index of the slab, matching skin.

@@ -11,8 +11,8 @@ use crate::shape_error::energy_error;
 use anyhow::Context;
 use indicatif::{ProgressBar, ProgressStyle};
 use multipole::skin::{Method, ShapeTable, ShapeTableOptions, total_reflectance};
-use render::plot::{LineChart, Panel, Series, SeriesStyle, palette_color, save_png};
 use skin_optics::{Preset, SkinParams, Wavelength};
+use skin_plot::{LineChart, Panel, Series, SeriesStyle, palette_color, save_png};
 use std::fmt::Write as _;
 use std::path::Path;
 use std::time::Instant;
@@ -163,7 +163,7 @@ pub fn run_table_knobs(mc_photons: u64, out: &Path) -> anyhow::Result<()> {
     let _ = writeln!(csv, ",{:.5}", noise.iter().copied().fold(0.0, f64::max));
     print!("{csv}");
     let path = out.join("table_knobs.csv");
-    render::atomic::write_bytes(&path, csv.as_bytes())
+    skin_io::atomic::write_bytes(&path, csv.as_bytes())
         .with_context(|| format!("writing {}", path.display()))?;
     chart(out, &rows, noise.iter().copied().fold(0.0, f64::max))
 }

@@ -3,8 +3,7 @@
 
 use super::{ShapeTable, ShapeTableOptions};
 use crate::error::MultipoleError;
-use std::io::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::{Arc, Mutex, PoisonError};
 
 /// Tables built or read in this process.
@@ -13,19 +12,7 @@ static TABLES: Mutex<Vec<Arc<ShapeTable>>> = Mutex::new(Vec::new());
 /// First bytes of a table file (format version in the last byte).
 const MAGIC: &[u8; 8] = b"SKINSHT1";
 
-/// Where tables are kept between runs: `$SKIN_CACHE_DIR`, else `$XDG_CACHE_HOME/skin`, else
-/// `$HOME/.cache/skin`; `None` when none is set (tables then live only in memory).
-#[must_use]
-pub fn cache_dir() -> Option<PathBuf> {
-    let var = |k: &str| {
-        std::env::var_os(k)
-            .filter(|v| !v.is_empty())
-            .map(PathBuf::from)
-    };
-    var("SKIN_CACHE_DIR")
-        .or_else(|| var("XDG_CACHE_HOME").map(|d| d.join("skin")))
-        .or_else(|| var("HOME").map(|d| d.join(".cache").join("skin")))
-}
+use skin_io::cache::cache_dir;
 
 /// The table for (`g`, `n`, `opts`): from memory, else from [`cache_dir`], else built (on all
 /// rayon threads' worth of plain threads) and written there. Holding the lock while building means
@@ -46,7 +33,7 @@ pub fn cached_table(
     let table = match path.as_deref().and_then(|p| read(p, g, n, opts)) {
         Some(t) => t,
         None => {
-            eprintln!(
+            log::info!(
                 "building the exact-profile shape table (g {g}, n {n}, {} photons; once{})",
                 opts.photons,
                 path.as_deref()
@@ -87,24 +74,14 @@ fn read(path: &Path, g: f64, n: f64, opts: &ShapeTableOptions) -> Option<ShapeTa
     Some(table)
 }
 
-/// Write `table` to `path` through a uniquely named temporary file in the same directory
-/// (`tempfile`), persisted onto the path: a reader never sees a half-written table, and two
-/// writers never share a temporary.
-fn write(path: &Path, table: &ShapeTable) -> std::io::Result<()> {
-    let dir = path
-        .parent()
-        .filter(|d| !d.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    std::fs::create_dir_all(dir)?;
+/// Write `table` to `path` whole or not at all ([`skin_io::atomic`]).
+fn write(path: &Path, table: &ShapeTable) -> Result<(), skin_io::atomic::AtomicWriteError> {
     let mut bytes = Vec::with_capacity(MAGIC.len() + 4 * table.counts.len());
     bytes.extend_from_slice(MAGIC);
     for c in &table.counts {
         bytes.extend_from_slice(&c.to_le_bytes());
     }
-    let mut tmp = tempfile::NamedTempFile::new_in(dir)?;
-    tmp.write_all(&bytes)?;
-    tmp.persist(path).map_err(|e| e.error)?;
-    Ok(())
+    skin_io::atomic::write_bytes(path, &bytes)
 }
 
 #[cfg(test)]

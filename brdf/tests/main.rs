@@ -1,0 +1,4 @@
+//! The Torrance–Sparrow lobe against its physics: sampling against its pdf, reciprocity, energy.
+
+mod chi2;
+mod lobe;

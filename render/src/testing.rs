@@ -1,0 +1,195 @@
+//! Scaffolding for end-to-end render tests, here and in the crates above: scene texts built from
+//! their parts ([`SceneText`]), loading, rendering and the XYZ of a spectrum. Built with the
+//! `test-support` feature only; the functions panic on failure, as tests want.
+
+use crate::film::Film;
+use crate::renderer::{RenderOptions, render};
+use crate::scene::{Scene, SceneOptions};
+use skin_optics::color::{cie_xyz_bar, cie_y_integral};
+
+/// The TOML of a test scene, assembled part by part so that no test spells out the same camera,
+/// material, mesh or light again. The camera looks at the origin with +Y up.
+#[derive(Debug, Clone)]
+pub struct SceneText(String);
+
+impl SceneText {
+    /// A scene whose camera at `position_mm` looks at the origin with a `fov_deg` field of view.
+    pub fn camera(position_mm: [f32; 3], fov_deg: f32) -> Self {
+        let [x, y, z] = position_mm;
+        Self(format!(
+            "[camera]\nposition_mm = [{x}, {y}, {z}]\nlook_at_mm = [0, 0, 0]\nfov_deg = {fov_deg}\n"
+        ))
+    }
+
+    /// Append raw TOML (a key, a section).
+    #[must_use]
+    pub fn with(mut self, toml: &str) -> Self {
+        self.0.push_str(toml);
+        self.0.push('\n');
+        self
+    }
+
+    /// A uniform environment of `spectrum` ("constant", "d65") with luminance `intensity`.
+    #[must_use]
+    pub fn environment(self, spectrum: &str, intensity: f32) -> Self {
+        self.with(&format!(
+            "[environment]\nspectrum = \"{spectrum}\"\nintensity = {intensity}"
+        ))
+    }
+
+    /// A Lambertian material `name` of constant `albedo`.
+    #[must_use]
+    pub fn diffuse(self, name: &str, albedo: f32) -> Self {
+        self.with(&format!(
+            "[materials.{name}]\ntype = \"diffuse\"\nalbedo = {albedo}"
+        ))
+    }
+
+    /// A skin material `name` with the given extra keys (`preset = "light"`, `melanin = 0.1`, ...).
+    #[must_use]
+    pub fn skin(self, name: &str, keys: &str) -> Self {
+        self.with(&format!("[materials.{name}]\ntype = \"skin\"\n{keys}"))
+    }
+
+    /// A built-in `shape` ("sphere", "quad") of `material`, scaled by `scale` at the origin.
+    #[must_use]
+    pub fn mesh(self, shape: &str, material: &str, scale: f32) -> Self {
+        self.with(&format!(
+            "[[meshes]]\nshape = \"{shape}\"\nmaterial = \"{material}\"\nscale = {scale}"
+        ))
+    }
+
+    /// A distant D65 light from unit direction `to_light` with irradiance (luminance) `intensity`.
+    #[must_use]
+    pub fn distant(self, to_light: [f32; 3], intensity: f32) -> Self {
+        let [x, y, z] = to_light;
+        self.with(&format!(
+            "[[lights]]\ntype = \"distant\"\ndirection = [{x}, {y}, {z}]\nspectrum = \"d65\"\nintensity = {intensity}"
+        ))
+    }
+
+    /// A sphere light at `center_mm` of `radius_mm` and luminance `intensity`.
+    #[must_use]
+    pub fn sphere_light(self, center_mm: [f32; 3], radius_mm: f32, intensity: f32) -> Self {
+        let [x, y, z] = center_mm;
+        self.with(&format!(
+            "[[lights]]\ntype = \"sphere\"\ncenter_mm = [{x}, {y}, {z}]\nradius_mm = {radius_mm}\nintensity = {intensity}"
+        ))
+    }
+
+    /// The TOML text.
+    #[must_use]
+    pub fn text(&self) -> &str {
+        &self.0
+    }
+
+    /// The scene, loaded with default options.
+    #[must_use]
+    pub fn load(&self) -> Scene {
+        scene(&self.0)
+    }
+}
+
+/// The white furnace: a diffuse albedo-1 sphere of radius 100 mm inside a constant environment
+/// of luminance 1, seen from 300 mm.
+#[must_use]
+pub fn white_furnace() -> SceneText {
+    SceneText::camera([0.0, 0.0, 300.0], 20.0)
+        .environment("constant", 1.0)
+        .diffuse("white", 1.0)
+        .mesh("sphere", "white", 100.0)
+}
+
+/// A 2 m wide quad of `material` at z = 0 seen head-on from 500 mm with a 10° field of view.
+#[must_use]
+pub fn plane(material: &str) -> SceneText {
+    SceneText::camera([0.0, 0.0, 500.0], 10.0).mesh("quad", material, 1000.0)
+}
+
+/// A scene from TOML text, with default options.
+pub fn scene(text: &str) -> Scene {
+    Scene::from_toml(text, "test.toml", None, &SceneOptions::default()).unwrap()
+}
+
+/// Render `scene` at `w`×`h` with `spp` samples per pixel and a fixed `seed`.
+pub fn run(scene: &Scene, w: usize, h: usize, spp: u32, seed: u64) -> Film {
+    let settings = RenderOptions {
+        width: w,
+        height: h,
+        spp,
+        seed,
+        ..Default::default()
+    };
+    render(scene, &settings.validate().unwrap()).unwrap().0
+}
+
+/// Mean XYZ over the whole film.
+pub fn mean_xyz(film: &Film) -> [f64; 3] {
+    film_mean(film, |x, y| film.xyz(x, y))
+}
+
+/// Mean over the whole film of a per-pixel triple `value(x, y)` (XYZ, linear sRGB, ...).
+pub fn film_mean(film: &Film, value: impl Fn(usize, usize) -> [f32; 3]) -> [f64; 3] {
+    let (w, h) = film.size();
+    let mut s = [0.0f64; 3];
+    for y in 0..h {
+        for x in 0..w {
+            let v = value(x, y);
+            for c in 0..3 {
+                s[c] += f64::from(v[c]);
+            }
+        }
+    }
+    s.map(|v| v / (w * h) as f64)
+}
+
+/// Fail, naming `what` and the pixel, unless every XYZ value of `film` is finite and ≥ 0.
+pub fn assert_finite_non_negative(film: &Film, what: &str) {
+    let (w, h) = film.size();
+    for y in 0..h {
+        for x in 0..w {
+            let v = film.xyz(x, y);
+            assert!(
+                v.iter().all(|c| c.is_finite() && *c >= 0.0),
+                "{what}: pixel {x},{y}: {v:?}"
+            );
+        }
+    }
+}
+
+/// XYZ of a spectrum s(λ) over the rendered range 380–780 nm, normalised like the film
+/// (a constant radiance of 1 has Y = 1).
+pub fn xyz_of(s: impl Fn(f64) -> f64) -> [f64; 3] {
+    let mut xyz = [0.0; 3];
+    for nm in 380..=780 {
+        let bar = cie_xyz_bar(f64::from(nm));
+        for c in 0..3 {
+            xyz[c] += s(f64::from(nm)) * bar[c];
+        }
+    }
+    xyz.map(|v| v / cie_y_integral())
+}
+
+/// Assert every channel of `got` is within relative `rel` of `want`.
+pub fn assert_close(got: [f64; 3], want: [f64; 3], rel: f64, what: &str) {
+    for c in 0..3 {
+        assert!(
+            (got[c] - want[c]).abs() <= rel * want[c].abs(),
+            "{what}: channel {c}: {got:?} vs {want:?}"
+        );
+    }
+}
+
+/// A valid 2×2 grey (0.5) RGB OpenEXR file written by the `exr` crate, for tests that corrupt it.
+pub fn grey_exr_2x2() -> Vec<u8> {
+    use exr::prelude::*;
+    let mut bytes = Vec::new();
+    Image::from_channels(
+        (2, 2),
+        SpecificChannels::rgb(|_: Vec2<usize>| (0.5f32, 0.5f32, 0.5f32)),
+    )
+    .write()
+    .to_buffered(std::io::Cursor::new(&mut bytes))
+    .unwrap();
+    bytes
+}

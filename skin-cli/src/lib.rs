@@ -1,0 +1,50 @@
+//! The `skin` command line: one module per subcommand, argument structs shared between them.
+//!
+//! Only this crate knows about the command line; the physics crates take validated types.
+
+pub mod args;
+pub mod brdf;
+pub mod export;
+pub mod fit;
+mod fit_measured;
+pub mod presets;
+pub mod profile;
+pub mod render;
+pub mod spectrum;
+
+/// An error and its causes on one line, `: `-separated, leaving out a cause whose text the message
+/// already shows (many errors print their source themselves, so `{:#}` would repeat it).
+#[must_use]
+pub fn one_line(e: &anyhow::Error) -> String {
+    let mut line = String::new();
+    for cause in e.chain() {
+        let text = cause.to_string();
+        let text = text.trim();
+        if line.contains(text) {
+            continue;
+        }
+        if !line.is_empty() {
+            line.push_str(": ");
+        }
+        line.push_str(text);
+    }
+    line.replace('\n', " ")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn os_error_is_printed_once() {
+        let io = std::io::Error::other("no such file (os error 2)");
+        let e = ::render::error::RenderError::MissingFile {
+            what: "scene",
+            path: "x.toml".into(),
+            source: io,
+        };
+        let line = one_line(&anyhow::Error::new(e).context("loading"));
+        assert_eq!(line.matches("os error 2").count(), 1, "{line}");
+        assert!(line.starts_with("loading: scene file x.toml"), "{line}");
+    }
+}

@@ -1,0 +1,79 @@
+//! `skin presets`: the named skins with their colour (CIELAB under D65, sRGB) and ITA°.
+
+use clap::Args;
+use multipole::Method;
+use skin_fit::ColourModel;
+use skin_optics::lab::Lab;
+use skin_optics::measured::{ita_presets, measured_presets};
+use skin_optics::{Preset, SkinParams};
+
+/// Arguments of `skin presets`.
+#[derive(Args, Debug, Clone)]
+pub struct PresetsArgs {
+    /// Print one JSON array instead of a table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+fn row(name: &str, what: &str, lab: Lab) -> String {
+    format!(
+        "{name:<18} {}  L*a*b* ({:5.1}, {:5.1}, {:5.1})  ITA° {:6.1} ({:<12}) {what}",
+        lab.to_srgb().to_hex(),
+        lab.l,
+        lab.a,
+        lab.b,
+        lab.ita_deg(),
+        lab.ita_category().name()
+    )
+}
+
+fn json_row(name: &str, what: &str, skin: &SkinParams, lab: Lab) -> serde_json::Value {
+    serde_json::json!({
+        "name": name, "source": what, "srgb": lab.to_srgb().to_hex(),
+        "lab": { "l": lab.l, "a": lab.a, "b": lab.b },
+        "ita_deg": lab.ita_deg(), "ita_category": lab.ita_category().name(),
+        "melanin": skin.melanin(), "eumelanin_blend": skin.eumelanin_blend(),
+        "hemoglobin": skin.hemoglobin(), "oiliness": skin.oiliness(),
+    })
+}
+
+/// Run `skin presets`.
+pub fn run(args: &PresetsArgs) -> anyhow::Result<()> {
+    let colour = ColourModel::new(10.0, Method::Exact, SkinParams::default())?;
+    let mut rows = Vec::new();
+    for (name, p) in [
+        ("paper", Preset::Light),
+        ("medium", Preset::Medium),
+        ("dark", Preset::Dark),
+    ] {
+        let skin = SkinParams::preset(p);
+        let what = if p == Preset::Light {
+            "the paper's Figure 1 (also `light`)"
+        } else {
+            "seed model, this project's values"
+        };
+        rows.push((name.to_string(), what.to_string(), skin, colour.lab(&skin)?));
+    }
+    for p in measured_presets() {
+        let what = format!(
+            "ISSA {} {} median of {} (fit RMS {:.4})",
+            p.group_code, p.site, p.n_records, p.rms
+        );
+        rows.push((p.name.clone(), what, p.skin, p.lab));
+    }
+    for (name, p) in ita_presets() {
+        rows.push((name, format!("= {}", p.name), p.skin, p.lab));
+    }
+    if args.json {
+        let v: Vec<_> = rows
+            .iter()
+            .map(|(n, w, s, l)| json_row(n, w, s, *l))
+            .collect();
+        println!("{}", serde_json::Value::Array(v));
+    } else {
+        for (n, w, _, l) in &rows {
+            println!("{}", row(n, w, *l));
+        }
+    }
+    Ok(())
+}

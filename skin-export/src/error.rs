@@ -1,0 +1,58 @@
+//! Errors of an export: every message names the parameter or input line and its valid range.
+
+use multipole::MultipoleError;
+use skin_optics::OpticsError;
+use thiserror::Error;
+
+/// Why an export failed.
+#[derive(Debug, Error)]
+#[non_exhaustive]
+pub enum ExportError {
+    /// The format name is not one of [`crate::Format::ALL`].
+    #[error(
+        "unknown export format '{0}' (valid: openpbr, standard-surface, unreal, hdrp, gaussians, burley, pbrt, mitsuba, mcml, mcx)"
+    )]
+    UnknownFormat(String),
+    /// A numeric option outside its range.
+    #[error("{name} = {value} outside {range}")]
+    OutOfRange {
+        /// The option (with its unit).
+        name: &'static str,
+        /// The rejected value.
+        value: f64,
+        /// The valid range.
+        range: &'static str,
+    },
+    /// Bad skin parameters or wavelengths.
+    #[error(transparent)]
+    Optics(#[from] OpticsError),
+    /// The transport models failed (profiles, adding-doubling, Monte Carlo).
+    #[error(transparent)]
+    Transport(#[from] MultipoleError),
+    /// An MCML input that does not parse.
+    #[error("MCML input line {line}: {message}")]
+    Mci {
+        /// 1-based line number in the input.
+        line: usize,
+        /// What was expected there.
+        message: String,
+    },
+    /// A fit that found no admissible value.
+    #[error("{0}")]
+    Fit(String),
+}
+
+/// Reject `value` outside [lo, hi] (or non-finite) as [`ExportError::OutOfRange`].
+pub fn check(
+    name: &'static str,
+    value: f64,
+    lo: f64,
+    hi: f64,
+    range: &'static str,
+) -> Result<f64, ExportError> {
+    if value.is_finite() && (lo..=hi).contains(&value) {
+        Ok(value)
+    } else {
+        Err(ExportError::OutOfRange { name, value, range })
+    }
+}
