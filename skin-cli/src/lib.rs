@@ -12,6 +12,17 @@ pub mod profile;
 pub mod render;
 pub mod spectrum;
 
+/// Show the libraries' notices (the `log` facade: a table being built, a fallback taken) on stderr
+/// as plain lines, at `info` and above unless `RUST_LOG` says otherwise. The binaries call it once.
+pub fn init_logging() {
+    let _ = env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("info"))
+        .format(|buf, record| {
+            use std::io::Write as _;
+            writeln!(buf, "{}", record.args())
+        })
+        .try_init();
+}
+
 /// An error and its causes on one line, `: `-separated, leaving out a cause whose text the message
 /// already shows (many errors print their source themselves, so `{:#}` would repeat it).
 #[must_use]

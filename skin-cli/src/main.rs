@@ -34,6 +34,7 @@ fn main() -> ExitCode {
     skin_io::atomic::remove_temporaries_on_interrupt(|n| {
         eprintln!("interrupted: removed {n} temporary file(s); nothing half-written is left");
     });
+    cli::init_logging();
     let cli = Cli::parse();
     let result = match &cli.command {
         Command::Spectrum(a) => cli::spectrum::run(a),

@@ -363,6 +363,7 @@ fn main() {
     skin_io::atomic::remove_temporaries_on_interrupt(|n| {
         eprintln!("interrupted: removed {n} temporary file(s); nothing half-written is left");
     });
+    skin_cli::init_logging();
     let cli = Cli::parse();
     let result = match &cli.command {
         Some(Command::Mc(args)) => run_mc(args),
