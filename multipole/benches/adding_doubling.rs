@@ -4,7 +4,7 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use multipole::adding_doubling::{AddingDoublingOptions, DEFAULT_G, skin_totals_spectrum};
+use multipole::exact::adding_doubling::{AddingDoublingOptions, DEFAULT_G, skin_totals_spectrum};
 use skin_optics::{Preset, SkinParams, WavelengthGrid};
 
 fn spectral_set(c: &mut Criterion) {

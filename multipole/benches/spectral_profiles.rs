@@ -2,8 +2,9 @@
 //! samples to the 99.9% radius, on ONE thread (a 1-thread rayon pool), plus single profiles.
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use multipole::ProfileOptions;
+use multipole::diffusion::slab::Poles;
 use multipole::skin::{Method, SpectralProfiles, profile};
-use multipole::{Poles, ProfileOptions};
 use skin_optics::{Preset, SkinParams, Wavelength, WavelengthGrid};
 use std::hint::black_box;
 

@@ -1,8 +1,11 @@
 //! Total diffuse reflectance (q = 0 of the stacked spectrum): one wavelength and a 31-λ spectrum.
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use multipole::diffusion::{
+    medium::Medium,
+    slab::{Poles, Slab},
+};
 use multipole::skin::{Method, diffuse_reflectance, total_reflectance};
-use multipole::{Medium, Poles, Slab};
 use skin_optics::{Preset, SkinParams, Wavelength, WavelengthGrid};
 use std::hint::black_box;
 

@@ -3,7 +3,7 @@
 //! Run: `valgrind --tool=callgrind target/release/examples/ad_workload 24 3`; the difference
 //! between `reps` = 3 and 1, halved, is the steady-state count per repetition (caches warm).
 
-use multipole::adding_doubling::{AddingDoublingOptions, DEFAULT_G, skin_totals_spectrum};
+use multipole::exact::adding_doubling::{AddingDoublingOptions, DEFAULT_G, skin_totals_spectrum};
 use skin_optics::{Preset, SkinParams, WavelengthGrid};
 
 fn main() {

@@ -4,7 +4,7 @@
 //!
 //! `cargo run --release -p multipole --example adding_doubling_tables`
 
-use multipole::adding_doubling::{
+use multipole::exact::adding_doubling::{
     AddingDoublingOptions, DEFAULT_G, SlabTotals, skin_totals, skin_totals_spectrum, solve,
 };
 use multipole::skin::diffuse_reflectance;

@@ -8,8 +8,9 @@
 #[path = "shared/write.rs"]
 mod shared;
 
+use multipole::ProfileOptions;
+use multipole::diffusion::slab::Poles;
 use multipole::skin::{Method, profile, profile_error};
-use multipole::{Poles, ProfileOptions};
 use skin_optics::{Preset, SkinParams, Wavelength};
 use std::time::Instant;
 

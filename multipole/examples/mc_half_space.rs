@@ -8,7 +8,7 @@
 //! wall-clock rate; for the CPU-time rate run the built binary under `/usr/bin/time -f "%U user"`
 //! and divide the photons by the user seconds (the setup is microseconds).
 
-use multipole::montecarlo::{Layer, LayeredMedium, McOptions, run};
+use multipole::exact::montecarlo::{Layer, LayeredMedium, McOptions, run};
 use std::time::Instant;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {

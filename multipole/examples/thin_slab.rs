@@ -8,9 +8,12 @@
 #[path = "shared/write.rs"]
 mod shared;
 
-use multipole::boundary::a_coefficient;
-use multipole::medium::pole_transform;
-use multipole::{Medium, Poles, Slab};
+use multipole::diffusion::boundary::a_coefficient;
+use multipole::diffusion::medium::pole_transform;
+use multipole::diffusion::{
+    medium::Medium,
+    slab::{Poles, Slab},
+};
 
 /// The untreated 11-pair multipole totals (R, T) at q = 0.
 fn raw(m: &Medium, d: f64) -> (f64, f64) {

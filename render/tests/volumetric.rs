@@ -8,8 +8,10 @@
 //! collimated normal beam (what adding-doubling and the Monte Carlo compute).
 
 use multipole::LayeredMedium;
-use multipole::adding_doubling::{AddingDoublingOptions, DEFAULT_QUADRATURE_POINTS, skin_totals};
-use multipole::montecarlo::{self, McOptions};
+use multipole::exact::adding_doubling::{
+    AddingDoublingOptions, DEFAULT_QUADRATURE_POINTS, skin_totals,
+};
+use multipole::exact::montecarlo::{self, McOptions};
 use render::film::Film;
 use render::material::{Material, SkinMaterial, SurfaceKind};
 use render::renderer::{RenderOptions, render};

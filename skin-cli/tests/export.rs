@@ -4,7 +4,7 @@
 //! length doubles every exported radius; bad input ends in a one-line error.
 
 use multipole::Method;
-use multipole::montecarlo::{McOptions, run};
+use multipole::exact::montecarlo::{McOptions, run};
 use serde_json::Value;
 use skin_export::burley::BurleyFit;
 use skin_export::gaussians::GaussianFit;

@@ -12,8 +12,8 @@
 
 use crate::error::{ExportError, check};
 use crate::rgb::{RgbProfile, shape_error, total_error};
-use multipole::adding_doubling::{AddingDoublingOptions, solve};
-use multipole::montecarlo::{McOptions, RadialGrid, run};
+use multipole::exact::adding_doubling::{AddingDoublingOptions, solve};
+use multipole::exact::montecarlo::{McOptions, RadialGrid, run};
 use multipole::{Layer, LayeredMedium, MultipoleError, Profile};
 
 /// Generator seed of the medium's Monte Carlo profiles (fixed: an export is a pure function).

@@ -4,7 +4,7 @@ pub mod compare;
 pub mod mcml;
 pub mod shape_error;
 /// The layered Monte Carlo (owned by `multipole`, which uses it for exact profile shapes).
-pub use multipole::montecarlo;
+pub use multipole::exact::montecarlo;
 pub mod mean_colours;
 pub mod measured;
 pub mod measured_colour;

@@ -3,7 +3,7 @@
 //! per-entering profile × (1 − F_r(0))). The run's own noise adds about Σ √(2/π) σ_annulus E / R_mc.
 
 use multipole::Profile;
-use multipole::montecarlo::McResult;
+use multipole::exact::montecarlo::McResult;
 
 /// ∫ 2πr R(r) dr over [a, b] (mm), exact in the profile's own model between its nodes
 /// (`Profile::energy_within_mm`): a quadrature of `eval` would miss peaks narrower than its step

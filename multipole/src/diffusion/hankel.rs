@@ -204,7 +204,7 @@ impl Pchip {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{Dipole, Medium};
+    use crate::diffusion::{dipole::Dipole, medium::Medium};
     use approx::assert_relative_eq;
 
     #[test]

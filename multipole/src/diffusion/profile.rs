@@ -184,7 +184,7 @@ impl Profile {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{Dipole, Medium};
+    use crate::diffusion::{dipole::Dipole, medium::Medium};
     use approx::assert_relative_eq;
 
     fn dipole_profile() -> (Dipole, Profile) {

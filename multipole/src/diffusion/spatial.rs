@@ -310,7 +310,7 @@ pub fn reference_reflectance(stack: &Stack, poles: Poles, radii_mm: &[f64]) -> V
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{Medium, Slab};
+    use crate::diffusion::{medium::Medium, slab::Slab};
 
     fn skin_like(sa_epi: f64, sa_derm: f64) -> Stack {
         let epi = Slab::new(Medium::new(sa_epi, 5.3).unwrap(), 0.25, 1.4, 1.0).unwrap();

@@ -322,7 +322,7 @@ pub fn skin_totals(
 }
 
 /// Exact total diffuse reflectance of the skin per unit flux *entering* it (the quantity diffusion's R_d
-/// stands for): the observable divided by 1 − F_r(0), so `multipole::boundary::observable_reflectance`
+/// stands for): the observable divided by 1 − F_r(0), so `multipole::diffusion::boundary::observable_reflectance`
 /// maps it back to [`SlabTotals::diffuse_reflectance`].
 pub fn skin_total_reflectance(
     skin: &SkinParams,

@@ -16,7 +16,7 @@ use crate::material::Material;
 use crate::scene::Scene;
 use crate::spectrum::{N_WAVELENGTHS, SampledSpectrum, SpectrumTable};
 use distance::SurfaceDistance;
-use multipole::montecarlo::HgSampler;
+use multipole::exact::montecarlo::HgSampler;
 use multipole::{LayeredMedium, MultipoleError};
 use skin_optics::Wavelength;
 use thiserror::Error;

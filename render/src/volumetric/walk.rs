@@ -2,7 +2,7 @@
 //! the majorant σ̄ = max(σt_epidermis, σt_dermis) at the hero wavelength, so the layer boundary
 //! (a distance from the surface, not a plane) is crossed exactly without ever being intersected;
 //! at a real collision the weight keeps σs/σt (implicit capture) and the direction turns by
-//! Henyey–Greenstein — both from `multipole::montecarlo`, the photon physics of the layered Monte
+//! Henyey–Greenstein — both from `multipole::exact::montecarlo`, the photon physics of the layered Monte
 //! Carlo; below its roulette threshold the walk plays its Russian roulette. At the surface the
 //! walk meets the skin's boundary: total internal reflection beyond the critical angle, else it
 //! leaves with probability T(θ_out) (the same energy split as the BSSRDF's, `Directional`:
@@ -14,7 +14,7 @@ use crate::bssrdf::Directional;
 use crate::geometry::offset_origin;
 use crate::scene::Scene;
 use glam::{DVec3, Vec3};
-use multipole::montecarlo::{ROULETTE_SURVIVAL, ROULETTE_THRESHOLD, scatter_direction};
+use multipole::exact::montecarlo::{ROULETTE_SURVIVAL, ROULETTE_THRESHOLD, scatter_direction};
 use rand::{Rng, RngCore};
 
 /// Most real collisions per walk (a bound on the cost; a walk reaching it is dropped, a bias

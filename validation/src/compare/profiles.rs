@@ -2,7 +2,7 @@
 
 use super::{Settings, Summary, progress, write_study};
 use crate::montecarlo::{self, DEFAULT_G, LayeredMedium, McOptions, RadialGrid};
-use multipole::boundary::observable_reflectance;
+use multipole::diffusion::boundary::observable_reflectance;
 use multipole::{Method, ProfileOptions};
 use skin_optics::{Preset, SkinParams, Wavelength};
 use skin_plot::{LineChart, Panel, Series};

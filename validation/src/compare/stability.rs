@@ -8,8 +8,11 @@
 
 use super::{Settings, Summary, progress, write_csv};
 use crate::montecarlo::{self, Layer, LayeredMedium, McOptions};
-use multipole::boundary::observable_reflectance;
-use multipole::{Medium, Poles, Slab};
+use multipole::diffusion::boundary::observable_reflectance;
+use multipole::diffusion::{
+    medium::Medium,
+    slab::{Poles, Slab},
+};
 use skin_plot::{HeatMap, Panel, Series, save_png};
 use std::path::Path;
 

@@ -1,5 +1,5 @@
 //! MCML 1.2 ([WJZ95] Wang, Jacques & Zheng 1995, the original C program) as an independent check of
-//! the layered Monte Carlo (`multipole::montecarlo`, docs/physics.md §11): the cases compared, their
+//! the layered Monte Carlo (`multipole::exact::montecarlo`, docs/physics.md §11): the cases compared, their
 //! MCML input (`.mci`) written from the same [`LayeredMedium`] our code builds, MCML's ASCII output
 //! (`.mco`) read back, and the reference data committed under `validation/data/mcml/`.
 //!

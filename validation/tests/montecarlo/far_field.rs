@@ -44,8 +44,11 @@ fn far_field_matches_the_dipole_at_high_albedo() {
         &stack,
         &McOptions::new(1_000_000, 32, 2024).unwrap().with_grid(grid),
     );
-    let dipole =
-        multipole::Dipole::new(multipole::Medium::new(sigma_a, sigma_s).unwrap(), 1.0).unwrap();
+    let dipole = multipole::diffusion::dipole::Dipole::new(
+        multipole::diffusion::medium::Medium::new(sigma_a, sigma_s).unwrap(),
+        1.0,
+    )
+    .unwrap();
     for i in 1..grid.bins() {
         let (a, b) = (grid.inner_mm(i), grid.outer_mm(i));
         let area = grid.annulus_area_mm2(i);

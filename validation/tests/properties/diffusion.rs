@@ -1,8 +1,13 @@
 //! `multipole` against physics limits and against the Monte Carlo in the high-albedo regime.
 
 use crate::montecarlo::photons;
-use multipole::boundary::observable_reflectance;
-use multipole::{Dipole, Medium, Method, Poles, Slab};
+use multipole::Method;
+use multipole::diffusion::boundary::observable_reflectance;
+use multipole::diffusion::{
+    dipole::Dipole,
+    medium::Medium,
+    slab::{Poles, Slab},
+};
 use proptest::prelude::*;
 use skin_optics::{SkinParams, Wavelength};
 use validation::montecarlo::{Layer, LayeredMedium, McOptions, run};

@@ -3,7 +3,7 @@
 
 use crate::montecarlo::photons;
 use multipole::Method;
-use multipole::adding_doubling::{AddingDoublingOptions, skin_totals};
+use multipole::exact::adding_doubling::{AddingDoublingOptions, skin_totals};
 use multipole::skin::diffuse_reflectance;
 use skin_optics::{Extension, Physiology, Preset, SkinParams, Wavelength};
 use validation::montecarlo::{LayeredMedium, McOptions, run};

@@ -123,7 +123,7 @@ fn spatial_exact_integrates_to_the_closed_form_totals() {
 #[test]
 fn thick_slab_converges_to_the_dipole() {
     let m = Medium::new(0.1, 2.0).unwrap();
-    let dip = crate::Dipole::new(m, 1.4).unwrap();
+    let dip = crate::diffusion::dipole::Dipole::new(m, 1.4).unwrap();
     let s = Slab::new(m, 60.0, 1.4, 1.0).unwrap();
     assert_relative_eq!(
         s.total_reflectance(Poles::Exact),
@@ -244,10 +244,11 @@ fn thin_slabs_are_non_negative_and_conserve_energy() {
             assert!(rr >= 0.0 || r > 2.0 * d, "{mfp} mfp, r = {r}: {rr}");
         }
         // Over a dermis, the profile that is passed on is finite and non-negative without clamping.
-        let dermis = crate::Dipole::new(Medium::new(0.05, 2.0).unwrap(), 1.0).unwrap();
-        let st = crate::Stack::new(vec![
-            crate::DiffusionLayer::Slab(s),
-            crate::DiffusionLayer::SemiInfinite(dermis),
+        let dermis =
+            crate::diffusion::dipole::Dipole::new(Medium::new(0.05, 2.0).unwrap(), 1.0).unwrap();
+        let st = crate::diffusion::stack::Stack::new(vec![
+            crate::diffusion::stack::DiffusionLayer::Slab(s),
+            crate::diffusion::stack::DiffusionLayer::SemiInfinite(dermis),
         ])
         .unwrap();
         let p = crate::diffusion::spatial::stack_profile(&st, &crate::ProfileOptions::default())
