@@ -316,7 +316,7 @@ pub fn breakdown(
     scene.lights = lights;
     alone?;
     for (what, p) in &rows {
-        eprintln!(
+        log::info!(
             "{what:<20} {spp} spp: {:7.1} CPU s, noise {:6.2}% (skin {:.2}%, other {:.2}%), noise·√CPU-s {:.4}",
             p.cpu_s,
             100.0 * p.noise,
@@ -344,7 +344,7 @@ pub fn run(
     for v in variants {
         for &spp in spps {
             let p = measure(scene, size, spp, threads, v.path, &skin)?;
-            eprintln!(
+            log::info!(
                 "{:<34} {spp:>5} spp: {:7.1} CPU s, noise {:6.2}% (skin {:.2}%, other {:.2}%; skin red {:.2}%, blue {:.2}%), noise·√CPU-s {:.4}",
                 v.name,
                 p.cpu_s,

@@ -48,8 +48,8 @@ fn rows() -> anyhow::Result<Vec<Row>> {
     Ok(out)
 }
 
-/// Fit every median and write the preset table to `path`; prints one line per preset.
-pub fn run_presets(noise: f64, path: &Path) -> anyhow::Result<()> {
+/// Fit every median and write the preset table to `path`; returns one line per preset.
+pub fn run_presets(noise: f64, path: &Path) -> anyhow::Result<String> {
     let opts = MeasuredOptions {
         geometry: Geometry::Sci,
         model: ModelChoice::Auto,
@@ -64,6 +64,7 @@ pub fn run_presets(noise: f64, path: &Path) -> anyhow::Result<()> {
             fit_measured(&m, &opts)
         })
         .collect::<Result<Vec<_>, _>>()?;
+    let mut report = String::new();
     let mut csv = String::from(
         "# Measured skin presets: the ISSA group/site median SCI spectra (skin_reflectance_issa_summary.csv; ISSA, Lu et al., Scientific Data 2025, CC BY 4.0) fitted by `skin-validate presets` (geometry sci, model auto, exact forward model).\n",
     );
@@ -109,7 +110,8 @@ pub fn run_presets(noise: f64, path: &Path) -> anyhow::Result<()> {
             bounds
         );
         let free: Vec<&str> = f.parameters.iter().skip(4).map(|p| p.name()).collect();
-        println!(
+        let _ = writeln!(
+            report,
             "{name:<18} RMS {:.4} (seed {:.4})  ΔE2000 to the median {de:.2}  L*a*b* ({:.1}, {:.1}, {:.1})  ITA° {:.1}  added: {}  on a bound: {}",
             f.rms,
             f.seed_rms,
@@ -122,5 +124,6 @@ pub fn run_presets(noise: f64, path: &Path) -> anyhow::Result<()> {
         );
     }
     skin_io::atomic::write_bytes(path, csv.as_bytes())
-        .with_context(|| format!("writing {}", path.display()))
+        .with_context(|| format!("writing {}", path.display()))?;
+    Ok(report)
 }

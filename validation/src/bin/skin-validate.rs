@@ -367,12 +367,16 @@ fn main() {
     let cli = Cli::parse();
     let result = match &cli.command {
         Some(Command::Mc(args)) => run_mc(args),
-        Some(Command::Exact(args)) => validation::compare::run_exact(args.quick, &args.out),
+        Some(Command::Exact(args)) => {
+            validation::compare::run_exact(args.quick, &args.out).map(|md| println!("{md}"))
+        }
         Some(Command::Noise(args)) => run_noise(args),
         Some(Command::NoiseChart(args)) => run_noise_chart(args),
         Some(Command::Measured(args)) => run_measured(args),
         Some(Command::MeanColours(args)) => run_mean_colours(args),
-        Some(Command::Presets(args)) => validation::presets::run_presets(args.noise, &args.out),
+        Some(Command::Presets(args)) => {
+            validation::presets::run_presets(args.noise, &args.out).map(|lines| print!("{lines}"))
+        }
         Some(Command::TableKnobs(args)) => {
             validation::compare::table_knobs::run_table_knobs(args.photons, &args.out)
         }
@@ -389,9 +393,9 @@ fn main() {
                 reference_cache: args.reference_cache.clone(),
                 threads: args.threads.map(|t| t as usize),
             };
-            run_render(study, &run, &args.out)
+            run_render(study, &run, &args.out).map(|md| println!("{md}"))
         }
-        None => validation::compare::run_comparison(cli.quick, &cli.out),
+        None => validation::compare::run_comparison(cli.quick, &cli.out).map(|md| println!("{md}")),
     };
     if let Err(e) = result {
         eprintln!("skin-validate: {}", skin_cli::one_line(&e));

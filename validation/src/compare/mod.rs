@@ -167,13 +167,13 @@ pub(crate) fn write_study(
 /// One study: writes its charts and CSV into the folder and its worst errors into the summary.
 type Study = fn(&Settings, &Path, &mut Summary) -> anyhow::Result<()>;
 
-/// Run only study 5 ([`exact`]) into `out` and write `summary.md`; prints the total time.
-pub fn run_exact(quick: bool, out: &Path) -> anyhow::Result<()> {
+/// Run only study 5 ([`exact`]) into `out` and write `summary.md`; returns the summary (Markdown).
+pub fn run_exact(quick: bool, out: &Path) -> anyhow::Result<String> {
     run_studies(quick, out, " exact", &[exact::run])
 }
 
-/// Run all five studies into `out` and write `summary.md`; prints the total time.
-pub fn run_comparison(quick: bool, out: &Path) -> anyhow::Result<()> {
+/// Run all five studies into `out` and write `summary.md`; returns the summary (Markdown).
+pub fn run_comparison(quick: bool, out: &Path) -> anyhow::Result<String> {
     run_studies(
         quick,
         out,
@@ -190,7 +190,12 @@ pub fn run_comparison(quick: bool, out: &Path) -> anyhow::Result<()> {
 
 /// Run `studies` in order into `out`, then write `summary.md` with the command that reproduces it
 /// (`subcommand` is what follows `skin-validate --`, with its leading space).
-fn run_studies(quick: bool, out: &Path, subcommand: &str, studies: &[Study]) -> anyhow::Result<()> {
+fn run_studies(
+    quick: bool,
+    out: &Path,
+    subcommand: &str,
+    studies: &[Study],
+) -> anyhow::Result<String> {
     let settings = Settings::new(quick);
     let start = Instant::now();
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
@@ -206,7 +211,6 @@ fn run_studies(quick: bool, out: &Path, subcommand: &str, studies: &[Study]) -> 
     );
     let md = summary.to_markdown(&command, seconds);
     skin_io::atomic::write_bytes(&out.join("summary.md"), md.as_bytes())?;
-    println!("{md}");
-    eprintln!("skin-validate: wrote {} in {seconds:.1} s", out.display());
-    Ok(())
+    log::info!("skin-validate: wrote {} in {seconds:.1} s", out.display());
+    Ok(md)
 }

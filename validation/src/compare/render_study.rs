@@ -423,7 +423,7 @@ fn heat(title: &str, film: &Film, map: Vec<f64>) -> Panel {
 
 /// Run the study into `out`: error maps, `render_cases.csv`, `render_time.csv`, `render_time.png`
 /// and `render.md` (the table).
-pub fn run_render(study: RenderStudy, run: &StudyRun, out: &Path) -> anyhow::Result<()> {
+pub fn run_render(study: RenderStudy, run: &StudyRun, out: &Path) -> anyhow::Result<String> {
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let meshes = tempfile::tempdir()?;
     let mesh_dir = meshes.path().display().to_string();
@@ -445,7 +445,7 @@ pub fn run_render(study: RenderStudy, run: &StudyRun, out: &Path) -> anyhow::Res
         if c.builtin && chart.is_empty() && !skip_chart {
             chart = time_chart(study, &cases[1], run.threads, out)?;
         }
-        eprintln!("[{}/{}] {label}", k + 1, cases.len());
+        log::info!("[{}/{}] {label}", k + 1, cases.len());
         let bssrdf = load(&c.toml, false)?;
         let (test, t_b) = timed(&bssrdf, c.width, c.height, study.bssrdf_spp, 1, run.threads)?;
         let ref_spp = run.reference_spp(&label).unwrap_or(if c.builtin {
@@ -494,9 +494,7 @@ pub fn run_render(study: RenderStudy, run: &StudyRun, out: &Path) -> anyhow::Res
     if chart.is_empty() && !skip_chart {
         chart = time_chart(study, &cases[1], run.threads, out)?;
     }
-    let md = write_md(study, out, &table, &chart)?;
-    println!("{md}");
-    Ok(())
+    write_md(study, out, &table, &chart)
 }
 
 /// Write `render.md` (the case table so far and the chart's lines); returns its text.
