@@ -1,7 +1,4 @@
 //! Typed errors for invalid BRDF parameters.
-//!
-//! `NonFinite` and `OutOfRange` have the same shape as `skin_optics::OpticsError`'s: both crates are
-//! leaves with no common dependency, and each library crate owns one error enum.
 
 use thiserror::Error;
 

@@ -5,9 +5,6 @@
 //! with the Beckmann D of [`crate::beckmann`], the V-cavity G of `v_cavity` and the exact unpolarised
 //! dielectric Fresnel F of [`crate::fresnel`]. Both directions must be unit vectors in the upper
 //! hemisphere; anything at or below the horizon gives 0.
-//!
-//! The constants and the sample record are documented one per line, each with its unit and source;
-//! that list shape recurs wherever the workspace documents knobs (e.g. the path tracer's settings).
 
 use crate::albedo;
 use crate::beckmann;

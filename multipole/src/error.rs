@@ -1,8 +1,7 @@
 //! Typed errors of the layered-transport crate: every variant names the parameter, its value and its range.
 //!
-//! [`check_range`] mirrors `skin_optics`'s private helper of the same name on purpose: each returns
-//! its own crate's error type (skin-optics also separates non-finite from out-of-range values), and
-//! sharing one would make the leaf crate export an internal helper only this crate needs.
+//! [`check_range`] returns this crate's error type, so every range check of the crate reports
+//! through it.
 
 use skin_optics::OpticsError;
 use thiserror::Error;

@@ -6,9 +6,8 @@
 //! (docs/physics.md §1, §6). The default anisotropy, the σs'→σs conversion and the valid ranges
 //! live here and nowhere else.
 //!
-//! `Layer::checked`'s arguments repeat the struct's fields one for one on purpose: it is the single
-//! constructor every public one funnels into, where the ranges are checked; its accessors are
-//! spelled out one per field so each carries its unit.
+//! `Layer::checked` is the single constructor every public one funnels into, where the ranges are
+//! checked.
 
 use crate::error::{MultipoleError, check_range};
 use skin_optics::{SkinParams, Wavelength};

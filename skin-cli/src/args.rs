@@ -1,8 +1,5 @@
 //! Arguments shared by several subcommands (skin parameters, method), and the value parser every
 //! flag goes through.
-//!
-//! The clap fields repeat one shape (doc, `#[arg]` with a `Checked` parser, `Option<f64>`) because
-//! each flag's help text and range are its own; the parsers they name are the shared part.
 
 use clap::Args;
 use clap::builder::TypedValueParser;

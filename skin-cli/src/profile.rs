@@ -42,7 +42,7 @@ pub struct ProfileArgs {
     /// Number of radii, geometric from 0.001 mm to the outer radius, in [2, 1000000].
     #[arg(long, value_name = "N", default_value_t = 256, value_parser = Checked(parse_samples), allow_hyphen_values = true)]
     pub samples: usize,
-    /// Profile method: exact (the default: adding-doubling total, shape from the layered Monte Carlo)
+    /// Profile method: exact (the default: adding-doubling total, exact shape from the shape table)
     /// or multipole (the paper's diffusion, too bright for dark skin).
     #[arg(long, value_name = "METHOD", default_value_t = Method::default(), value_parser = Checked(parse_method), allow_hyphen_values = true)]
     pub method: Method,

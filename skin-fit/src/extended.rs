@@ -18,8 +18,6 @@
 //!    plus noise gains a spurious parameter about 40 % of the time (best of 7 χ²₁ draws above ln 31).
 //!
 //! A colour target (module `colour`) shares the refinement and selection (module `select`).
-//! The result's fields and the options' `Default` are listed one by one, the shape of the other
-//! result types of the workspace (shape only, different fields).
 
 use super::forward::Forward;
 use super::geometry::{Geometry, unit_surface_reflectance};

@@ -12,9 +12,6 @@
 //! Approximation: the subsurface term keeps its smooth-surface entry factor 1 − F_r(0) rather than
 //! 1 − ρ_s a(cos 8°); for the default lobe the two differ by under 0.03 of R_d (≤ 0.015 in
 //! reflectance at R = 0.6), as F_r(0) = 0.028 and ρ_s a ≤ 0.03.
-//!
-//! The `Display`/`FromStr` pair repeats the shape of the other name enums (`Method`,
-//! `ModelChoice`): each spells out its own names so the accepted spelling sits beside the variant.
 
 use super::FitError;
 use brdf::TorranceSparrow;

@@ -1,9 +1,5 @@
 //! The parameters a spectrum fit may free, each with the physiological range it explores
 //! (docs/physics.md §13), and the model choices `seed`, `full` and `auto`.
-//!
-//! The `Display`/`FromStr` pair of [`ModelChoice`] repeats the shape of the other name enums
-//! (`Geometry`, `Method`): each spells out its own names so the accepted spelling sits beside the
-//! variant.
 
 use super::{EUMELANIN_RANGE, FitError, HEMOGLOBIN_RANGE, MELANIN_RANGE};
 use skin_optics::{Extension, OpticsError, SkinParams};

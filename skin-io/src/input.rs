@@ -2,8 +2,8 @@
 //! regular file (not a device, FIFO or folder) no larger than its kind's cap, and only then are
 //! the bytes read (never more than the cap, even if the file grows meanwhile).
 //!
-//! The constants are alike by design: each is a row of the table of what may be read (what,
-//! extensions, size cap), kept as named constants so the loaders and the errors cite them.
+//! Each kind's constants are one row of the table of what may be read (what, extensions, size
+//! cap), named so the loaders and the errors cite them.
 
 use std::fs;
 use std::io::Read;

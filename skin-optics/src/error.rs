@@ -1,7 +1,4 @@
 //! Typed errors for invalid optical inputs.
-//!
-//! `NonFinite` and `OutOfRange` have the same shape as `brdf::BrdfError`'s: both crates are leaves
-//! with no common dependency, and each library crate owns one error enum.
 
 use thiserror::Error;
 

@@ -4,7 +4,7 @@
 //! by the `image` crate and written atomically through [`skin_io::atomic`]. Text uses the bundled
 //! DejaVu Sans, registered once, so charts look the same on every machine.
 //!
-//! Robust by design: non-finite points are skipped (a line breaks there), points ≤ 0 are dropped on
+//! Bad data still draws: non-finite points are skipped (a line breaks there), points ≤ 0 are dropped on
 //! a log axis, an empty or degenerate range is padded, and a panel with no data still draws axes.
 //!
 //! ```no_run

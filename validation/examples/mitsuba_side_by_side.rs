@@ -19,9 +19,6 @@
 //! libLLVM ≥ 16, e.g. `DRJIT_LIBLLVM_PATH=/usr/lib/x86_64-linux-gnu/libLLVM-19.so`). CPU time: ours from the process clock around `render` (a
 //! rayon pool of one thread), Mitsuba's from `time.process_time()` around `mi.render` after a
 //! warm-up render (the LLVM kernels compiled once, not counted).
-//!
-//! The matched scene is a list of named constants, one a line, like other such lists of scene
-//! constants in the tests: the shape repeats by nature.
 
 use anyhow::Context;
 use render::mesh::TriangleMesh;

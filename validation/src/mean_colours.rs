@@ -3,9 +3,6 @@
 //! spectra — the figure a study of skin colour publishes — is fitted as a colour target with each
 //! model under the SCI geometry (`skin_fit::fit_measured_colour`), which measures whether
 //! the model's gamut reaches the measured colours.
-//!
-//! The summary line is a `writeln!` of figures in the shape of `measured_report`'s, with other
-//! figures (shape only).
 
 use crate::measured::{EXPLORE_CSV, HELDOUT_CSV, Record, parse_records, progress, quantile};
 use crate::measured_colour::{lab_of, mean_lab};

@@ -36,10 +36,11 @@ pub struct ProfileOptions {
     pub transform_radii: usize,
     /// Spectrum cutoff: stop at Q where |F(Q)| Q² < tolerance × peak (default 1e-5; [1e-16, 0.1]).
     pub transform_tolerance: f64,
-    /// Shape of `Method::Exact` profiles (default [`ExactShape::MonteCarlo`] with
-    /// [`crate::skin::DEFAULT_SHAPE_ESCAPES`]); the other fields are the diffusion knobs.
+    /// Shape of `Method::Exact` profiles (default [`ExactShape::Table`], the shape table); the other
+    /// fields are the diffusion knobs.
     pub exact_shape: ExactShape,
-    /// Wavelength spacing of Monte Carlo shapes in `SpectralProfiles`, nm (default 10; [0.01, 1000]):
+    /// Wavelength spacing of run-time Monte Carlo shapes ([`ExactShape::MonteCarlo`]) in
+    /// `SpectralProfiles`, nm (default 10; [0.01, 1000]):
     /// rows between two shape wavelengths mix their unit-energy shapes linearly in λ, each row
     /// scaled to its own exact total.
     pub shape_step_nm: f64,

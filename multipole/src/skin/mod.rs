@@ -1,8 +1,5 @@
 //! Two-layer skin ([DJ06]): an epidermis slab of the given thickness (index `skin.eta()` above it,
 //! matched below) over a semi-infinite dermis (dipole with A = 1), stacked in the frequency domain.
-//!
-//! `Method`'s `FromStr` has the shape of every option parser of the workspace (trim, lower case,
-//! match the names, a typed error naming the value); each returns its own crate's error type.
 
 use crate::diffusion::boundary::observable_reflectance;
 use crate::diffusion::profile::Profile;
@@ -36,8 +33,8 @@ pub use shape_table::{
 pub enum Method {
     /// Exact plane-parallel transport by adding-doubling ([Prahl95], [vdH80]; HG g = 0.9,
     /// σs = σs'/(1 − g), Fresnel boundaries; `crate::exact::adding_doubling` with default options) for the
-    /// totals, which diffusion overestimates two- to threefold for dark skin. Profiles: the layered Monte
-    /// Carlo's radial shape scaled to the exact total ([`ExactShape::MonteCarlo`]). The default.
+    /// totals, which diffusion overestimates two- to threefold for dark skin. Profiles: the exact
+    /// radial shape from the shape table scaled to the exact total ([`ExactShape::Table`]). The default.
     #[default]
     Exact,
     /// Donner & Jensen's multipole diffusion with frequency-domain layer stacking ([DJ05], [DJ06]):
@@ -116,8 +113,8 @@ pub fn diffuse_reflectance(
 }
 
 /// The radial profile R(r) of `skin` at `lambda` (per unit flux entering; mm⁻²) with the knobs `opts`.
-/// `Method::Exact` uses the shape `opts.exact_shape` (default [`ExactShape::MonteCarlo`]; see
-/// [`ExactShape`] for the measured choice).
+/// `Method::Exact` uses the shape `opts.exact_shape` (default [`ExactShape::Table`]; see
+/// [`ExactShape`] for the choices).
 pub fn profile(
     skin: &SkinParams,
     lambda: Wavelength,
@@ -138,9 +135,10 @@ pub struct SpectralProfiles {
 }
 
 impl SpectralProfiles {
-    /// Profiles of `skin` at every wavelength of `grid`. With `Method::Exact` and the Monte Carlo
-    /// shape, shapes are traced every `opts.shape_step_nm` (rounded to a multiple of the grid step;
-    /// always at both ends) and mixed linearly in between; every row keeps its own exact total.
+    /// Profiles of `skin` at every wavelength of `grid`. With `Method::Exact` and the run-time
+    /// Monte Carlo shape ([`ExactShape::MonteCarlo`]), shapes are traced every `opts.shape_step_nm`
+    /// (rounded to a multiple of the grid step; always at both ends) and mixed linearly in between;
+    /// every row keeps its own exact total.
     pub fn new(
         skin: &SkinParams,
         grid: &WavelengthGrid,

@@ -1,6 +1,7 @@
 //! The radial shape of `Method::Exact` profiles. The total always comes from adding-doubling; the
-//! shape either from diffusion (rescaled as a whole or per layer) or from the layered Monte Carlo
-//! (exact transport, cached per material by whoever tabulates it, e.g. the renderer's tables).
+//! shape by default from the shape table (exact transport tabulated once per (g, n), module
+//! `shape_table`), else from a run-time layered Monte Carlo (where the table does not apply, or
+//! when asked for) or from diffusion (rescaled as a whole or per layer, for comparison).
 
 use super::{Method, stack, total_reflectance_at_g};
 use crate::diffusion::boundary::observable_reflectance;
@@ -14,8 +15,9 @@ use crate::exact::montecarlo::{self, McOptions, RadialGrid};
 use crate::layered::LayeredMedium;
 use skin_optics::{SkinParams, Wavelength};
 
-/// Escaping photons per wavelength of the default Monte Carlo shape (the accuracy knob: the
-/// energy-weighted noise of the shape falls as 1/√escapes; see [`ExactShape`] for measurements).
+/// Escaping photons per wavelength of a run-time Monte Carlo shape, and of the fallback where the
+/// shape table does not apply (the accuracy knob: the energy-weighted noise of the shape falls as
+/// 1/√escapes).
 pub const DEFAULT_SHAPE_ESCAPES: u64 = 4_000;
 /// Most photons one Monte Carlo shape may trace, whatever its reflectance (bounds the cost for very
 /// dark skin in the blue, where fewer than 1% of photons escape).
@@ -31,24 +33,14 @@ pub const SHAPE_SEED: u64 = 0x5EED_5111;
 
 /// How `Method::Exact` shapes its radial profile; every variant's total is the exact total.
 ///
-/// Measured against an independent layered Monte Carlo run (10⁶ photons, seed 7, energy-weighted
-/// error Σ|2πr Δr (R − R_mc)| / R_mc over its 0.01 mm annuli to 10 mm, which includes that run's own
-/// noise, last column; `cargo run --release -p validation --example exact_profiles`), light / dark
-/// preset; `MonteCarlo` at 1,000 / 4,000 / 16,000 escapes (wall ms per profile on 2 cores):
-///
-/// | λ | multipole | `RescaledTotal` | `PerLayer` | `MonteCarlo`, light | `MonteCarlo`, dark | noise |
-/// |---|---|---|---|---|---|---|
-/// | 450 nm | 29.4% / 220% | 29.2% / 75.6% | 27.8% / 75.6% | 9.2 / 4.3 / 2.7% (13 / 52 / 214 ms) | 4.7 / 4.4 / 4.7% (36 / 145 / 567 ms) | 1.0% / 1.0% |
-/// | 550 nm | 32.0% / 224% | 32.3% / 67.8% | 29.8% / 67.8% | 10.0 / 5.3 / 2.8% (14 / 52 / 204 ms) | 5.6 / 3.9 / 3.2% (55 / 220 / 884 ms) | 1.2% / 1.3% |
-/// | 650 nm | 25.9% / 185% | 25.8% / 61.1% | 24.8% / 57.9% | 8.5 / 4.0 / 3.6% (27 / 105 / 406 ms) | 3.9 / 2.9 / 2.8% (226 / 882 / 3496 ms) | 1.5% / 1.5% |
-///
-/// Neither diffusion shape meets a 10% target: the error is the shape of diffusion *within* a
-/// layer, which no scalar per layer can change. For dark skin the epidermis (transmitting 3·10⁻⁵ to
-/// 4% of the light) makes almost all of the reflectance, and the Monte Carlo puts 81% of it within
-/// 0.03 mm at 450 nm where diffusion puts 68%; for light skin diffusion has too much at 0.03–0.3 mm
-/// and too little beyond 0.3 mm (the pencil beam's forward-peaked entry, g = 0.9, which a single
-/// dipole source at one transport mean free path cannot represent). Hence the default,
-/// [`ExactShape::MonteCarlo`].
+/// The default is [`ExactShape::Table`]: exact transport read from the shape table. The diffusion
+/// shapes are kept for comparison: their error is the shape of diffusion *within* a layer, which no
+/// scalar per layer can change. For dark skin the epidermis makes almost all of the reflectance and
+/// the Monte Carlo puts most of it within 0.03 mm, nearer than diffusion does; for light skin
+/// diffusion has too much at 0.03–0.3 mm and too little beyond 0.3 mm (the pencil beam's
+/// forward-peaked entry, g = 0.9, which a single dipole source at one transport mean free path
+/// cannot represent). Errors of each shape against an independent Monte Carlo: BENCHMARKS.md
+/// `## Exact profile table` and `## Diffusion against exact transport`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[non_exhaustive]
 pub enum ExactShape {
@@ -67,14 +59,13 @@ pub enum ExactShape {
     /// [`SHAPE_R_MAX_MM`], [`SHAPE_BINS`] annuli, fixed seed [`SHAPE_SEED`]), scaled to the exact
     /// total: transport is exact, only noise remains. `escapes` is the knob: the photons traced are
     /// escapes / (observable exact reflectance), at most [`MAX_SHAPE_PHOTONS`], so the noise is about
-    /// the same for every skin tone. The default, with [`DEFAULT_SHAPE_ESCAPES`].
+    /// the same for every skin tone. The fallback of `Table`, with [`DEFAULT_SHAPE_ESCAPES`].
     MonteCarlo {
         /// Escaping photons wanted (≥ 100).
         escapes: u64,
     },
     /// The same exact transport read from the universal white-Monte-Carlo table
-    /// ([`super::ShapeTable`], built once per (g, n) and cached): milliseconds per spectral set,
-    /// no run-time photons. Covers every skin whose layers share σs (dermis scattering scale 1),
+    /// ([`super::ShapeTable`], built once per (g, n) and cached): no run-time photons. Covers every skin whose layers share σs (dermis scattering scale 1),
     /// any index and epidermal scattering depth σs·d in [`super::TABLE_TAU_MIN`],
     /// [`super::TABLE_TAU_MAX`]; elsewhere it falls back to `MonteCarlo` with
     /// [`DEFAULT_SHAPE_ESCAPES`]. The default.

@@ -9,9 +9,6 @@
 //! Knobs ([`ShapeTableOptions`]): photons (noise), depths per octave (interpolation), radial and
 //! path bins per decade (binning); errors against the run-time Monte Carlo in BENCHMARKS.md
 //! (`## Exact profile table`).
-//!
-//! The `g` and `n` accessors read like `Layer`'s on purpose: a shape table is tabulated for one
-//! such layer's anisotropy and index, and callers compare the two.
 
 use super::shape::profile_from_shape;
 use crate::diffusion::profile::Profile;

@@ -1,8 +1,6 @@
 //! MCML 1.2's ASCII output (`.mco`, written by `WriteResult` in `mcmlio.c`), the parts compared.
 //!
-//! [`McmlOutput`] has plain documented fields, the workspace's form for a value record (as
-//! `render::bssrdf::TableOptions`); `ReferenceData` (`reference.rs`) repeats them as statistics
-//! over runs.
+//! `ReferenceData` (`reference.rs`) holds the same quantities as statistics over runs.
 
 use super::McmlError;
 

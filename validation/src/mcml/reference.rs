@@ -4,11 +4,9 @@
 //! `ran3` stream continued from run to run, so the runs are independent batches) and the standard
 //! error of every quantity is sd(run values) / √runs, as for our Monte Carlo's batches.
 //!
-//! [`ReferenceData`] repeats [`McmlOutput`]'s fields with an `Estimate` in place of each number on
-//! purpose: one is what a single run prints, the other the statistic over runs the tests compare
-//! against, and the specular term stays a plain number because it is deterministic.
-//! [`ReferenceData::from_runs`] opens like other validating constructors (inputs in, a typed error
-//! out) only by convention.
+//! [`ReferenceData`] holds [`McmlOutput`]'s quantities with an `Estimate` in place of each number:
+//! one is what a single run prints, the other the statistic over runs the tests compare against;
+//! the specular term stays a plain number because it is deterministic.
 
 use super::{McmlError, McmlOutput};
 use crate::montecarlo::Estimate;

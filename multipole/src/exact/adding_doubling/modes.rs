@@ -15,9 +15,8 @@
 //! R̂ = (G₋ − G₊ E Γ E) N⁻¹, T̂ = (G₊ E − G₋ Γ E) N⁻¹, and for τ → ∞ simply R̂ = G₋ G₊⁻¹.
 //! Every exponential is a decaying one, so thick layers are as stable as thin ones.
 //!
-//! [`layer_by_modes`] takes the same arguments as the thin-layer start in `layer.rs` on purpose:
-//! both solve one homogeneous layer on the same quadrature and are interchangeable behind
-//! `Singular`.
+//! [`layer_by_modes`] and the thin-layer start in `layer.rs` solve one homogeneous layer on the
+//! same quadrature; the start is the fallback when the modes are `Singular`.
 
 use super::eigen::symmetric_eigen;
 use super::layer::Angles;

@@ -1,8 +1,4 @@
 //! Closed forms, limits and reference values for the adding-doubling solver.
-//!
-//! The conservation cases are a table per solver, like the diffusion slab's own tests
-//! (`diffusion/slab/tests.rs`): the two solvers take different parameters, so the loops look alike
-//! but cannot share one table.
 
 use super::*;
 

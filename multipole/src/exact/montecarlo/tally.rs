@@ -1,7 +1,4 @@
 //! What one batch of photons scores, and how independent batches become means with standard errors.
-//!
-//! The tallies and results are plain records of documented fields; their constructors list every
-//! field, which makes them resemble other records of the workspace in shape only.
 
 use crate::error::{MultipoleError, check_range};
 

@@ -8,8 +8,7 @@
 //! The photons run in SIMD lanes ([`lanes`]); the scalar path, one photon at a time, is kept as
 //! their reference in the tests. Both share one interaction ([`Photon::interact`]), one face test
 //! ([`reaches_face`]), one face crossing ([`Lane::face`]) and one roulette ([`Lane::roulette`]);
-//! `trace_batch` and the scalar `trace_scalar` repeat one signature on purpose, so that a test
-//! can run either.
+//! `trace_batch` and the scalar `trace_scalar` take the same arguments, so a test can run either.
 
 mod free_path;
 mod lanes;
