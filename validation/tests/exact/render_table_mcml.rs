@@ -1,17 +1,15 @@
 //! The profile the renderer actually uses, against MCML 1.2 ([WJZ95]; the committed runs of
 //! `validation/data/mcml/`, see `montecarlo::mcml`): `render::bssrdf::ProfileTable` built with
-//! `TableOptions::default()` (`Method::Exact`: adding-doubling totals, Monte Carlo shapes of
-//! `RENDER_SHAPE_ESCAPES` = 1,000 escapes every `RENDER_SHAPE_STEP_NM` = 20 nm, rows in between
-//! mixing the two neighbouring shapes, re-tabulated in f32), evaluated at a wavelength that lies
-//! between two shape rows.
+//! `TableOptions::default()` (`Method::Exact`: adding-doubling totals, shapes from the shape table,
+//! re-tabulated in f32), evaluated at a wavelength off the `RENDER_SHAPE_STEP_NM` grid.
 //!
 //! Error = Σ_i |E_table,i − E_MCML,i| / R_d,MCML over MCML's 0.01 mm annuli (the last one: all
 //! energy beyond 9.99 mm), E_table,i = (1 − F_r(0)) ∫ 2πr R(r) dr (the table is per unit flux
 //! entering; midpoint rule on 16 sub-intervals, exact enough for its piecewise-linear 2πr R).
 //!
 //! # Tolerance
-//! The stated accuracy of these settings is an energy-weighted error ≤ 10% (`ExactShape` and
-//! `RENDER_SHAPE_ESCAPES` docs: 9.1–10.0% measured for light skin, 6.0% for dark). MCML's noise n_i
+//! The renderer's stated accuracy is an energy-weighted error ≤ 10% (the shape table alone measures
+//! 1.0–2.5% against 10⁶-photon Monte Carlo, BENCHMARKS.md `## Exact profile table`). MCML's noise n_i
 //! adds at most Σ|n_i| (triangle inequality), whose mean is Σ √(2/π) σ_i and whose standard
 //! deviation is √(Σ (1 − 2/π) σ_i²); the bound is 10% + that mean + 4 of those deviations (σ_i:
 //! MCML's stated per-annulus errors). The diffusion profile (`Method::Multipole`) misses by 25–32%
