@@ -1,6 +1,4 @@
-//! The `skin` command line: one module per subcommand, argument structs shared between them.
-//!
-//! Only this crate knows about the command line; the physics crates take validated types.
+#![doc = include_str!("../README.md")]
 
 pub mod args;
 pub mod brdf;

@@ -1,17 +1,4 @@
-//! `skin export`: the skin written for other renderers and simulators, each with its units,
-//! conventions and its error measured against our exact profiles (docs/physics.md §14).
-//!
-//! Two families:
-//! - **RGB-reduced** (OpenPBR, Standard Surface, Unreal, HDRP, Burley, Gaussians): our exact spectral
-//!   profiles (`Method::Exact`: adding-doubling totals, Monte Carlo shapes) reduced to RGB
-//!   ([`rgb::RgbProfile`]); each engine's own profile model is then fitted per channel to our total and
-//!   mean radial distance, and its total and shape errors are measured against the RGB profiles.
-//! - **Spectral** (pbrt-v4, Mitsuba 3, MCML, MCX): the layers' σa, σs, g, n and thickness per
-//!   wavelength ([`spectral::SpectralSkin`]), exact by construction where the program takes two layers;
-//!   pbrt's `subsurface` takes one, so it gets the single layer that returns our total.
-//!
-//! [`Format`]'s `Display`/`FromStr` pair follows the same pattern as `ColourSpace`'s (canonical
-//! name out, names in, case-insensitive); the names and the error type are each type's own.
+#![doc = include_str!("../README.md")]
 
 pub mod burley;
 pub mod colour;

@@ -1,10 +1,11 @@
 //! The fit's forward model per wavelength, and the two-stage scheme that makes an exact fit fast:
 //! search with a cheap exact model, then correct to the full one by output space mapping.
 //!
-//! **Search model.** `Method::Exact` at its default quadrature (24 points) costs about 5 ms of CPU per
-//! 31-wavelength colour, and a fit evaluates the model some 1500 times (grid, starts, β_m sweep). The
-//! search stage therefore uses adding-doubling with [`super::FitOptions::search_quadrature_points`]
-//! (default 8: ≈ 0.4 ms per colour, colour error against 24 points measured in BENCHMARKS.md `## Fit`).
+//! **Search model.** `Method::Exact` at its default quadrature (24 points) costs about twelve times
+//! as much per colour as at 8 points (BENCHMARKS.md `## Exact method`), and a fit evaluates the model
+//! some 1500 times (grid, starts, β_m sweep). The search stage therefore uses adding-doubling with
+//! [`super::FitOptions::search_quadrature_points`] (default 8; its colour error against 24 points is
+//! measured in BENCHMARKS.md `## Fit`).
 //!
 //! **Correction (output space mapping**, Bandler et al. 2004). At the search optimum x₀ the full
 //! model's output (XYZ for a colour, the reflectances for a spectrum) is evaluated once, and the cheap

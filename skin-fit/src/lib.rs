@@ -1,48 +1,4 @@
-//! Fitting the skin parameters C_m, β_m, C_h to a target colour or a measured reflectance spectrum
-//! (docs/physics.md §12):
-//! the inverse of the spectral skin model ([DJ06]), with [`multipole::skin::diffuse_reflectance`] as the
-//! forward model (the observable: per unit incident flux, specular excluded).
-//!
-//! * [`fit_colour`]: minimise CIEDE2000 ([SWD05]) between a target CIELAB colour (e.g. an sRGB hex
-//!   through [`skin_optics::lab::Lab::from_srgb`]) and the skin's colour under D65, which is its
-//!   reflectance over 400–700 nm (step [`FitOptions::step_nm`]) through [`skin_optics::color`].
-//! * [`fit_spectrum`]: weighted least squares against a [`MeasuredSpectrum`] (CSV `lambda_nm,reflectance[,weight]`).
-//!
-//! **Search.** The parameters live in their physical ranges C_m ∈ [0, 0.5], β_m ∈ [0, 1],
-//! C_h ∈ [0.001, 0.1]. The search runs in a unit box over the eumelanin fraction C_m β_m, the
-//! pheomelanin fraction C_m (1 − β_m) (each on a log-like scale) and log C_h, where colour changes
-//! roughly evenly and C_m = 0 is one point rather than a face of equal skins (`search_to_params`).
-//! A coarse grid ([`FitOptions::grid`]) finds the global basins; Nelder–Mead from the best
-//! [`FitOptions::starts`] distinct nodes refines them (module `nelder_mead`).
-//!
-//! **Non-uniqueness.** Three colour coordinates against three parameters is square, but not every
-//! direction is seen well: with little melanin, β_m moves the colour by less than one ΔE00 over its
-//! whole range; under much melanin (C_m ≳ 0.2) the epidermis hides the dermis and C_h changes the
-//! reflectance by well under 0.1 %. The fit resolves this explicitly with a tiny prior: the objective
-//! adds w² [(β_m − 0.6)² + (log₁₀(C_h / 0.01) / 2)²] (β_m 0.6 is the medium preset's blend; C_h 0.01
-//! the geometric middle of its range and the light preset's value; the β_m term fades out below
-//! C_m ≈ 0.001 where β_m means nothing), with w = [`FitOptions::prior_weight_de`] = 0.01 ΔE00 for
-//! colours and [`FitOptions::prior_weight_rms`] = 1e-4 reflectance for spectra. It costs at most about
-//! 0.01 ΔE00, so it only decides between fits the data cannot tell apart. (A colour fit stops
-//! refining further starts once one reproduces the target to ΔE00 < 0.001, [`EXACT_DE`], so the prior
-//! then acts within that start's basin; the sweep still reports every β_m the colour allows.) The result then reports
-//! which β_m the data do allow ([`BetaRange`]): β_m is swept over [`FitOptions::beta_scan`] values
-//! with C_m and C_h refitted at each, and the connected range around the fit whose residual stays
-//! within a tolerance of the best is returned.
-//!
-//! **Forward model.** [`FitOptions::method`], default [`Method::Exact`] (adding-doubling totals: right
-//! for every skin tone, where diffusion draws dark skin two to three times too bright and so returns
-//! the wrong melanin; BENCHMARKS.md `## Exact method`). An exact fit runs in two stages (module `forward`): the search
-//! above with adding-doubling at [`FitOptions::search_quadrature_points`] (8) and
-//! [`FitOptions::search_step_nm`] (20 nm), then output space mapping onto the full model (24 points,
-//! [`FitOptions::step_nm`]) in two to four full evaluations, about 0.7 CPU-s per colour fit instead
-//! of some 7 for the full model throughout, with the same answer (BENCHMARKS.md `## Fit`).
-//! [`Method::Multipole`] (the paper's diffusion, ~47 ms per colour fit) runs in one stage and
-//! reproduces [DJ06].
-//!
-//! **Out of gamut.** A target no skin can produce (pure green) still gets its nearest skin, with
-//! `in_gamut = false` when ΔE00 exceeds [`FitOptions::gamut_threshold_de`] (3), or for spectra
-//! when the RMS exceeds [`FitOptions::max_rms`] (0.02).
+#![doc = include_str!("../README.md")]
 
 mod colour;
 mod error;

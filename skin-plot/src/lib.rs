@@ -1,20 +1,4 @@
-//! Charts to PNG: line / scatter panels and heat maps, stacked vertically in one image.
-//!
-//! Drawn with plotters into an in-memory RGB buffer (`BitMapBackend::with_buffer`), encoded as PNG
-//! by the `image` crate and written atomically through [`skin_io::atomic`]. Text uses the bundled
-//! DejaVu Sans, registered once, so charts look the same on every machine.
-//!
-//! Bad data still draws: non-finite points are skipped (a line breaks there), points ≤ 0 are dropped on
-//! a log axis, an empty or degenerate range is padded, and a panel with no data still draws axes.
-//!
-//! ```no_run
-//! use skin_plot::{LineChart, Panel, Series, save_png};
-//! let chart = LineChart::new("Absorption", "wavelength (nm)", "σa (mm⁻¹)")
-//!     .log_y()
-//!     .with_series(Series::line("eumelanin", vec![(400.0, 142.8), (700.0, 22.15)]));
-//! save_png("out/absorption.png".as_ref(), &[Panel::Line(chart)], 900, 600)?;
-//! # Ok::<(), skin_plot::PlotError>(())
-//! ```
+#![doc = include_str!("../README.md")]
 
 use plotters::prelude::*;
 use std::path::Path;
