@@ -1,8 +1,5 @@
 //! `skin render`: load a scene (the built-in three-head scene by default), path trace it, and write
 //! OUT/render.exr (linear sRGB, f32, with the passes of `render::passes`) and OUT/render.png (sRGB, exposure + filmic tone curve).
-//!
-//! Its clap fields share the shape of the skin flags in `cli::args` (doc, `#[arg]` with a `Checked`
-//! parser, `Option<f64>`): each flag's help and range differ, the parsers are shared.
 
 use crate::args::{Checked, parse_number, parse_whole};
 use ::render::fidelity::{Fidelity, FidelityKnobs, LodBand, LodSetting};

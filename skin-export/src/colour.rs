@@ -1,9 +1,5 @@
 //! The colour spaces an RGB export is declared in: linear Rec.709 (the primaries of sRGB, D65 white) and
 //! ACEScg (AP1 primaries, ACES white), docs/physics.md §14.
-//!
-//! [`ColourSpace`]'s `Display` and `FromStr` follow the workspace's pattern for a named choice
-//! (display the canonical name, parse it and its aliases case-insensitively), as `Format` does in
-//! `export`; each has its own names and error type.
 
 use std::fmt;
 use std::str::FromStr;

@@ -1,9 +1,6 @@
 //! The skin as the spectral formats write it: per wavelength, each layer's σa, σs (not reduced), g, n
 //! and thickness, taken from the one layer description `multipole` builds from the skin's parameters
 //! (σs = σs'/(1 − g), docs/physics.md §6, §11), with the exact totals `skin spectrum` prints.
-//!
-//! [`to_stack`] has the usual shape of a validating converter in this workspace (inputs in, a typed
-//! error out), which is all it shares with `validation::mcml`'s constructors.
 
 use crate::error::ExportError;
 use crate::volume::{semi_infinite_total, solve_decreasing};

@@ -1,10 +1,4 @@
 //! Fit to a colour: the skin's D65 colour from its model spectrum, and the ΔE00 search.
-//!
-//! The search objective (failure capture, β_m prior and box penalties) has the shape of
-//! `fit_spectrum`'s: the two differ in the residual and the type of its space-mapping shift (XYZ
-//! against one value per wavelength), and spelling each out keeps today's fits bit for bit.
-//! The option check of the colour model's step is the shape of every typed range check (name,
-//! value, valid range), spelled out where the option is read.
 
 use super::forward::{Forward, space_mapping};
 use super::{

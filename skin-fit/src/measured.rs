@@ -1,7 +1,5 @@
 //! A measured diffuse reflectance spectrum to fit: wavelengths in 400–700 nm, reflectance in [0, 1],
 //! optional non-negative weights; parsed from CSV `lambda_nm,reflectance[,weight]`.
-//!
-//! The range constants are one documented line each, the shape of every constant block.
 
 use super::error::FitError;
 

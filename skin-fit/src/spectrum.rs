@@ -1,7 +1,4 @@
 //! Fit to a measured spectrum: weighted least squares in reflectance at the measured wavelengths.
-//!
-//! The search objective and the result's fields have the shape of `fit_colour`'s (module
-//! `colour`), spelled out for the reason given there.
 
 use super::forward::{Forward, space_mapping};
 use super::{

@@ -5,9 +5,6 @@
 //! The reference white is the perfect reflecting diffuser under D65 as [`crate::color`] integrates it
 //! (so a perfect white spectrum is exactly L* = 100, a* = b* = 0); it agrees with CIE 015's tabulated
 //! D65 white (0.95047, 1, 1.08883) to about 1e-4.
-//!
-//! [`ItaCategory`]'s `name` + `Display` pair is the crate's pattern for a named enum (as `Preset`
-//! in `params`): the match arms are each enum's own names.
 
 use crate::color::{Srgb, Xyz, reflectance_to_xyz};
 use crate::spectrum::{GridSpectrum, WavelengthGrid};

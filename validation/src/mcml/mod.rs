@@ -9,8 +9,7 @@
 //! the annulus' exact area π((i + 1)² − i²)dr². [`mcml_binned`] puts our run on that footing.
 //! It needs finite layers: a semi-infinite layer is written [`HALF_SPACE_DEPTH_MM`] thick.
 //!
-//! The grid constants are documented one per line with their units, the shape of every such list
-//! of constants in the workspace; each is MCML's input, so none can be derived from another.
+//! Each grid constant is MCML's input, so none can be derived from another.
 
 mod compare;
 mod output;

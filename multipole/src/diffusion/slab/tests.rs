@@ -1,5 +1,5 @@
 //! Tests of the slab: closed forms, published check values and limits. Each test lists its cases
-//! (thickness, indices) as a literal table, the shape of every table-driven test of the workspace.
+//! (thickness, indices) as a literal table.
 
 use super::*;
 use approx::assert_relative_eq;
