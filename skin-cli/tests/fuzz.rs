@@ -6,7 +6,7 @@
 //! BENCHMARKS.md quotes:
 //!
 //! ```text
-//! FUZZ_CASES=5000 FUZZ_SEED=1 cargo test -p render --release --test fuzz -- --nocapture --include-ignored
+//! FUZZ_CASES=5000 FUZZ_SEED=1 cargo test -p skin-cli --release --test main fuzz -- --nocapture --include-ignored
 //! ```
 
 use crate::common;

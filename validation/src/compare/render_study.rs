@@ -57,7 +57,7 @@ impl RenderStudy {
         builtin_reference_spp: 16,
         ladder: &[1, 4],
     };
-    /// The counts of BENCHMARKS.md (about 6 CPU minutes).
+    /// The counts of BENCHMARKS.md, "BSSRDF against the volumetric reference".
     pub const FULL: Self = Self {
         side: 32,
         bssrdf_spp: 256,

@@ -2,12 +2,9 @@
 //! scaling, LU solves with partial pivoting, and the Cholesky factorisation with its triangular
 //! solves that `modes` uses (the symmetric eigensolver is in `eigen`).
 //!
-//! Hand-written rather than nalgebra, on measurement: the same solver with these kernels and the
-//! eigensolver on nalgebra 0.34 (`DMatrix` products, `LU`, `Cholesky`, triangular solves,
-//! `SymmetricEigen`) took 17–24% more CPU time at 8–24 quadrature points and 6% more at 32
-//! (`examples/ad_workload.rs`, 31-λ light + dark skin totals, process user time interleaved
-//! with the hand-written build in one script, three rounds), although it executed 2–27% fewer
-//! instructions (callgrind). BENCHMARKS.md, "Layout change", has the table and the commands.
+//! Hand-written rather than nalgebra, on measurement: the same solver on nalgebra 0.34 took more
+//! CPU time at every quadrature point count, although it executed fewer instructions
+//! (docs/benchmarks-archive.md, "Layout change", has the table and the commands).
 
 /// A dense square matrix of f64, row-major.
 #[derive(Debug, Clone, PartialEq)]
