@@ -2,7 +2,7 @@
 //! the multipole against the exact totals, on-CPU time per 31-wavelength skin spectrum, and the worst
 //! quadrature error against 64 points.
 //!
-//! `cargo run --release -p multipole --example adding_doubling_tables`
+//! `cargo run --release -p multipole --features studies --example adding_doubling_tables`
 
 use multipole::exact::adding_doubling::{
     AddingDoublingOptions, DEFAULT_G, SlabTotals, skin_totals, skin_totals_spectrum, solve,

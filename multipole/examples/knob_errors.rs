@@ -1,6 +1,6 @@
 //! Time versus error of every profile knob, against the converged reference (`skin::profile_error`).
 //!
-//! `cargo run --release -p multipole --example knob_errors [OUT.csv]` (default `out/multipole_knobs.csv`).
+//! `cargo run --release -p multipole --features studies --example knob_errors [OUT.csv]` (default `out/multipole_knobs.csv`).
 //! Columns: preset, lambda_nm, knob, value, time_us (median of 7 single-threaded runs),
 //! max_energy_density_error, total_relative_error, r99_relative_error. One knob varies at a time,
 //! the others stay at their defaults.

@@ -2,7 +2,7 @@
 //! with σa = 0.01, σs' = 1 mm⁻¹ (σs = 10 mm⁻¹), g = 0.9, n = 1.4 under air (about 1,600 scatterings
 //! per photon: long histories, the hardest case for the photon loop).
 //!
-//! `cargo run --release -p multipole --example mc_half_space [PHOTONS] [THREADS] [SIGMA_A]`
+//! `cargo run --release -p multipole --features studies --example mc_half_space [PHOTONS] [THREADS] [SIGMA_A]`
 //! (defaults 100000, 1, 0.01 mm⁻¹; σs' stays 1 mm⁻¹). Prints R_d (exact-transport reference
 //! values, BENCHMARKS.md `## Exact method`: 0.6040 for σa 0.01, 0.0713 for σa 0.5), energy, scatterings per photon, and the
 //! wall-clock rate; for the CPU-time rate run the built binary under `/usr/bin/time -f "%U user"`

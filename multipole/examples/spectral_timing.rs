@@ -2,7 +2,7 @@
 //! 99.9% radius) on one thread, robust to a loaded machine: it reads this thread's on-CPU time (`cpu-time`)
 //! besides the wall clock.
 //!
-//! `cargo run --release -p multipole --example spectral_timing [ITERATIONS [METHOD]]` (default 200,
+//! `cargo run --release -p multipole --features studies --example spectral_timing [ITERATIONS [METHOD]]` (default 200,
 //! multipole; `exact` times adding-doubling totals with the shape table's profiles, the table
 //! built or read from its cache before timing).
 

@@ -2,7 +2,7 @@
 //! multipole of docs/physics.md §4 (source at ℓ, 11 pairs, no treatment) and for this crate's documented
 //! treatment (`Slab`: diffused fraction w = min(1, σs'd), source at ℓw², delta pass-through).
 //!
-//! `cargo run --release -p multipole --example thin_slab [OUT.csv]` (default `out/multipole_thin_slab.csv`).
+//! `cargo run --release -p multipole --features studies --example thin_slab [OUT.csv]` (default `out/multipole_thin_slab.csv`).
 //! Slab: σa = 0.1, σs' = 2 mm⁻¹ (ℓ = 0.476 mm), η_top = 1.4, η_bottom = 1; also σa = 0 (energy check).
 
 #[path = "shared/write.rs"]

@@ -2,7 +2,7 @@
 //! (search at 8 quadrature points and 20 nm, corrected to the full model) and, with `--single`, a
 //! single-stage fit with the full model throughout, on four skins from light to dark.
 //!
-//! `cargo run --release -p multipole --example fit_timing [-- --single]`; prints a Markdown table
+//! `cargo run --release -p skin-fit --features studies --example fit_timing [-- --single]`; prints a Markdown table
 //! (wall and process CPU seconds, evaluations, ΔE00, the fitted skin and the β_m range).
 
 use skin_fit::{ColourModel, FitOptions, fit_colour};

@@ -8,7 +8,7 @@
 //!
 //! The Monte Carlo shapes (`ExactShape::MonteCarlo`) are timed (wall, ms, all cores).
 //!
-//! `cargo run --release -p validation --example exact_profiles [photons]` (default 1e6, seed 7).
+//! `cargo run --release -p validation --features studies --example exact_profiles [photons]` (default 1e6, seed 7).
 
 use indicatif::{ProgressBar, ProgressStyle};
 use multipole::skin::{ExactShape, Method, exact_profile, profile};

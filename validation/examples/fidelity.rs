@@ -26,7 +26,7 @@
 //! The default scene (`builtin:three-heads`, three cells, one head each) at SPP_DEFAULT: full,
 //! auto, and auto with the 500,000-photon shape table (SPP_DEFAULT 0 skips it).
 //!
-//! `cargo run --release -p render --example fidelity -- [OUT] [SPP_FAR] [SPP_EAR] [NOISE] [MAX_SPP]
+//! `cargo run --release -p render --features studies --example fidelity -- [OUT] [SPP_FAR] [SPP_EAR] [NOISE] [MAX_SPP]
 //! [SPP_DEFAULT]` (default out/fidelity, 64, 16, 0.1, 4096, 8; MAX_SPP 0 skips the renders to the
 //! noise target)
 

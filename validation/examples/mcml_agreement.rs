@@ -3,7 +3,7 @@
 //! tests run the same comparison with few photons), their largest |z| and mean z² (≈ 1 when the two
 //! codes agree and both errors are right).
 //!
-//! `cargo run --release -p validation --example mcml_agreement [PHOTONS] [CASE…]`
+//! `cargo run --release -p validation --features studies --example mcml_agreement [PHOTONS] [CASE…]`
 //! (default 10⁶ photons in 40 runs, every case).
 
 use indicatif::{ProgressBar, ProgressStyle};

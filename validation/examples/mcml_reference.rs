@@ -2,7 +2,7 @@
 //! `validation::mcml::cases`, the `.mci` input (the layers our code builds, in MCML's cm units) and,
 //! after running MCML on it, the means and standard errors over its independent runs as CSV.
 //!
-//! `cargo run --release -p validation --example mcml_reference -- PATH_TO_MCML [RUNS] [PHOTONS_PER_RUN]`
+//! `cargo run --release -p validation --features studies --example mcml_reference -- PATH_TO_MCML [RUNS] [PHOTONS_PER_RUN]`
 //! (defaults 20 runs × 100,000 photons; MCML is built by its own build script, outside this tree).
 //! Cases run in parallel on the rayon pool. MCML seeds its generator from the clock, so a re-run
 //! gives other numbers within the stated standard errors.

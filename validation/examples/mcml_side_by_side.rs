@@ -9,7 +9,7 @@
 //! (`/proc/thread-self/schedstat`), so other load on the machine does not count (Linux only).
 //! The two alternate `REPEATS` times per case; each line is one pair, the summary the median ratio.
 //!
-//! `cargo run --release -p validation --example mcml_side_by_side -- PATH_TO_MCML [PHOTONS] [REPEATS]`
+//! `cargo run --release -p validation --features studies --example mcml_side_by_side -- PATH_TO_MCML [PHOTONS] [REPEATS]`
 //! (defaults 100,000 photons, 3 repeats; MCML built by its own build script, outside this tree).
 
 use anyhow::Context;

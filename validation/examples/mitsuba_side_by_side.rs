@@ -13,7 +13,7 @@
 //! (paths/s ÷ σ₁²)_ours / (paths/s ÷ σ₁²)_Mitsuba.
 //!
 //! Mitsuba runs in a Python outside this tree (`validation/examples/mitsuba_sphere.py`):
-//! `cargo run --release -p validation --example mitsuba_side_by_side -- PYTHON [VARIANT]
+//! `cargo run --release -p validation --features studies --example mitsuba_side_by_side -- PYTHON [VARIANT]
 //! [RR_DEPTH] [ROUNDS] [SPP] [SIDE]` (defaults llvm_ad_mono, Mitsuba's own rr_depth 5, 3 rounds,
 //! 32 spp, 48 px), PYTHON a python with `mitsuba` and `numpy` installed (the LLVM variants need
 //! libLLVM ≥ 16, e.g. `DRJIT_LIBLLVM_PATH=/usr/lib/x86_64-linux-gnu/libLLVM-19.so`). CPU time: ours from the process clock around `render` (a

@@ -7,7 +7,7 @@
 //! mean(e)²·P/N; so the most any allocation gains in variance at equal samples is
 //! E[e²]/E[e]². e_i comes from the film's variance pass (σ̂²/n, so e_i² = n · σ̂²/n / Ȳ_i²).
 //!
-//! `cargo run --release -p validation --example noise_spread -- [SPP] [SEED]`
+//! `cargo run --release -p validation --features studies --example noise_spread -- [SPP] [SEED]`
 
 use render::noise::lit_threshold;
 use render::passes::Passes;

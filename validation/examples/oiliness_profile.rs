@@ -5,7 +5,7 @@
 //! χ² cost of holding ρ_s, n (rms_fixed² − rms_free²) / σ², against the criterion's price of one
 //! parameter, ln n; plus how often the scattering scales sit on their lower bound.
 //!
-//!     cargo run --release -p validation --example oiliness_profile [-- RECORDS]
+//!     cargo run --release -p validation --features studies --example oiliness_profile [-- RECORDS]
 //!
 //! Exploration records only (the held-out ones are for reporting), spread evenly (default 24).
 

@@ -6,7 +6,7 @@
 //! error included), for the light, medium and dark presets. Time: wall clock of the whole 380–780 nm,
 //! 10 nm table on all cores.
 //!
-//! `cargo run --release -p validation --example shape_step`
+//! `cargo run --release -p validation --features studies --example shape_step`
 
 use multipole::skin::{ExactShape, Method, SpectralProfiles, exact_profile};
 use multipole::{Profile, ProfileOptions};

@@ -36,9 +36,9 @@ const Z_MAX: f64 = 4.64;
 /// Relative difference in absorption per layer forgiven (besides MCML's rounding): in light skin
 /// our epidermis absorbs up to 0.9% more than the committed MCML runs (+0.24%, +0.72%, +0.88% at
 /// 450, 550, 650 nm, z = 2.6, 7.4, 9.9 with 10⁶ photons of ours, `cargo run --release -p
-/// validation --example mcml_agreement`). The cause is MCML's `ran3` generator: MCML with only
-/// its generator replaced by xoshiro256** (`validation/data/mcml/random_num_xoshiro.c`, README
-/// there) absorbs 0.87% more in the epidermis at 650 nm (0.09633 ± 0.00007 against 0.09550 ±
+/// validation --features studies --example mcml_agreement`). The cause is MCML's `ran3`
+/// generator: MCML with only its generator replaced by xoshiro256**
+/// (`validation/data/mcml/random_num_xoshiro.c`, README there) absorbs 0.87% more in the epidermis at 650 nm (0.09633 ± 0.00007 against 0.09550 ±
 /// 0.00006 for the same build with `ran3`), ours 0.0964, and its R_d moves from 0.6093 to 0.6076,
 /// onto ours (0.6075) and adding-doubling's (0.6077). The reference data are `ran3`'s, so the
 /// allowance stays, scoped to per-layer absorption; dark skin and the half-space agree within
