@@ -1,6 +1,6 @@
 //! Typed errors of the layered-transport crate: every variant names the parameter, its value and its range.
 //!
-//! [`check_range`] returns this crate's error type, so every range check of the crate reports
+//! `check_range` returns this crate's error type, so every range check of the crate reports
 //! through it.
 
 use skin_optics::OpticsError;

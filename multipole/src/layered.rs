@@ -1,8 +1,8 @@
 //! The one description of a layered medium, shared by every transport method: each layer's σa,
 //! σs (and σs'), Henyey–Greenstein g, index n and thickness, with the ambient indices above and
-//! below. Diffusion ([`crate::Stack::from_medium`]), adding-doubling
-//! ([`crate::exact::adding_doubling::solve`]) and the Monte Carlo ([`crate::exact::montecarlo::run`]) all take a
-//! [`LayeredMedium`]; [`LayeredMedium::skin`] builds the two-layer skin from its parameters
+//! below. Diffusion ([`crate::diffusion::stack::Stack::from_medium`]), adding-doubling
+//! ([`crate::exact::adding_doubling::solve`]) and the Monte Carlo
+//! ([`crate::exact::montecarlo::run`]) all take a [`LayeredMedium`]; [`LayeredMedium::skin`] builds the two-layer skin from its parameters
 //! (docs/physics.md §1, §6). The default anisotropy, the σs'→σs conversion and the valid ranges
 //! live here and nowhere else.
 //!
