@@ -1,5 +1,5 @@
 //! `skin fit`: the skin parameters (C_m, β_m, C_h) that match an sRGB colour or a measured reflectance
-//! spectrum, from `multipole::fit`; prints the fit (with the forward model used), its colour, residual,
+//! spectrum, from `skin_fit`; prints the fit (with the forward model used), its colour, residual,
 //! CIELAB and ITA°, or JSON.
 
 use crate::args::{Checked, parse_number};
