@@ -34,8 +34,8 @@ pub struct FitArgs {
     #[arg(long, value_name = "FILE.csv")]
     pub spectrum: Option<PathBuf>,
     /// Forward model: `exact` (adding-doubling totals, right for every skin tone; searched with a
-    /// cheap 8-point exact model, then corrected to the full one: about 1 s per colour) or `multipole`
-    /// (the paper's diffusion: reproduces Donner & Jensen 2006, about 50 ms, but dark skin comes out too bright,
+    /// cheap 8-point exact model, then corrected to the full one) or `multipole` (the paper's
+    /// diffusion: reproduces Donner & Jensen 2006 and is faster, but dark skin comes out too bright,
     /// so its melanin is fitted too high).
     #[arg(long, value_name = "METHOD", default_value = "exact", value_parser = Checked(parse_method), allow_hyphen_values = true)]
     pub method: Method,

@@ -67,7 +67,8 @@ impl Forward {
     }
 
     /// [`Forward::reflectance`] at every wavelength of `lambdas`, in order; an adding-doubling model
-    /// spreads the wavelengths over rayon's threads (each ~10–150 µs), a diffusion one does not (~1 µs).
+    /// spreads the wavelengths over rayon's threads (each costs enough to pay for it), a diffusion
+    /// one does not (too cheap per wavelength).
     pub(crate) fn spectrum(
         &self,
         skin: &SkinParams,

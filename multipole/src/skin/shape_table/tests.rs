@@ -1,7 +1,7 @@
 use super::*;
 use std::sync::OnceLock;
 
-/// A small table (40,000 photons, ≈ 1 CPU-s in release) shared by the tests below.
+/// A small table (40,000 photons, so the tests stay cheap) shared by the tests below.
 fn table() -> &'static ShapeTable {
     static T: OnceLock<ShapeTable> = OnceLock::new();
     T.get_or_init(|| {
