@@ -68,9 +68,15 @@ pub struct ExportArgs {
     /// Gaussians written by `gaussians`, [1, 8] (4, 5 and 6 are always reported).
     #[arg(long, value_name = "N", default_value_t = ExportOptions::default().gaussian_terms)]
     pub terms: usize,
-    /// Wavelength of the MCX input, nm, [250, 1000].
-    #[arg(long, value_name = "NM", default_value_t = ExportOptions::default().mcx_lambda_nm, allow_negative_numbers = true)]
+    /// The one wavelength of `mcx` and of `mitsuba --variant mono`, nm, [250, 1000] ([360, 830] for Mitsuba).
+    #[arg(long, value_name = "NM", default_value_t = ExportOptions::default().lambda_nm, allow_negative_numbers = true)]
     pub lambda: f64,
+    /// Mitsuba 3 variant family: spectral (360–830 nm spectra), rgb (σt scaled into [0, 1]) or mono (--lambda).
+    #[arg(long, value_name = "NAME", default_value = "spectral")]
+    pub variant: String,
+    /// Write a complete scene (camera and uniform sky) that renders as is (mitsuba).
+    #[arg(long)]
+    pub scene: bool,
     /// Finite dermis thickness for MCML, MCX and Mitsuba, mm, [1, 1000].
     #[arg(long = "dermis-mm", value_name = "MM", default_value_t = ExportOptions::default().dermis_thickness_mm)]
     pub dermis_mm: f64,
@@ -97,7 +103,13 @@ impl ExportArgs {
             photons: self.photons,
             volume_photons: self.volume_photons,
             gaussian_terms: self.terms,
-            mcx_lambda_nm: self.lambda,
+            lambda_nm: self.lambda,
+            mitsuba_variant: self
+                .variant
+                .parse::<skin_export::mitsuba::Variant>()
+                .map_err(anyhow::Error::msg)
+                .context("--variant")?,
+            scene: self.scene,
             dermis_thickness_mm: self.dermis_mm,
             ..ExportOptions::default()
         };

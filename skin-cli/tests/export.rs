@@ -105,9 +105,285 @@ fn materialx_parses_and_holds_the_medium_fit() {
     for (got, want) in rgb_aces.totals().iter().zip(want) {
         assert!(close(*got, want, 1e-9));
     }
-    let e = export_rgb(Format::OpenPbr, &rgb_aces, surface, &aces).unwrap();
+    // The medium is fitted in linear Rec.709: an ACEScg profile is refused, and the ACEScg
+    // document is written from the Rec.709 one.
+    assert!(export_rgb(Format::OpenPbr, &rgb_aces, surface, &aces).is_err());
+    let e = export_rgb(Format::OpenPbr, rgb(), surface, &aces).unwrap();
     let doc = roxmltree::Document::parse(&e.text).unwrap();
     assert_eq!(doc.root_element().attribute("colorspace"), Some("acescg"));
+}
+
+/// A 3×3 matrix product.
+fn matmul(a: [[f64; 3]; 3], b: [[f64; 3]; 3]) -> [[f64; 3]; 3] {
+    std::array::from_fn(|i| std::array::from_fn(|j| (0..3).map(|k| a[i][k] * b[k][j]).sum()))
+}
+
+/// The inverse of a 3×3 matrix by its adjugate.
+fn inverse(m: [[f64; 3]; 3]) -> [[f64; 3]; 3] {
+    let c = |i: usize, j: usize| {
+        let (r0, r1) = ((i + 1) % 3, (i + 2) % 3);
+        let (c0, c1) = ((j + 1) % 3, (j + 2) % 3);
+        m[r0][c0] * m[r1][c1] - m[r0][c1] * m[r1][c0]
+    };
+    let det: f64 = (0..3).map(|j| m[0][j] * c(0, j)).sum();
+    std::array::from_fn(|i| std::array::from_fn(|j| c(j, i) / det))
+}
+
+fn apply(m: [[f64; 3]; 3], v: [f64; 3]) -> [f64; 3] {
+    std::array::from_fn(|i| (0..3).map(|k| m[i][k] * v[k]).sum())
+}
+
+/// RGB → XYZ of primaries and white given as CIE xy chromaticities (the white has Y = 1).
+fn rgb_to_xyz(primaries: [[f64; 2]; 3], white: [f64; 2]) -> [[f64; 3]; 3] {
+    let xyz = |[x, y]: [f64; 2]| [x / y, 1.0, (1.0 - x - y) / y];
+    let cols = primaries.map(xyz);
+    let p: [[f64; 3]; 3] = std::array::from_fn(|i| std::array::from_fn(|j| cols[j][i]));
+    let s = apply(inverse(p), xyz(white));
+    std::array::from_fn(|i| std::array::from_fn(|j| p[i][j] * s[j]))
+}
+
+/// ACEScg → linear Rec.709 from the published definitions: AP1 primaries and the ACES white
+/// (SMPTE ST 2065-1 / Academy S-2014-004), Rec.709 primaries and D65 (ITU-R BT.709), and the
+/// Bradford chromatic adaptation from the ACES white to D65.
+fn acescg_to_rec709() -> [[f64; 3]; 3] {
+    let ap1 = rgb_to_xyz(
+        [[0.713, 0.293], [0.165, 0.830], [0.128, 0.044]],
+        [0.32168, 0.33767],
+    );
+    let rec709 = rgb_to_xyz([[0.64, 0.33], [0.30, 0.60], [0.15, 0.06]], [0.3127, 0.3290]);
+    let bradford = [
+        [0.8951, 0.2664, -0.1614],
+        [-0.7502, 1.7135, 0.0367],
+        [0.0389, -0.0685, 1.0296],
+    ];
+    let white = |[x, y]: [f64; 2]| apply(bradford, [x / y, 1.0, (1.0 - x - y) / y]);
+    let (src, dst) = (white([0.32168, 0.33767]), white([0.3127, 0.3290]));
+    let scale = [
+        [dst[0] / src[0], 0.0, 0.0],
+        [0.0, dst[1] / src[1], 0.0],
+        [0.0, 0.0, dst[2] / src[2]],
+    ];
+    let cat = matmul(inverse(bradford), matmul(scale, bradford));
+    matmul(inverse(rec709), matmul(cat, ap1))
+}
+
+#[test]
+fn acescg_radii_transformed_as_materialx_does_equal_the_rec709_file() {
+    let o = opts();
+    let surface = Surface::of(&skin());
+    let m = acescg_to_rec709();
+    // MaterialX's own acescg → lin_rec709 matrix (its stdlib colour-transform node), to 4 decimals.
+    assert!(
+        (m[0][0] - 1.70505).abs() < 2e-4 && (m[1][1] - 1.14080).abs() < 2e-4,
+        "{m:?}"
+    );
+    for format in [Format::OpenPbr, Format::StandardSurface] {
+        let read = |space: ColourSpace| {
+            let e = export_rgb(
+                format,
+                rgb(),
+                surface,
+                &ExportOptions {
+                    colour_space: space,
+                    ..o
+                },
+            )
+            .unwrap();
+            let doc = roxmltree::Document::parse(&e.text).unwrap();
+            let (radius, scale) = match format {
+                Format::OpenPbr => (
+                    mtlx_input(&doc, "subsurface_radius")[0],
+                    mtlx_input(&doc, "subsurface_radius_scale"),
+                ),
+                _ => (
+                    mtlx_input(&doc, "subsurface_scale")[0],
+                    mtlx_input(&doc, "subsurface_radius"),
+                ),
+            };
+            let colour = mtlx_input(&doc, "subsurface_color");
+            (
+                [0, 1, 2].map(|c| radius * scale[c]),
+                [colour[0], colour[1], colour[2]],
+            )
+        };
+        let (rec_radii, rec_colour) = read(ColourSpace::LinRec709);
+        let (aces_radii, aces_colour) = read(ColourSpace::AcesCg);
+        // MaterialX transforms every color3 input of an acescg document, radii included.
+        let (radii, colour) = (apply(m, aces_radii), apply(m, aces_colour));
+        for c in 0..3 {
+            assert!(
+                close(radii[c], rec_radii[c], 5e-3),
+                "{format} {radii:?} vs {rec_radii:?}"
+            );
+            assert!(close(colour[c], rec_colour[c], 5e-3), "{format} {colour:?}");
+        }
+    }
+}
+
+/// The number after `name="NAME" value="` in a Mitsuba medium, as numbers.
+fn mitsuba_values(medium: roxmltree::Node, name: &str) -> Vec<f64> {
+    medium
+        .children()
+        .find(|n| n.attribute("name") == Some(name))
+        .unwrap_or_else(|| panic!("no {name}"))
+        .attribute("value")
+        .unwrap()
+        .split(',')
+        .map(|v| v.trim().parse().unwrap())
+        .collect()
+}
+
+#[test]
+fn mitsuba_rgb_scene_configured_in_our_monte_carlo_returns_our_rgb_totals() {
+    let s = skin();
+    let o = ExportOptions {
+        mitsuba_variant: skin_export::mitsuba::Variant::Rgb,
+        scene: true,
+        ..opts()
+    };
+    let grid = skin_export::mitsuba::spectral_grid(10.0).unwrap();
+    let spectral = SpectralSkin::new(&s, &grid).unwrap();
+    let e = export_spectral(Format::Mitsuba, &spectral, &s, Surface::of(&s), &o).unwrap();
+    let doc = roxmltree::Document::parse(&e.text).unwrap();
+    assert!(doc.descendants().any(|n| n.has_tag_name("sensor")));
+    assert!(doc.descendants().any(|n| n.has_tag_name("emitter")));
+    let media: Vec<_> = doc
+        .descendants()
+        .filter(|n| n.has_tag_name("medium"))
+        .collect();
+    // The dermis block's top face: translate z + scale z of the second cube.
+    let epidermis_mm = skin().epidermis_thickness_mm();
+    // Reference: the RGB of `skin spectrum`'s exact spectrum (per incident photon) over 400–700 nm,
+    // independent of the channel fit.
+    let rows = skin_cli::spectrum::rows(&s, &o.grid, Method::Exact).unwrap();
+    let xyz = skin_optics::color::reflectance_to_xyz(
+        &skin_optics::GridSpectrum::new(
+            o.grid,
+            rows.iter().map(|r| r.diffuse_reflectance).collect(),
+        )
+        .unwrap(),
+    );
+    let want = xyz.to_linear_srgb().0;
+    for c in 0..3 {
+        let layers: Vec<multipole::Layer> = media
+            .iter()
+            .enumerate()
+            .map(|(i, m)| {
+                let sigma_t = mitsuba_values(*m, "scale")[0] * mitsuba_values(*m, "sigma_t")[c];
+                let albedo = mitsuba_values(*m, "albedo")[c];
+                assert!(mitsuba_values(*m, "sigma_t").iter().all(|v| *v <= 1.0));
+                let (sa, ss) = (sigma_t * (1.0 - albedo), sigma_t * albedo);
+                if i == 0 {
+                    multipole::Layer::slab(sa, ss, 0.9, 1.4, epidermis_mm).unwrap()
+                } else {
+                    multipole::Layer::slab(sa, ss, 0.9, 1.4, o.dermis_thickness_mm).unwrap()
+                }
+            })
+            .collect();
+        let stack = multipole::LayeredMedium::new(layers, 1.0, 1.0).unwrap();
+        let result = run(
+            &stack,
+            &McOptions::new(o.photons, 32, 40 + c as u64).unwrap(),
+        );
+        // The scene's stated normalisation: pixel − F(0) = diffuse reflectance per incident photon.
+        // Colour integration at 10 nm against 400–700 nm moves the reference by < 0.1%, below σ.
+        let z = result.diffuse_reflectance.z_score(want[c]);
+        assert!(
+            z.abs() < 3.0,
+            "{c}: MC {:?} vs {}",
+            result.diffuse_reflectance,
+            want[c]
+        );
+    }
+}
+
+#[test]
+fn mcx_input_configured_in_our_monte_carlo_returns_the_stated_per_entering_total() {
+    let s = skin();
+    let o = opts();
+    let one = SpectralSkin::new(&s, &WavelengthGrid::new(550.0, 550.0, 1.0).unwrap()).unwrap();
+    let e = export_spectral(Format::Mcx, &one, &s, Surface::of(&s), &o).unwrap();
+    assert!(e.notes.iter().any(|n| n.contains("per photon entering")));
+    let v = json(&e.text);
+    let unit = v["Domain"]["LengthUnit"].as_f64().unwrap();
+    let dim: Vec<f64> = v["Domain"]["Dim"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|d| d.as_f64().unwrap())
+        .collect();
+    let epi_voxels = v["Shapes"][1]["ZLayers"][0][1].as_f64().unwrap();
+    // One detector at the entry point holding the whole top face and not reaching the bottom.
+    let det = &v["Optode"]["Detector"][0];
+    let r = det["R"].as_f64().unwrap();
+    assert!(
+        r >= dim[0] / 2.0 * std::f64::consts::SQRT_2 && r < dim[2],
+        "{r}"
+    );
+    assert_eq!(det["Pos"][2].as_f64(), Some(0.0));
+    let media = v["Domain"]["Media"].as_array().unwrap();
+    let layer = |i: usize, d: f64| {
+        let m = &media[i];
+        multipole::Layer::slab(
+            m["mua"].as_f64().unwrap(),
+            m["mus"].as_f64().unwrap(),
+            m["g"].as_f64().unwrap(),
+            m["n"].as_f64().unwrap(),
+            d,
+        )
+        .unwrap()
+    };
+    let stack = multipole::LayeredMedium::new(
+        vec![
+            layer(1, epi_voxels * unit),
+            layer(2, (dim[2] - epi_voxels) * unit),
+        ],
+        media[0]["n"].as_f64().unwrap(),
+        1.0,
+    )
+    .unwrap();
+    let result = run(&stack, &McOptions::new(o.photons, 32, 11).unwrap());
+    // MCX counts per photon entering: our incident-photon estimate over 1 − specular.
+    let entering = 1.0 - result.specular_reflectance;
+    let (mean, se) = (
+        result.diffuse_reflectance.mean / entering,
+        result.diffuse_reflectance.stderr / entering,
+    );
+    let total = one.rows[0].total;
+    assert!(
+        ((mean - total) / se).abs() < 3.0,
+        "MC {mean} ± {se} vs {total}"
+    );
+}
+
+#[test]
+fn what_a_format_cannot_carry_is_refused() {
+    let s = skin();
+    let aces = ExportOptions {
+        colour_space: ColourSpace::AcesCg,
+        ..opts()
+    };
+    for format in [
+        Format::Unreal,
+        Format::Hdrp,
+        Format::Mcx,
+        Format::Mcml,
+        Format::Mitsuba,
+    ] {
+        let err = skin_export::export(&s, format, &aces).unwrap_err();
+        assert!(
+            matches!(err, skin_export::ExportError::ColourSpace { .. }),
+            "{format}: {err}"
+        );
+        assert!(err.to_string().contains("lin_rec709"), "{err}");
+    }
+    let mono = ExportOptions {
+        mitsuba_variant: skin_export::mitsuba::Variant::Mono,
+        lambda_nm: 900.0,
+        ..opts()
+    };
+    let err = skin_export::export(&s, Format::Mitsuba, &mono).unwrap_err();
+    assert!(err.to_string().contains("[360, 830] nm"), "{err}");
 }
 
 #[test]
@@ -181,7 +457,14 @@ fn spectral_formats_parse_and_hold_our_layers() {
     let s = skin();
     let spectral = SpectralSkin::new(&s, &o.grid).unwrap();
     let surface = Surface::of(&s);
-    // Mitsuba: two media, the epidermis' σt and albedo per wavelength (written to 7 digits).
+    // Mitsuba: two media, the epidermis' σt and albedo per wavelength over 360–830 nm (written to
+    // 7 digits); a spectrum that stops short of that range is refused.
+    assert!(matches!(
+        export_spectral(Format::Mitsuba, &spectral, &s, surface, &o),
+        Err(skin_export::ExportError::OutOfRange { .. })
+    ));
+    let spectral =
+        SpectralSkin::new(&s, &skin_export::mitsuba::spectral_grid(20.0).unwrap()).unwrap();
     let e = export_spectral(Format::Mitsuba, &spectral, &s, surface, &o).unwrap();
     let doc = roxmltree::Document::parse(&e.text).unwrap();
     let media: Vec<_> = doc
@@ -204,6 +487,7 @@ fn spectral_formats_parse_and_hold_our_layers() {
             1e-6
         ));
     }
+    let spectral = SpectralSkin::new(&s, &o.grid).unwrap();
     // MCX: media in mm⁻¹.
     let one = SpectralSkin::new(&s, &WavelengthGrid::new(550.0, 550.0, 1.0).unwrap()).unwrap();
     let e = json(
@@ -403,8 +687,9 @@ fn bad_input_ends_in_one_line_naming_the_problem() {
     std::fs::write(&blocker, b"x").unwrap();
     let target = blocker.join("skin.mci");
     let target = target.to_str().unwrap();
-    let cases: [(&[&str], &str); 4] = [
-        (&["export", "blender"], "unknown export format 'blender'"),
+    let cases: [(&[&str], &str); 5] = [
+        (&["export", "cycles"], "unknown export format 'cycles'"),
+        (&["export", "mitsuba", "--variant", "gray"], "--variant"),
         (&["export", "mcml", "--from", "200"], "--from"),
         (&["export", "mcml", "--colour-space", "xyz"], "lin_rec709"),
         (&["export", "mcml", "--out", target], "not a folder"),

@@ -23,6 +23,16 @@ pub enum ExportError {
         /// The valid range.
         range: &'static str,
     },
+    /// A colour space the format cannot carry.
+    #[error("--colour-space {space}: {format} cannot carry it (valid: {valid})")]
+    ColourSpace {
+        /// The format's name.
+        format: &'static str,
+        /// The refused colour space.
+        space: &'static str,
+        /// What the format takes.
+        valid: &'static str,
+    },
     /// Bad skin parameters or wavelengths.
     #[error(transparent)]
     Optics(#[from] OpticsError),

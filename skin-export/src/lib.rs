@@ -129,8 +129,12 @@ pub struct ExportOptions {
     pub volume_photons: u64,
     /// Gaussians written by the `gaussians` format (4, 5 and 6 are always measured).
     pub gaussian_terms: usize,
-    /// Wavelength of the MCX input, nm.
-    pub mcx_lambda_nm: f64,
+    /// The one wavelength of the MCX input and of Mitsuba's mono variant, nm.
+    pub lambda_nm: f64,
+    /// Which Mitsuba 3 variant family the scene is written for.
+    pub mitsuba_variant: mitsuba::Variant,
+    /// Write a complete scene (camera, sky) where the format has one (Mitsuba).
+    pub scene: bool,
     /// Thickness given to the dermis where the program needs a finite layer (MCML, MCX, Mitsuba), mm.
     pub dermis_thickness_mm: f64,
 }
@@ -146,7 +150,9 @@ impl Default for ExportOptions {
             photons: 1_000_000,
             volume_photons: 20_000,
             gaussian_terms: 6,
-            mcx_lambda_nm: 550.0,
+            lambda_nm: 550.0,
+            mitsuba_variant: mitsuba::Variant::Spectral,
+            scene: false,
             dermis_thickness_mm: 20.0,
         }
     }
@@ -192,8 +198,8 @@ impl ExportOptions {
             "[1, 8]",
         )?;
         check(
-            "MCX wavelength (nm)",
-            self.mcx_lambda_nm,
+            "wavelength (nm)",
+            self.lambda_nm,
             250.0,
             1000.0,
             "[250, 1000] nm",
@@ -205,6 +211,37 @@ impl ExportOptions {
             1000.0,
             "[1, 1000] mm",
         )?;
+        Ok(())
+    }
+
+    /// Refuse what `format` cannot carry: a colour space other than linear Rec.709 where the
+    /// engine has no colour-space tag (or no colours), and wavelengths outside what it samples.
+    pub fn check_format(&self, format: Format) -> Result<(), ExportError> {
+        let carries_acescg = match format {
+            Format::OpenPbr | Format::StandardSurface | Format::Gaussians | Format::Burley => true,
+            Format::Unreal | Format::Hdrp | Format::Pbrt | Format::Mcml | Format::Mcx => false,
+            Format::Mitsuba => false,
+        };
+        if self.colour_space != ColourSpace::LinRec709 && !carries_acescg {
+            return Err(ExportError::ColourSpace {
+                format: format.name(),
+                space: self.colour_space.materialx_name(),
+                valid: if format.is_rgb() {
+                    "lin_rec709 (the engine's working space; the file has no colour-space tag)"
+                } else {
+                    "lin_rec709 (the format is spectral: it holds no colours)"
+                },
+            });
+        }
+        if format == Format::Mitsuba && self.mitsuba_variant == mitsuba::Variant::Mono {
+            check(
+                "Mitsuba mono wavelength (nm)",
+                self.lambda_nm,
+                mitsuba::SPECTRAL_RANGE_NM.0,
+                mitsuba::SPECTRAL_RANGE_NM.1,
+                "[360, 830] nm (Mitsuba's spectral range)",
+            )?;
+        }
         Ok(())
     }
 }
@@ -291,11 +328,31 @@ pub fn export(
         opts.escapes,
         opts.shape_step_nm,
     )];
+    opts.check_format(format)?;
     let mut out = if format.is_rgb() {
-        let rgb = rgb_profile(skin, opts)?;
+        // MaterialX documents are fitted in linear Rec.709 and carry their colour space themselves.
+        let rgb_opts = match format {
+            Format::OpenPbr | Format::StandardSurface => ExportOptions {
+                colour_space: ColourSpace::LinRec709,
+                ..*opts
+            },
+            _ => *opts,
+        };
+        let rgb = rgb_profile(skin, &rgb_opts)?;
         export_rgb(format, &rgb, surface, opts)?
-    } else if format == Format::Mcx {
-        let grid = WavelengthGrid::new(opts.mcx_lambda_nm, opts.mcx_lambda_nm, 1.0)?;
+    } else if format == Format::Mcx
+        || (format == Format::Mitsuba && opts.mitsuba_variant == mitsuba::Variant::Mono)
+    {
+        let grid = WavelengthGrid::new(opts.lambda_nm, opts.lambda_nm, 1.0)?;
+        export_spectral(
+            format,
+            &SpectralSkin::new(skin, &grid)?,
+            skin,
+            surface,
+            opts,
+        )?
+    } else if format == Format::Mitsuba {
+        let grid = mitsuba::spectral_grid(opts.grid.step_nm())?;
         export_spectral(
             format,
             &SpectralSkin::new(skin, &grid)?,
@@ -327,6 +384,12 @@ pub fn export_rgb(
 ) -> Result<Export, ExportError> {
     let (text, notes) = match format {
         Format::OpenPbr | Format::StandardSurface => {
+            if rgb.space() != ColourSpace::LinRec709 {
+                return Err(ExportError::Fit(format!(
+                    "{format}: the medium is fitted to linear Rec.709 profiles (got {})",
+                    rgb.space()
+                )));
+            }
             let fit = volume::VolumeFit::fit(
                 rgb,
                 multipole::DEFAULT_G,
@@ -366,7 +429,7 @@ pub fn export_spectral(
 ) -> Result<Export, ExportError> {
     let (text, notes) = match format {
         Format::Pbrt => pbrt::write(spectral, skin, surface, opts)?,
-        Format::Mitsuba => mitsuba::write(spectral, surface, opts)?,
+        Format::Mitsuba => mitsuba::write(spectral, skin, surface, opts)?,
         Format::Mcml => mcml::write(spectral, opts)?,
         Format::Mcx => mcx::write(spectral, opts)?,
         _ => unreachable!("RGB formats go through export_rgb"),

@@ -1,5 +1,11 @@
 //! MaterialX documents of OpenPBR Surface ([OpenPBR]) and Autodesk Standard Surface ([ASS]): the
-//! subsurface medium of [`VolumeFit`] and the dielectric specular face (docs/physics.md §14).
+//! subsurface medium of [`VolumeFit`] and the dielectric specular face (docs/physics.md §14.4).
+//!
+//! MaterialX colour-manages every `color3` input from the document's `colorspace` to the renderer's
+//! working space, the radii (`subsurface_radius_scale`, Standard Surface's `subsurface_radius`)
+//! included. The medium is therefore fitted once, in linear Rec.709, and every `color3` (colours
+//! and radii alike) is written as its image in the document's space: MaterialX's transform back to
+//! lin_rec709 then returns the fitted mean free paths, whatever space the file is declared in.
 
 use crate::volume::VolumeFit;
 use crate::{ExportOptions, Format, Surface, percent3};
@@ -10,7 +16,8 @@ fn triple(v: [f64; 3]) -> String {
     format!("{:.6}, {:.6}, {:.6}", v[0], v[1], v[2])
 }
 
-/// The document for `format` (OpenPBR or Standard Surface) and its notes.
+/// The document for `format` (OpenPBR or Standard Surface) of a medium fitted in linear Rec.709,
+/// its colours and radii written in `opts.colour_space`, and its notes.
 #[must_use]
 pub fn write(
     format: Format,
@@ -18,7 +25,8 @@ pub fn write(
     surface: Surface,
     opts: &ExportOptions,
 ) -> (String, Vec<String>) {
-    let mfp_units = fit.mean_free_path_mm.map(|l| l / opts.scene_unit_mm);
+    let to_space = |v: [f64; 3]| opts.colour_space.from_rec709(v);
+    let mfp_units = to_space(fit.mean_free_path_mm.map(|l| l / opts.scene_unit_mm));
     let radius = mfp_units.iter().copied().fold(0.0, f64::max);
     let scale = mfp_units.map(|l| l / radius);
     let space = opts.colour_space.materialx_name();
@@ -36,7 +44,7 @@ pub fn write(
         _ => ("standard_surface", "skin_standard_surface"),
     };
     let _ = writeln!(x, r#"  <{node} name="{shader}" type="surfaceshader">"#);
-    let colour = triple(fit.colour);
+    let colour = triple(to_space(fit.colour));
     let roughness = format!("{:.6}", surface.ggx_roughness());
     let ior = format!("{:.6}", surface.eta);
     let weight = format!("{:.6}", surface.oiliness);
@@ -77,11 +85,24 @@ pub fn write(
     );
     let notes = vec![
         format!(
-            "units: mean free paths (radius × scale) in scene units of {} mm: {:.5}/{:.5}/{:.5} mm (R/G/B); colours linear {space}",
+            "units: mean free paths (radius × scale) in scene units of {} mm: {:.5}/{:.5}/{:.5} mm (R/G/B, linear Rec.709 channels); colour space {space}: every color3 (colours and the radius colour) is the {space} image of the linear Rec.709 fit, so MaterialX's colour management to a lin_rec709 working space returns these mean free paths",
             opts.scene_unit_mm,
             fit.mean_free_path_mm[0],
             fit.mean_free_path_mm[1],
             fit.mean_free_path_mm[2]
+        ),
+        format!(
+            "engine model: {}'s subsurface (MaterialX 1.39 nodedef {}); normalisation: subsurface_color is a fraction of the flux entering through the specular face (per entering photon); measured in MaterialX 1.39.5: loads and validate()s cleanly, radii round-trip through its colour management (BENCHMARKS.md, Engines)",
+            if format == Format::OpenPbr {
+                "OpenPBR Surface 1.1"
+            } else {
+                "Autodesk Standard Surface 1.0.1"
+            },
+            if format == Format::OpenPbr {
+                "ND_open_pbr_surface_surfaceshader"
+            } else {
+                "ND_standard_surface_surfaceshader"
+            },
         ),
         format!(
             "conventions: subsurface colour = multiple-scattering albedo C, our total per unit flux entering; mean free path = 1/μt of a semi-infinite HG medium (g = {}) under a dielectric of index {} whose single-scattering albedo ({:.6}/{:.6}/{:.6}) returns C and whose mean exit radius equals ours; specular weight = ρ_s, roughness √m with GGX α = m (Beckmann m = {})",

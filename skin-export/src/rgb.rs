@@ -19,6 +19,7 @@ pub struct RgbProfile {
     radii_mm: Vec<f64>,
     values_per_mm2: [Vec<f64>; 3],
     totals: [f64; 3],
+    space: ColourSpace,
 }
 
 impl RgbProfile {
@@ -61,17 +62,25 @@ impl RgbProfile {
             radii_mm: radii,
             values_per_mm2: values,
             totals,
+            space,
         })
     }
 
-    /// A profile from its parts (radii increasing, mm; values mm⁻²; totals per channel).
+    /// A linear Rec.709 profile from its parts (radii increasing, mm; values mm⁻²; totals per channel).
     #[must_use]
     pub fn from_parts(radii_mm: Vec<f64>, values_per_mm2: [Vec<f64>; 3], totals: [f64; 3]) -> Self {
         Self {
             radii_mm,
             values_per_mm2,
             totals,
+            space: ColourSpace::LinRec709,
         }
+    }
+
+    /// The colour space of the channels.
+    #[must_use]
+    pub fn space(&self) -> ColourSpace {
+        self.space
     }
 
     /// The same skin with every length multiplied by `k`: R(r) → R(r/k)/k², totals unchanged
@@ -85,6 +94,7 @@ impl RgbProfile {
                 .clone()
                 .map(|v| v.into_iter().map(|x| x / (k * k)).collect()),
             totals: self.totals,
+            space: self.space,
         }
     }
 

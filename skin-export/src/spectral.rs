@@ -89,7 +89,7 @@ impl SpectralSkin {
                 let stack = LayeredMedium::skin(skin, lambda, DEFAULT_G)?;
                 Ok(SpectralRow {
                     lambda_nm: lambda.nm(),
-                    layers: stack.layers().iter().map(LayerOptics::from_layer).collect(),
+                    layers: Self::layers_of(&stack),
                     total: multipole::skin::total_reflectance(skin, lambda, Method::Exact)?,
                     diffuse_reflectance: multipole::skin::diffuse_reflectance(
                         skin,
@@ -100,6 +100,12 @@ impl SpectralSkin {
             })
             .collect::<Result<Vec<_>, ExportError>>()?;
         Ok(Self { rows, n_above: 1.0 })
+    }
+
+    /// The layers of a layered medium, top first.
+    #[must_use]
+    pub fn layers_of(stack: &LayeredMedium) -> Vec<LayerOptics> {
+        stack.layers().iter().map(LayerOptics::from_layer).collect()
     }
 
     /// The same skin with every length × k (totals unchanged: transport is scale-free).

@@ -1,6 +1,7 @@
 #![doc = include_str!("../README.md")]
 
 pub mod compare;
+pub mod engines;
 pub mod mcml;
 pub mod shape_error;
 /// The layered Monte Carlo (owned by `multipole`, which uses it for exact profile shapes).

@@ -53,6 +53,58 @@ enum Command {
     /// The BSSRDF against the volumetric reference in image space: per-pixel error maps, region
     /// means by shape and skin tone, error against render time (PNG, CSV, render.md) into --out.
     Render(RenderStudyArgs),
+    /// Each installed engine (MaterialX, Mitsuba 3) on the exported files against our exact
+    /// numbers: CSV and PNG into --out; an engine that is not installed is skipped with a note.
+    Engines(EnginesArgs),
+}
+
+#[derive(Args, Debug)]
+struct EnginesArgs {
+    /// Python interpreter with the engines installed (default: $SKIN_ENGINES_PYTHON, else python3).
+    #[arg(long, value_name = "PATH")]
+    python: Option<PathBuf>,
+    /// Folder of the driver scripts.
+    #[arg(long, value_name = "DIR", default_value = validation::engines::SCRIPTS)]
+    scripts: PathBuf,
+    /// Samples per pixel of the Mitsuba renders (16 × 16 pixels), [1, 65536].
+    #[arg(long, value_name = "N", default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=65_536))]
+    spp: u32,
+    /// Output folder.
+    #[arg(long, value_name = "DIR", default_value = "out/engines")]
+    out: PathBuf,
+}
+
+fn run_engines(args: &EnginesArgs) -> anyhow::Result<()> {
+    let python = args
+        .python
+        .clone()
+        .or_else(|| std::env::var_os("SKIN_ENGINES_PYTHON").map(PathBuf::from))
+        .unwrap_or_else(|| PathBuf::from("python3"));
+    let opts = validation::engines::EngineOptions {
+        python,
+        scripts: args.scripts.clone(),
+        out: args.out.clone(),
+        spp: args.spp,
+    };
+    let (rows, notes) = validation::engines::run_engines(&opts)?;
+    for r in &rows {
+        println!(
+            "{:<16} {:<6} {:<4} ours {:.5} engine {:.5} ± {:.5}  {:+.2}%  ({})",
+            r.engine,
+            r.preset,
+            r.channel,
+            r.ours,
+            r.engine_value,
+            r.engine_stderr,
+            100.0 * r.rel_error(),
+            r.quantity
+        );
+    }
+    for n in notes {
+        eprintln!("{n}");
+    }
+    eprintln!("wrote {}", args.out.join("engines.csv").display());
+    Ok(())
 }
 
 #[derive(Args, Debug)]
@@ -395,6 +447,7 @@ fn main() {
             };
             run_render(study, &run, &args.out).map(|md| println!("{md}"))
         }
+        Some(Command::Engines(args)) => run_engines(args),
         None => validation::compare::run_comparison(cli.quick, &cli.out).map(|md| println!("{md}")),
     };
     if let Err(e) = result {
