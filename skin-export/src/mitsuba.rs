@@ -9,8 +9,8 @@
 //!   as 0 beyond its ends, and σt = 0 makes every path NaN);
 //! - **rgb** (`scalar_rgb`, `llvm_ad_rgb`): `<rgb>` albedo per channel and one σt per layer, carried
 //!   by the medium's `scale` with `sigma_t` = 1 (RGB variants clamp a colour to [0, 1]); each
-//!   channel's albedos are the skin's at a representative wavelength with the dermis' σa solved so
-//!   that the two layers return our RGB total of that channel ([`channel_layers`]);
+//!   channel's albedos come from the skin's σa at a representative wavelength times one factor
+//!   solved so that the two layers return our RGB total of that channel ([`channel_layers`]);
 //! - **mono** (`llvm_ad_mono`): `<float>` values at one wavelength.
 //!
 //! The spectral variants carry four wavelengths per path and sample distances at one of them:
@@ -41,7 +41,7 @@ pub const SPECTRAL_RANGE_NM: (f64, f64) = (360.0, 830.0);
 pub const RR_DEPTH: u32 = 100_000;
 /// Wavelengths whose layers stand for the R, G and B channels, nm: about the dominant wavelengths of
 /// the Rec.709 primaries seen from D65 on the CIE 1931 locus ([CIE]); the dermis' σa is solved
-/// afterwards, so they only pick the layers' scattering and the epidermis.
+/// afterwards, so they only pick the ratio of the two layers' absorption.
 pub const CHANNEL_NM: [f64; 3] = [611.3, 549.1, 464.3];
 /// Film of the complete scene, pixels per side.
 pub const SCENE_FILM_PX: u32 = 16;
@@ -119,8 +119,10 @@ fn two_layer_total(layers: &[LayerOptics]) -> Result<f64, ExportError> {
 pub struct ChannelLayers {
     /// Wavelength whose layers were taken, nm.
     pub lambda_nm: f64,
-    /// Epidermis, then dermis (its σa solved).
+    /// Epidermis, then dermis.
     pub layers: Vec<LayerOptics>,
+    /// The factor k on both layers' σa at `lambda_nm`.
+    pub absorption_factor: f64,
     /// Our RGB total of the channel (per unit flux entering), the target.
     pub target: f64,
     /// The two layers' adding-doubling total.
@@ -136,9 +138,9 @@ pub fn rgb_totals(spectral: &SpectralSkin, grid: &WavelengthGrid) -> Result<[f64
 }
 
 /// Per channel, the skin's layers with one extinction σt per layer for all channels (the skin's at
-/// the green wavelength) and per-channel albedos: the epidermis' σa at the channel's
-/// [`CHANNEL_NM`], the dermis' σa solved (bisection on the adding-doubling total) so that the two
-/// layers return `targets` (per unit flux entering). A grey σt keeps Mitsuba's RGB `volpath` from
+/// the green wavelength) and per-channel albedos: both layers' σa at the channel's [`CHANNEL_NM`]
+/// times one factor k, solved (bisection on the adding-doubling total) so that the two layers
+/// return `targets` (per unit flux entering). A grey σt keeps Mitsuba's RGB `volpath` from
 /// weighting the other channels by ratios of transmittances, whose variance grows without bound
 /// over the hundreds of events a path takes in skin.
 pub fn channel_layers(
@@ -152,25 +154,27 @@ pub fn channel_layers(
     let grey = layers_at(CHANNEL_NM[1])?;
     let one = |c: usize| -> Result<ChannelLayers, ExportError> {
         let own = layers_at(CHANNEL_NM[c])?;
-        let with = |dermis_sigma_a: f64| {
+        // The largest k keeps every σa below its layer's σt.
+        let k_max = (0..2)
+            .map(|i| grey[i].sigma_t_per_mm() / own[i].sigma_a_per_mm)
+            .fold(f64::INFINITY, f64::min)
+            * (1.0 - 1e-9);
+        let with = |k: f64| {
             let mut l = grey.clone();
-            for (i, sigma_a) in [own[0].sigma_a_per_mm, dermis_sigma_a]
-                .into_iter()
-                .enumerate()
-            {
-                let sigma_t = grey[i].sigma_t_per_mm();
+            for i in 0..2 {
+                let sigma_a = k * own[i].sigma_a_per_mm;
                 l[i].sigma_a_per_mm = sigma_a;
-                l[i].sigma_s_per_mm = sigma_t - sigma_a;
+                l[i].sigma_s_per_mm = grey[i].sigma_t_per_mm() - sigma_a;
             }
             l
         };
-        let sigma_t = grey[1].sigma_t_per_mm();
-        let sigma_a = solve_decreasing(targets[c], 1e-9 * sigma_t, (1.0 - 1e-9) * sigma_t, |a| {
-            two_layer_total(&with(a))
+        let k = solve_decreasing(targets[c], 1e-9 * k_max, k_max, |k| {
+            two_layer_total(&with(k))
         })?;
-        let layers = with(sigma_a);
+        let layers = with(k);
         Ok(ChannelLayers {
             lambda_nm: CHANNEL_NM[c],
+            absorption_factor: k,
             total: two_layer_total(&layers)?,
             layers,
             target: targets[c],
@@ -341,10 +345,13 @@ pub fn write(
     ];
     notes.push(match (&channels, variant) {
         (Some(ch), _) => format!(
-            "variant rgb (scalar_rgb, llvm_ad_rgb): colour space lin_rec709; sigma_t is divided by its largest channel and that factor is in \"scale\" (RGB variants clamp colours to [0, 1]); channel layers at {}/{}/{} nm with the dermis σa solved for our RGB totals (per entering photon) {:.5}/{:.5}/{:.5}, returned {:.5}/{:.5}/{:.5}",
+            "variant rgb (scalar_rgb, llvm_ad_rgb): colour space lin_rec709; one sigma_t per layer (the skin's at 549.1 nm) carried by \"scale\" with sigma_t = 1 (RGB variants clamp colours to [0, 1]); albedos per channel from both layers' σa at {}/{}/{} nm times {:.4}/{:.4}/{:.4}, solved for our RGB totals (per entering photon) {:.5}/{:.5}/{:.5}, returned {:.5}/{:.5}/{:.5}",
             ch[0].lambda_nm,
             ch[1].lambda_nm,
             ch[2].lambda_nm,
+            ch[0].absorption_factor,
+            ch[1].absorption_factor,
+            ch[2].absorption_factor,
             ch[0].target,
             ch[1].target,
             ch[2].target,

@@ -303,7 +303,8 @@ pub fn run_engines(opts: &EngineOptions) -> anyhow::Result<(Vec<Row>, Vec<String
         "Engines against our exact numbers",
         "comparison (CSV row)",
         "engine / ours − 1 (%)",
-    );
+    )
+    .with_x_range(0.0, rows.len() as f64 + 1.0);
     let mut engines_seen: Vec<&str> = Vec::new();
     for r in &rows {
         if !engines_seen.contains(&r.engine.as_str()) {
