@@ -25,7 +25,7 @@ use crate::error::{ExportError, check};
 use crate::spectral::{LayerOptics, SpectralSkin, to_stack};
 use crate::volume::solve_decreasing;
 use crate::{ExportOptions, Surface};
-use multipole::adding_doubling::{AddingDoublingOptions, solve};
+use multipole::exact::adding_doubling::{AddingDoublingOptions, solve};
 use multipole::{DEFAULT_G, LayeredMedium, MultipoleError};
 use skin_optics::color::reflectance_to_xyz;
 use skin_optics::{GridSpectrum, SkinParams, Wavelength, WavelengthGrid};
