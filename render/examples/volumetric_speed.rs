@@ -8,8 +8,10 @@
 use glam::Vec3;
 use rand::{Rng, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
-use render::renderer::{RenderOptions, render};
-use render::scene::{Scene, SceneOptions};
+use render::integrator::{BodyIntegrator, IntegratorKind};
+use render::material::SkinKnobs;
+use render::renderer::{RenderOptions, render_with};
+use render::scene::Scene;
 use render::volumetric::{SkinVolume, Volumetric};
 
 fn main() -> anyhow::Result<()> {
@@ -17,23 +19,20 @@ fn main() -> anyhow::Result<()> {
                   [environment]\nspectral_radiance = 1\n\
                   [materials.skin]\ntype = \"skin\"\npreset = \"light\"\nsurface = \"smooth\"\n\
                   [[meshes]]\nshape = \"sphere\"\nmaterial = \"skin\"\nunits_mm = 10\n";
-    let mut scene = Scene::from_toml(sphere, "sphere.toml", None, &SceneOptions::default())?;
-    scene.use_volumetric()?;
-    let two_layer = scene.volumetric.clone();
+    let scene = Scene::from_toml(sphere, "sphere.toml", None, &SkinKnobs::default())?;
+    let two_layer = Volumetric::build(&scene)?;
     // Homogeneous: both layers the dermis.
-    if let Some(v) = scene.volumetric.as_mut()
-        && let Some(Some(m)) = v.media.first_mut()
-    {
+    let mut homogeneous = two_layer.clone();
+    if let Some(Some(m)) = homogeneous.media.first_mut() {
         m.epidermis = m.dermis.clone();
     }
     let side = 64;
     for (label, nm) in [("550 nm", Some(550.0)), ("spectral", None)] {
         for (what, vol) in [
-            ("homogeneous", scene.volumetric.clone()),
+            ("homogeneous", homogeneous.clone()),
             ("two-layer", two_layer.clone()),
         ] {
-            let mut s = Scene::from_toml(sphere, "sphere.toml", None, &SceneOptions::default())?;
-            s.volumetric = vol;
+            let body = BodyIntegrator::Volumetric(vol);
             let opts = RenderOptions {
                 width: side,
                 height: side,
@@ -43,7 +42,7 @@ fn main() -> anyhow::Result<()> {
                 ..Default::default()
             };
             let t0 = cpu_time::ProcessTime::now();
-            let (_, stats) = render(&s, &opts.validate()?)?;
+            let (_, stats) = render_with(&scene, &body, &opts.validate()?, None)?;
             let cpu = t0.elapsed().as_secs_f64();
             let paths = (side * side * 8) as f64;
             println!(
@@ -60,9 +59,10 @@ fn main() -> anyhow::Result<()> {
 
 /// CPU ns per epidermis test on the head, beside one closest-hit ray cast.
 fn distance_cost() -> anyhow::Result<()> {
-    let mut head = Scene::load("builtin:ear", &SceneOptions::default())?;
-    head.use_volumetric()?;
-    let Some(Volumetric { media }) = &head.volumetric else {
+    let head = Scene::load("builtin:ear", &SkinKnobs::default())?;
+    let BodyIntegrator::Volumetric(Volumetric { media }) =
+        BodyIntegrator::build(&head, IntegratorKind::Volumetric)?
+    else {
         anyhow::bail!("no media");
     };
     let skin: &SkinVolume = media

@@ -75,7 +75,10 @@ pub enum RenderError {
     Write(#[from] skin_io::atomic::AtomicWriteError),
     /// A render option outside its range (see [`crate::renderer::RenderOptions::validate`]).
     #[error(transparent)]
-    Settings(#[from] crate::renderer::SettingError),
+    Settings(#[from] SettingError),
+    /// The volumetric media of a skin material could not be built.
+    #[error(transparent)]
+    Volumetric(#[from] VolumetricError),
     /// The render's worker threads could not be started.
     #[error("cannot start {threads:?} render threads: {message}")]
     Threads {
@@ -94,6 +97,33 @@ pub enum RenderError {
         path: PathBuf,
         /// What went wrong.
         message: String,
+    },
+}
+
+/// A render option outside its valid range; `name` is the `renderer::RenderOptions` field.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[error("render setting {name} = {value} outside {range}")]
+pub struct SettingError {
+    /// The field of `renderer::RenderOptions` (e.g. `spp`, `path.max_depth`).
+    pub name: &'static str,
+    /// The offending value.
+    pub value: String,
+    /// The valid range.
+    pub range: &'static str,
+}
+
+/// Why the volumetric media could not be built.
+#[derive(Debug, Error)]
+pub enum VolumetricError {
+    /// A skin's layers at one wavelength were refused by the layered-medium description.
+    #[error("material {material}: layers at {nm} nm: {source}")]
+    Layers {
+        /// The material's name.
+        material: String,
+        /// The wavelength, nm.
+        nm: f64,
+        /// What `multipole::layered` reported.
+        source: multipole::MultipoleError,
     },
 }
 

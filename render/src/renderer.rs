@@ -15,17 +15,16 @@
 
 use crate::adaptive::{Accumulator, ErrorEstimate, MIN_SPP};
 use crate::error::RenderError;
+pub use crate::error::SettingError;
 use crate::film::Film;
-use crate::integrator::{PathSettings, radiance};
+use crate::integrator::{BodyIntegrator, IntegratorKind, PathSettings, PathTracer};
 use crate::sampler::{PathSampler, SamplerKind};
 use crate::scene::Scene;
 use crate::spectrum::{LAMBDA_MAX_NM, LAMBDA_MIN_NM, SampledWavelengths};
 use glam::Vec2;
-use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::{Duration, Instant};
-use thiserror::Error;
 
 /// Tile edge, pixels.
 pub const TILE: usize = 16;
@@ -67,8 +66,8 @@ pub struct RenderOptions {
     pub threads: Option<usize>,
     /// Path tracer knobs (`max_depth` in [1, [`MAX_DEPTH`]]).
     pub path: PathSettings,
-    /// Show a progress bar on stderr.
-    pub progress: bool,
+    /// How skin's body is rendered (default the BSSRDF).
+    pub integrator: IntegratorKind,
     /// Render one wavelength, nm, in [380, 780]: each pixel holds the spectral radiance there
     /// as a grey (R = G = B) instead of the colour of the visible spectrum (None = colour).
     pub wavelength_nm: Option<f32>,
@@ -87,22 +86,10 @@ impl Default for RenderOptions {
             seed: 1,
             threads: None,
             path: PathSettings::default(),
-            progress: false,
+            integrator: IntegratorKind::Bssrdf,
             wavelength_nm: None,
         }
     }
-}
-
-/// A render option outside its valid range; `name` is the [`RenderOptions`] field.
-#[derive(Debug, Clone, PartialEq, Error)]
-#[error("render setting {name} = {value} outside {range}")]
-pub struct SettingError {
-    /// The field of [`RenderOptions`] (e.g. `spp`, `path.max_depth`).
-    pub name: &'static str,
-    /// The offending value.
-    pub value: String,
-    /// The valid range.
-    pub range: &'static str,
 }
 
 impl RenderOptions {
@@ -217,10 +204,43 @@ impl RenderStats {
 /// A tile's sampled pixels (row-major index) and their XYZ.
 type TileResult = Vec<(usize, [f32; 3])>;
 
-/// Render `scene` into a new film with validated `settings`.
+/// Where a render stands after a pass, for a progress display.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Progress {
+    /// Passes done (samples per pixel of the pixels still sampling).
+    pub done: u32,
+    /// Most passes the render takes.
+    pub spp: u32,
+    /// Pixels whose noise is below the target.
+    pub converged: usize,
+    /// Pixels of the image.
+    pub pixels: usize,
+    /// Image-wide noise estimate, relative (refreshed at most every 0.5 s; infinite before the
+    /// second pass).
+    pub noise: f64,
+    /// Rays traced per second so far.
+    pub rays_per_second: f64,
+    /// The render stops after this pass because the next would end past the time limit.
+    pub time_limit_reached: bool,
+}
+
+/// Render `scene` into a new film with validated `settings`, skin's body by
+/// `settings.integrator`.
 pub fn render(
     scene: &Scene,
     settings: &RenderSettings,
+) -> Result<(Film, RenderStats), RenderError> {
+    let body = BodyIntegrator::build(scene, settings.integrator)?;
+    render_with(scene, &body, settings, None)
+}
+
+/// Render `scene` with skin's body by `body` (whose state, such as the thin-part walks' counts,
+/// the caller keeps), calling `on_pass` after every pass.
+pub fn render_with(
+    scene: &Scene,
+    body: &BodyIntegrator,
+    settings: &RenderSettings,
+    on_pass: Option<&mut (dyn FnMut(&Progress) + Send)>,
 ) -> Result<(Film, RenderStats), RenderError> {
     let mut builder = rayon::ThreadPoolBuilder::new();
     if let Some(t) = settings.threads {
@@ -230,13 +250,23 @@ pub fn render(
         threads: settings.threads,
         message: e.to_string(),
     })?;
-    pool.install(|| render_passes(scene, settings))
+    let tracer = PathTracer {
+        scene,
+        body,
+        settings: &settings.path,
+    };
+    pool.install(|| render_passes(&tracer, settings, on_pass))
 }
 
-/// How often the progress bar's image-wide noise estimate is refreshed.
+/// How often the image-wide noise estimate of [`Progress`] is refreshed.
 const PROGRESS_NOISE_EVERY: Duration = Duration::from_millis(500);
 
-fn render_passes(scene: &Scene, s: &RenderSettings) -> Result<(Film, RenderStats), RenderError> {
+fn render_passes(
+    tracer: &PathTracer<'_>,
+    s: &RenderSettings,
+    mut on_pass: Option<&mut (dyn FnMut(&Progress) + Send)>,
+) -> Result<(Film, RenderStats), RenderError> {
+    let scene = tracer.scene;
     let (w, h) = (s.width, s.height);
     let estimate = s
         .error_estimate
@@ -247,17 +277,6 @@ fn render_passes(scene: &Scene, s: &RenderSettings) -> Result<(Film, RenderStats
     let tiles: Vec<(usize, usize)> = (0..h.div_ceil(TILE))
         .flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| (tx * TILE, ty * TILE)))
         .collect();
-    let bar = if s.progress {
-        let b = ProgressBar::new((w * h) as u64);
-        b.set_style(
-            ProgressStyle::with_template("{elapsed_precise} [{bar:30}] {percent:>3}% {msg}")
-                .unwrap_or_else(|_| ProgressStyle::default_bar())
-                .progress_chars("=> "),
-        );
-        b
-    } else {
-        ProgressBar::hidden()
-    };
     let rays = AtomicU64::new(0);
     let start = Instant::now();
     let aspect = w as f32 / h as f32;
@@ -290,7 +309,7 @@ fn render_passes(scene: &Scene, s: &RenderSettings) -> Result<(Film, RenderStats
                         );
                         let lens = sampler.get_2d();
                         let (o, d) = scene.camera.generate_ray(film_pos, aspect, lens);
-                        let l = radiance(scene, &s.path, o, d, &wl, &mut sampler, &mut tile_rays);
+                        let l = tracer.radiance(o, d, &wl, &mut sampler, &mut tile_rays);
                         // A non-finite sample is dropped and counted by the accumulator.
                         let xyz = if s.wavelength_nm.is_some() {
                             wl.to_grey_xyz(&l)
@@ -317,41 +336,37 @@ fn render_passes(scene: &Scene, s: &RenderSettings) -> Result<(Film, RenderStats
         }
         let elapsed = start.elapsed();
         // The image-wide estimate costs a pass over every pixel and is only shown, so it is formed
-        // for a visible progress bar and at most every PROGRESS_NOISE_EVERY: a pass late in a
+        // for a progress callback and at most every PROGRESS_NOISE_EVERY: a pass late in a
         // noise-targeted render samples a few pixels, and work over the whole image at every
         // pass would then set the frame's time.
-        if done >= 2 && s.progress && elapsed >= noise_at + PROGRESS_NOISE_EVERY {
+        if done >= 2 && on_pass.is_some() && elapsed >= noise_at + PROGRESS_NOISE_EVERY {
             noise = acc.noise_estimate();
             noise_at = elapsed;
-        }
-        if s.noise.is_some() {
-            bar.set_position(converged as u64);
-        } else {
-            bar.set_position((w * h) as u64 * u64::from(done) / u64::from(s.spp));
-        }
-        bar.set_message(format!(
-            "{done}/{} spp, noise {:.2}%, {converged}/{} px converged, {:.2} Mrays/s",
-            s.spp,
-            100.0 * noise,
-            w * h,
-            rays.load(Ordering::Relaxed) as f64 / elapsed.as_secs_f64().max(1e-9) / 1e6
-        ));
-        if converged == w * h {
-            break;
         }
         // Stop when the next pass would end past the limit (passes shrink as pixels converge, so
         // the last one is a safe guess).
         let pass_time = elapsed.checked_sub(last).unwrap_or_default();
         last = elapsed;
-        if let Some(limit) = s.time_limit
-            && elapsed + pass_time > limit
-            && done < s.spp
-        {
-            bar.println(format!("time limit reached after {done} passes"));
+        let all_converged = converged == w * h;
+        let time_limit_reached = !all_converged
+            && s.time_limit
+                .is_some_and(|limit| elapsed + pass_time > limit && done < s.spp);
+        if let Some(f) = on_pass.as_mut() {
+            f(&Progress {
+                done,
+                spp: s.spp,
+                converged,
+                pixels: w * h,
+                noise,
+                rays_per_second: rays.load(Ordering::Relaxed) as f64
+                    / elapsed.as_secs_f64().max(1e-9),
+                time_limit_reached,
+            });
+        }
+        if all_converged || time_limit_reached {
             break;
         }
     }
-    bar.finish_and_clear();
     let film = acc.to_film();
     let stats = RenderStats {
         spp: film.spp(),

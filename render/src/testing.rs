@@ -3,8 +3,9 @@
 //! `test-support` feature only; the functions panic on failure, as tests want.
 
 use crate::film::Film;
+use crate::material::SkinKnobs;
 use crate::renderer::{RenderOptions, render};
-use crate::scene::{Scene, SceneOptions};
+use crate::scene::Scene;
 use skin_optics::color::{cie_xyz_bar, cie_y_integral};
 
 /// The TOML of a test scene, assembled part by part so that no test spells out the same camera,
@@ -108,7 +109,7 @@ pub fn plane(material: &str) -> SceneText {
 
 /// A scene from TOML text, with default options.
 pub fn scene(text: &str) -> Scene {
-    Scene::from_toml(text, "test.toml", None, &SceneOptions::default()).unwrap()
+    Scene::from_toml(text, "test.toml", None, &SkinKnobs::default()).unwrap()
 }
 
 /// Render `scene` at `w`×`h` with `spp` samples per pixel and a fixed `seed`.

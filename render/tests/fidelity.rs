@@ -6,9 +6,11 @@
 //! render tests' scenes, so a reader sees the whole scene a number comes from.
 
 use render::integrator::PathSettings;
+use render::integrator::{BodyIntegrator, IntegratorKind};
 use render::material::Material;
-use render::renderer::{RenderOptions, render};
-use render::scene::{Scene, SceneOptions};
+use render::material::SkinKnobs;
+use render::renderer::{RenderOptions, render, render_with};
+use render::scene::Scene;
 
 /// A 2 m slab of light skin under a distant D65 light, seen head-on from 500 mm (2° field).
 const SLAB: &str = r#"
@@ -42,7 +44,6 @@ fn mean_xyz(scene: &Scene, angle: f32, spp: u32, seed: u64) -> [f64; 3] {
             pixel_angle_rad: angle,
             ..PathSettings::default()
         },
-        progress: false,
         ..Default::default()
     };
     let film = render(scene, &settings.validate().unwrap()).unwrap().0;
@@ -68,7 +69,7 @@ fn mean_xyz(scene: &Scene, angle: f32, spp: u32, seed: u64) -> [f64; 3] {
 /// half-blended, +0.17 / +0.17 / +0.01% collapsed.
 #[test]
 fn the_lod_switch_preserves_a_flat_slabs_reflected_energy() {
-    let scene = Scene::from_toml(SLAB, "slab.toml", None, &SceneOptions::default()).unwrap();
+    let scene = Scene::from_toml(SLAB, "slab.toml", None, &SkinKnobs::default()).unwrap();
     let Material::Skin(skin) = &scene.materials[0] else {
         panic!("skin first")
     };
@@ -94,12 +95,12 @@ fn the_lod_switch_preserves_a_flat_slabs_reflected_energy() {
 /// `--fidelity full` builds the reference tables: 10-nm rows and 128 radii, no level of detail.
 #[test]
 fn full_fidelity_keeps_the_reference_tables() {
-    let opts = SceneOptions {
+    let opts = SkinKnobs {
         fidelity: render::fidelity::FidelityKnobs {
             fidelity: Some(render::fidelity::Fidelity::Full),
             ..Default::default()
         },
-        ..SceneOptions::default()
+        ..SkinKnobs::default()
     };
     let scene = Scene::from_toml(SLAB, "slab.toml", None, &opts).unwrap();
     let Material::Skin(skin) = &scene.materials[0] else {
@@ -117,12 +118,12 @@ fn full_fidelity_keeps_the_reference_tables() {
 #[test]
 fn shape_photons_follow_the_pixel_footprint() {
     use render::fidelity::photons::{self, PhotonChoice, TABLE_PHOTON_LAW};
-    let opts = |height| SceneOptions {
+    let opts = |height| SkinKnobs {
         fidelity: render::fidelity::FidelityKnobs {
             image_height: Some(height),
             ..Default::default()
         },
-        ..SceneOptions::default()
+        ..SkinKnobs::default()
     };
     let scene = Scene::from_toml(SLAB, "slab.toml", None, &opts(4)).unwrap();
     let Material::Skin(skin) = &scene.materials[0] else {
@@ -202,7 +203,7 @@ fn scene_keys_set_the_fidelity_and_bad_ones_are_named() {
         &with("wavelength_step_nm = 50\nlod = \"off\""),
         "slab.toml",
         None,
-        &SceneOptions::default(),
+        &SkinKnobs::default(),
     )
     .unwrap();
     let Material::Skin(skin) = &scene.materials[0] else {
@@ -217,7 +218,7 @@ fn scene_keys_set_the_fidelity_and_bad_ones_are_named() {
         ("fidelity = \"half\"", "fidelity.fidelity"),
         ("shape_photons = 10", "fidelity.shape_photons"),
     ] {
-        let e = Scene::from_toml(&with(keys), "slab.toml", None, &SceneOptions::default())
+        let e = Scene::from_toml(&with(keys), "slab.toml", None, &SkinKnobs::default())
             .err()
             .unwrap_or_else(|| panic!("{keys} loaded"))
             .to_string();
@@ -252,29 +253,37 @@ fn slab_scene(dir: &std::path::Path, thickness_mm: f32, backlit: bool) -> String
 
 /// The slab scene with the thin-part walk at `thin_walk_r99` (`None`: the default, off).
 fn load_slab(toml: &str, thin_walk_r99: Option<f64>) -> Scene {
-    let opts = SceneOptions {
+    let opts = SkinKnobs {
         fidelity: render::fidelity::FidelityKnobs {
             thin_walk_r99,
             ..Default::default()
         },
-        ..SceneOptions::default()
+        ..SkinKnobs::default()
     };
     Scene::from_toml(toml, "slab.toml", None, &opts).unwrap()
 }
 
 /// (mean luminance Y over the frame, its standard error from the variance pass) of `scene`
-/// rendered at `side`² pixels and `spp`, level of detail off (pixel angle 0).
-fn mean_y(scene: &Scene, side: usize, spp: u32, seed: u64) -> (f64, f64, render::film::Film) {
+/// rendered with skin's body by `body` at `side`² pixels and `spp`, level of detail off (pixel
+/// angle 0).
+fn mean_y(
+    scene: &Scene,
+    body: &BodyIntegrator,
+    side: usize,
+    spp: u32,
+    seed: u64,
+) -> (f64, f64, render::film::Film) {
     let settings = RenderOptions {
         width: side,
         height: side,
         spp,
         seed,
         noise: None,
-        progress: false,
         ..Default::default()
     };
-    let film = render(scene, &settings.validate().unwrap()).unwrap().0;
+    let film = render_with(scene, body, &settings.validate().unwrap(), None)
+        .unwrap()
+        .0;
     let n = (side * side) as f64;
     let (mut sum, mut var) = (0.0, 0.0);
     for y in 0..side {
@@ -300,12 +309,10 @@ struct AutoSlab {
 fn auto_slab(thickness_mm: f32, backlit: bool, side: usize, spp: u32, seed: u64) -> AutoSlab {
     let dir = tempfile::tempdir().unwrap();
     let toml = slab_scene(dir.path(), thickness_mm, backlit);
-    let scene = load_slab(
-        &toml,
-        Some(render::fidelity::transport::DEFAULT_THIN_WALK_R99),
-    );
-    let (y, err, film) = mean_y(&scene, side, spp, seed);
-    let counts = scene.thin_parts.as_ref().unwrap().part(0).unwrap().counts();
+    let scene = load_slab(&toml, Some(render::fidelity::DEFAULT_THIN_WALK_R99));
+    let body = BodyIntegrator::build(&scene, IntegratorKind::Bssrdf).unwrap();
+    let (y, err, film) = mean_y(&scene, &body, side, spp, seed);
+    let counts = body.thin_parts().unwrap().part(0).unwrap().counts();
     AutoSlab {
         _dir: dir,
         toml,
@@ -330,11 +337,12 @@ fn the_thin_walk_takes_a_thin_slab_and_matches_the_volumetric_reference() {
         tested > 0 && walked as f64 >= 0.95 * tested as f64,
         "{walked}/{tested} walked"
     );
-    let mut reference = load_slab(&auto.toml, Some(0.0));
-    assert!(reference.thin_parts.is_none());
-    let (y_bssrdf, _, _) = mean_y(&reference, 16, 128, 3);
-    reference.use_volumetric().unwrap();
-    let (y_ref, e_ref, _) = mean_y(&reference, 16, 128, 2);
+    let reference = load_slab(&auto.toml, Some(0.0));
+    let bssrdf = BodyIntegrator::build(&reference, IntegratorKind::Bssrdf).unwrap();
+    assert!(bssrdf.thin_parts().is_none());
+    let (y_bssrdf, _, _) = mean_y(&reference, &bssrdf, 16, 128, 3);
+    let volumetric = BodyIntegrator::build(&reference, IntegratorKind::Volumetric).unwrap();
+    let (y_ref, e_ref, _) = mean_y(&reference, &volumetric, 16, 128, 2);
     let sigma = auto.err.hypot(e_ref);
     let y_auto = auto.y;
     assert!(
@@ -354,6 +362,8 @@ fn the_thin_walk_keeps_the_bssrdf_on_a_thick_slab() {
     let auto = auto_slab(20.0, false, 8, 4, 7);
     let (tested, walked) = auto.counts;
     assert!(tested > 0 && walked == 0, "{walked}/{tested} walked");
-    let (_, _, b) = mean_y(&load_slab(&auto.toml, Some(0.0)), 8, 4, 7);
+    let thick = load_slab(&auto.toml, Some(0.0));
+    let bssrdf = BodyIntegrator::build(&thick, IntegratorKind::Bssrdf).unwrap();
+    let (_, _, b) = mean_y(&thick, &bssrdf, 8, 4, 7);
     assert_eq!(auto.film, b);
 }

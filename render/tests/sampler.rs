@@ -54,7 +54,7 @@ fn old_settings() -> PathSettings {
     PathSettings {
         sampler: SamplerKind::Independent,
         wavelengths: WavelengthSampling::Uniform,
-        probe_axes: ProbeAxes::DEFAULT,
+        probe_axes: ProbeAxes::PBRT,
         split_subsurface: false,
         ..PathSettings::default()
     }

@@ -6,7 +6,8 @@
 //! test appear exactly as a user writes them.
 
 use render::material::Material;
-use render::scene::{Scene, SceneOptions};
+use render::material::SkinKnobs;
+use render::scene::Scene;
 use skin_optics::SkinParams;
 use skin_optics::measured::find_measured;
 
@@ -30,12 +31,12 @@ scale = 50
     )
 }
 
-fn opts() -> SceneOptions {
+fn opts() -> SkinKnobs {
     // The diffusion method and no BSSRDF keep the load cheap; the parameters do not depend on it.
-    SceneOptions {
+    SkinKnobs {
         method: multipole::Method::Multipole,
         no_subsurface: true,
-        ..SceneOptions::default()
+        ..SkinKnobs::default()
     }
 }
 

@@ -5,8 +5,9 @@
 use render::testing as common;
 
 use common::{SceneText, assert_close, film_mean, mean_xyz, plane, run, white_furnace, xyz_of};
+use render::material::SkinKnobs;
 use render::renderer::{RenderOptions, TILE, render};
-use render::scene::{Scene, SceneOptions};
+use render::scene::Scene;
 
 /// Seed of every render in this file.
 const SEED: u64 = 42;
@@ -118,7 +119,7 @@ fn time_limit_stops_after_whole_passes() {
 /// The default scene renders at 64×48, 2 spp: finite, not all alike.
 #[test]
 fn default_scene_renders_small() {
-    let s = Scene::load("builtin:three-heads", &SceneOptions::default()).unwrap();
+    let s = Scene::load("builtin:three-heads", &SkinKnobs::default()).unwrap();
     let film = run(&s, 64, 48, 2, SEED);
     let mut ys = Vec::new();
     for y in 0..48 {
@@ -139,6 +140,6 @@ fn default_scene_renders_small() {
 /// The built-in ear scene loads.
 #[test]
 fn ear_scene_loads() {
-    let s = Scene::load("builtin:ear", &SceneOptions::default()).unwrap();
+    let s = Scene::load("builtin:ear", &SkinKnobs::default()).unwrap();
     assert!(s.geometry.triangle_count() > 17_000);
 }

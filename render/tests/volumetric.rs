@@ -13,9 +13,11 @@ use multipole::exact::adding_doubling::{
 };
 use multipole::exact::montecarlo::{self, McOptions};
 use render::film::Film;
+use render::integrator::{BodyIntegrator, IntegratorKind};
+use render::material::SkinKnobs;
 use render::material::{Material, SkinMaterial, SurfaceKind};
-use render::renderer::{RenderOptions, render};
-use render::scene::{Scene, SceneOptions};
+use render::renderer::{RenderOptions, render_with};
+use render::scene::Scene;
 use render::spectrum::SpectrumTable;
 use render::volumetric::shapes::box_obj;
 use render::volumetric::{LayerTables, SkinVolume, Volumetric};
@@ -35,7 +37,7 @@ fn box_scene(dir: &Path, size_mm: [f32; 3], tilt_deg: f32, skin_keys: &str) -> S
          [materials.skin]\ntype = \"skin\"\n{skin_keys}\n\
          [[meshes]]\nfile = \"box.obj\"\nmaterial = \"skin\"\nrotate_deg = [{tilt_deg}, 0, 0]\n"
     );
-    Scene::from_toml(&text, "box.toml", Some(dir), &SceneOptions::default()).unwrap()
+    Scene::from_toml(&text, "box.toml", Some(dir), &SkinKnobs::default()).unwrap()
 }
 
 /// Mean grey radiance over the film and its standard error (from each pixel's variance pass).
@@ -58,7 +60,7 @@ fn mean_and_sigma(film: &Film) -> (f64, f64) {
     (sum / n, var.sqrt() / n)
 }
 
-fn render_mono(scene: &Scene, side: usize, spp: u32, seed: u64) -> Film {
+fn render_mono(scene: &Scene, body: &BodyIntegrator, side: usize, spp: u32, seed: u64) -> Film {
     let opts = RenderOptions {
         width: side,
         height: side,
@@ -67,7 +69,9 @@ fn render_mono(scene: &Scene, side: usize, spp: u32, seed: u64) -> Film {
         wavelength_nm: Some(NM),
         ..Default::default()
     };
-    render(scene, &opts.validate().unwrap()).unwrap().0
+    render_with(scene, body, &opts.validate().unwrap(), None)
+        .unwrap()
+        .0
 }
 
 /// Flat slab, smooth surface, at g = 0.9 and g = 0: the volumetric walk equals F(0) + R_d of
@@ -83,9 +87,9 @@ fn slab_matches_adding_doubling_and_monte_carlo() {
     let lambda = Wavelength::new(f64::from(NM)).unwrap();
     for (g, spp) in [(0.9, 1500), (0.0, 1500)] {
         let keys = format!("preset = \"light\"\nsurface = \"smooth\"\nphase_g = {g}");
-        let mut scene = box_scene(dir.path(), [200.0, 200.0, 20.0], 0.0, &keys);
-        scene.use_volumetric().unwrap();
-        let film = render_mono(&scene, 4, spp, 11);
+        let scene = box_scene(dir.path(), [200.0, 200.0, 20.0], 0.0, &keys);
+        let body = BodyIntegrator::build(&scene, IntegratorKind::Volumetric).unwrap();
+        let film = render_mono(&scene, &body, 4, spp, 11);
         let (l, sigma) = mean_and_sigma(&film);
         let ad = skin_totals(
             &params,
@@ -112,9 +116,9 @@ fn slab_matches_adding_doubling_and_monte_carlo() {
     }
 }
 
-/// Give the scene's first mesh a skin body of constant [σa, σs] (mm⁻¹) per layer, epidermis then
-/// dermis: g 0.9, n 1.4, a 0.1-mm epidermis.
-fn set_constant_body(scene: &mut Scene, epidermis: [f32; 2], dermis: [f32; 2]) {
+/// The volumetric walk with the scene's first mesh given a skin body of constant [σa, σs] (mm⁻¹)
+/// per layer, epidermis then dermis: g 0.9, n 1.4, a 0.1-mm epidermis.
+fn constant_body(scene: &Scene, epidermis: [f32; 2], dermis: [f32; 2]) -> BodyIntegrator {
     let body = SkinVolume::new(
         LayerTables::constant(epidermis[0], epidermis[1]),
         LayerTables::constant(dermis[0], dermis[1]),
@@ -123,9 +127,9 @@ fn set_constant_body(scene: &mut Scene, epidermis: [f32; 2], dermis: [f32; 2]) {
         0.1,
         scene.geometry.triangles_of(0),
     );
-    scene.volumetric = Some(Volumetric {
+    BodyIntegrator::Volumetric(Volumetric {
         media: vec![Some(body)],
-    });
+    })
 }
 
 /// White furnace: a 2-mm sphere of non-absorbing skin (σa = 0) under a sky of radiance 1 is
@@ -140,10 +144,9 @@ fn white_furnace_sphere_conserves_energy() {
              [materials.skin]\ntype = \"skin\"\nsurface = \"{surface}\"\n\
              [[meshes]]\nshape = \"sphere\"\nmaterial = \"skin\"\nunits_mm = 2\n"
         );
-        let mut scene =
-            Scene::from_toml(&text, "furnace.toml", None, &SceneOptions::default()).unwrap();
-        set_constant_body(&mut scene, [0.0, 20.0], [0.0, 10.0]);
-        let film = render_mono(&scene, 6, 200, 5);
+        let scene = Scene::from_toml(&text, "furnace.toml", None, &SkinKnobs::default()).unwrap();
+        let body = constant_body(&scene, [0.0, 20.0], [0.0, 10.0]);
+        let film = render_mono(&scene, &body, 6, 200, 5);
         let (l, sigma) = mean_and_sigma(&film);
         assert!(
             (l - 1.0).abs() <= 3.0 * sigma + 1e-4,
@@ -172,9 +175,9 @@ fn smooth_surface_reflects_fresnel_over_a_clear_absorber() {
     let dir = tempfile::tempdir().unwrap();
     for theta in [0.0f64, 45.0, 70.0] {
         let keys = "surface = \"smooth\"";
-        let mut scene = box_scene(dir.path(), [400.0, 400.0, 20.0], theta as f32, keys);
-        set_constant_body(&mut scene, [50.0, 0.0], [50.0, 0.0]);
-        let film = render_mono(&scene, 4, 4000, 3);
+        let scene = box_scene(dir.path(), [400.0, 400.0, 20.0], theta as f32, keys);
+        let body = constant_body(&scene, [50.0, 0.0], [50.0, 0.0]);
+        let film = render_mono(&scene, &body, 4, 4000, 3);
         let (l, sigma) = mean_and_sigma(&film);
         let (lo, hi) = fresnel_bounds(theta);
         assert!(
@@ -204,7 +207,8 @@ fn one_wavelength_black_absorber_is_exactly_fresnel() {
         )
         .with_surface_kind(SurfaceKind::Smooth, 0.9);
         scene.materials[0] = Material::Skin(black);
-        let film = render_mono(&scene, 4, 16, 9);
+        let body = BodyIntegrator::build(&scene, IntegratorKind::Bssrdf).unwrap();
+        let film = render_mono(&scene, &body, 4, 16, 9);
         let (l, _) = mean_and_sigma(&film);
         let (lo, hi) = fresnel_bounds(theta);
         assert!(

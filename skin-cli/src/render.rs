@@ -2,10 +2,14 @@
 //! OUT/render.exr (linear sRGB, f32, with the passes of `render::passes`) and OUT/render.png (sRGB, exposure + filmic tone curve).
 
 use crate::args::{Checked, parse_number, parse_whole};
+use ::render::fidelity::explain::{diffusion_warning, explain_table};
 use ::render::fidelity::{Fidelity, FidelityKnobs, LodBand, LodSetting};
-use ::render::renderer::{RenderOptions, SettingError, render};
-use ::render::scene::{Scene, SceneOptions};
+use ::render::integrator::{BodyIntegrator, IntegratorKind};
+use ::render::material::SkinKnobs;
+use ::render::renderer::{Progress, RenderOptions, SettingError, render_with};
+use ::render::scene::Scene;
 use clap::Args;
+use indicatif::{ProgressBar, ProgressStyle};
 use skin_optics::echo::Num;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
@@ -165,7 +169,10 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
             max_depth: args.max_depth,
             ..Default::default()
         },
-        progress: !args.quiet,
+        integrator: match args.integrator {
+            Integrator::Bssrdf => IntegratorKind::Bssrdf,
+            Integrator::Volumetric => IntegratorKind::Volumetric,
+        },
         wavelength_nm: args.wavelength,
         ..Default::default()
     };
@@ -195,21 +202,25 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     if args.integrator == Integrator::Volumetric && args.no_subsurface {
         anyhow::bail!("--integrator volumetric renders the subsurface: drop --no-subsurface");
     }
-    let mut scene = Scene::load(
+    let scene = Scene::load(
         &args.scene,
-        &SceneOptions {
+        &SkinKnobs {
             method: args.method,
             no_subsurface: args.no_subsurface,
             shape_escapes: args.shape_escapes,
             fidelity,
-            ..SceneOptions::default()
+            ..SkinKnobs::default()
         },
     )?;
-    if args.integrator == Integrator::Volumetric {
-        scene.use_volumetric()?;
-    }
+    let body = BodyIntegrator::build(&scene, options.integrator)?;
     let load = t0.elapsed();
-    ::render::fidelity::explain::report(&scene, args.explain);
+    let skins = scene.skin_choices();
+    if args.explain {
+        print!("{}", explain_table(&skins));
+    }
+    if let Some(warning) = diffusion_warning(&skins) {
+        eprintln!("{warning}");
+    }
     // The level of detail needs the pixel footprint: the camera's pixel angle at this height.
     options.path.pixel_angle_rad = scene.camera.pixel_angle_rad(options.height);
     let settings = options.validate().map_err(flag_error)?;
@@ -221,7 +232,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         scene.materials.len(),
         load.as_secs_f64()
     );
-    let (film, stats) = render(&scene, &settings)?;
+    let (film, stats) = render_with_bar(&scene, &body, &settings, !args.quiet)?;
     if film.dropped_samples() > 0 {
         eprintln!(
             "dropped {} non-finite samples (not averaged into any pixel)",
@@ -255,9 +266,9 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         100.0 * passes.skin.iter().sum::<f32>() / passes.skin.len().max(1) as f32
     );
     if args.explain
-        && let Some(report) = ::render::fidelity::explain::thin_walk_report(&scene)
+        && let Some(thin) = body.thin_parts()
     {
-        print!("{report}");
+        print!("{}", thin.report(&scene.material_names));
     }
     println!(
         "total {:.1} s; wrote {} and {}",
@@ -266,6 +277,50 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         png.display()
     );
     Ok(())
+}
+
+/// Render with a progress bar on stderr (hidden when `show` is false or stderr is not a
+/// terminal): passes, noise, converged pixels and ray rate.
+fn render_with_bar(
+    scene: &Scene,
+    body: &BodyIntegrator,
+    settings: &::render::renderer::RenderSettings,
+    show: bool,
+) -> Result<(::render::film::Film, ::render::renderer::RenderStats), ::render::error::RenderError> {
+    let bar = if show {
+        let b = ProgressBar::new((settings.width * settings.height) as u64);
+        b.set_style(
+            ProgressStyle::with_template("{elapsed_precise} [{bar:30}] {percent:>3}% {msg}")
+                .unwrap_or_else(|_| ProgressStyle::default_bar())
+                .progress_chars("=> "),
+        );
+        b
+    } else {
+        ProgressBar::hidden()
+    };
+    let noise_target = settings.noise.is_some();
+    let mut on_pass = |p: &Progress| {
+        if noise_target {
+            bar.set_position(p.converged as u64);
+        } else {
+            bar.set_position(p.pixels as u64 * u64::from(p.done) / u64::from(p.spp));
+        }
+        bar.set_message(format!(
+            "{}/{} spp, noise {:.2}%, {}/{} px converged, {:.2} Mrays/s",
+            p.done,
+            p.spp,
+            100.0 * p.noise,
+            p.converged,
+            p.pixels,
+            p.rays_per_second / 1e6
+        ));
+        if p.time_limit_reached {
+            bar.println(format!("time limit reached after {} passes", p.done));
+        }
+    };
+    let out = render_with(scene, body, settings, Some(&mut on_pass));
+    bar.finish_and_clear();
+    out
 }
 
 /// A settings error in the words of the command line: the flag that sets the option.

@@ -14,9 +14,10 @@ use crate::common;
 use proptest::prelude::*;
 use proptest::strategy::ValueTree;
 use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
+use render::material::SkinKnobs;
 use render::mesh::{TriangleMesh, glb_container};
 use render::renderer::{RenderOptions, render};
-use render::scene::{Scene, SceneOptions};
+use render::scene::Scene;
 use render::texture::Texture;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::Path;
@@ -307,10 +308,10 @@ where
 }
 
 fn load_scene(text: &str) -> Result<(), String> {
-    let opts = SceneOptions {
+    let opts = SkinKnobs {
         method: multipole::Method::Multipole,
         no_subsurface: true,
-        ..SceneOptions::default()
+        ..SkinKnobs::default()
     };
     // Syntax and schema errors as `scene_file::parse` reports them (one line, with the position).
     render::scene_file::parse(text)?;
@@ -320,7 +321,6 @@ fn load_scene(text: &str) -> Result<(), String> {
         width: 4,
         height: 3,
         spp: 1,
-        progress: false,
         threads: Some(1),
         ..RenderOptions::default()
     }

@@ -34,9 +34,10 @@ use render::fidelity::{Fidelity, FidelityKnobs, LodBand, LodSetting};
 use render::film::Film;
 use render::integrator::PathSettings;
 use render::material::Material;
+use render::material::SkinKnobs;
 use render::passes::Passes;
 use render::renderer::{RenderOptions, render};
-use render::scene::{Scene, SceneOptions};
+use render::scene::Scene;
 use skin_plot::{LineChart, Panel, Series, save_png};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -48,7 +49,7 @@ const HEIGHT: usize = 384;
 /// One configuration to render.
 struct Config {
     label: &'static str,
-    opts: SceneOptions,
+    opts: SkinKnobs,
     seed: u64,
     spp: u32,
     noise: Option<f64>,
@@ -57,7 +58,7 @@ struct Config {
 
 impl Config {
     /// `spp` samples in every pixel (no noise target).
-    fn fixed(label: &'static str, opts: SceneOptions, seed: u64, spp: u32) -> Self {
+    fn fixed(label: &'static str, opts: SkinKnobs, seed: u64, spp: u32) -> Self {
         Self {
             label,
             opts,
@@ -81,8 +82,8 @@ struct Run {
     load_s: f64,
 }
 
-fn knobs(fidelity: Fidelity, lod: LodSetting, no_subsurface: bool) -> SceneOptions {
-    SceneOptions {
+fn knobs(fidelity: Fidelity, lod: LodSetting, no_subsurface: bool) -> SkinKnobs {
+    SkinKnobs {
         fidelity: FidelityKnobs {
             fidelity: Some(fidelity),
             lod,
@@ -91,7 +92,7 @@ fn knobs(fidelity: Fidelity, lod: LodSetting, no_subsurface: bool) -> SceneOptio
             ..FidelityKnobs::default()
         },
         no_subsurface,
-        ..SceneOptions::default()
+        ..SkinKnobs::default()
     }
 }
 
@@ -117,7 +118,6 @@ fn render_one(spec: &str, c: &Config, out: &Path) -> Run {
             pixel_angle_rad: scene.camera.pixel_angle_rad(HEIGHT),
             ..PathSettings::default()
         },
-        progress: false,
         ..Default::default()
     }
     .validate()

@@ -21,9 +21,11 @@
 //! warm-up render (the LLVM kernels compiled once, not counted).
 
 use anyhow::Context;
+use render::integrator::BodyIntegrator;
+use render::material::SkinKnobs;
 use render::mesh::TriangleMesh;
-use render::renderer::{RenderOptions, render};
-use render::scene::{Scene, SceneOptions};
+use render::renderer::{RenderOptions, render_with};
+use render::scene::Scene;
 use render::volumetric::{LayerTables, SkinVolume, Volumetric};
 use std::fmt::Write as _;
 use std::path::Path;
@@ -54,14 +56,14 @@ fn sphere_obj() -> String {
 }
 
 /// Our scene: the OBJ under the constant sky, its body the homogeneous medium (both layers).
-fn our_scene(dir: &Path) -> anyhow::Result<Scene> {
+fn our_scene(dir: &Path) -> anyhow::Result<(Scene, BodyIntegrator)> {
     let text = format!(
         "[camera]\nposition_mm = [0, 0, {DISTANCE_MM}]\nlook_at_mm = [0, 0, 0]\nfov_deg = {FOV_DEG}\n\
          [environment]\nspectral_radiance = 1\n\
          [materials.skin]\ntype = \"skin\"\nsurface = \"smooth\"\nphase_g = {G}\n\
          [[meshes]]\nfile = \"sphere.obj\"\nmaterial = \"skin\"\n"
     );
-    let mut scene = Scene::from_toml(&text, "sphere.toml", Some(dir), &SceneOptions::default())?;
+    let scene = Scene::from_toml(&text, "sphere.toml", Some(dir), &SkinKnobs::default())?;
     let body = SkinVolume::new(
         LayerTables::constant(SIGMA_A, SIGMA_S),
         LayerTables::constant(SIGMA_A, SIGMA_S),
@@ -70,10 +72,10 @@ fn our_scene(dir: &Path) -> anyhow::Result<Scene> {
         0.1,
         scene.geometry.triangles_of(0),
     );
-    scene.volumetric = Some(Volumetric {
+    let body = BodyIntegrator::Volumetric(Volumetric {
         media: vec![Some(body)],
     });
-    Ok(scene)
+    Ok((scene, body))
 }
 
 /// Pixels whose centre lies within 0.9 of the sphere's projected radius (row-major).
@@ -100,7 +102,12 @@ fn stats(a: &[f64], b: &[f64], pixels: &[usize], spp: u32) -> (f64, f64, f64) {
 }
 
 /// One of our renders: the grey image and its CPU seconds.
-fn ours(scene: &Scene, side: usize, spp: u32, seed: u64) -> anyhow::Result<(Vec<f64>, f64)> {
+fn ours(
+    (scene, body): &(Scene, BodyIntegrator),
+    side: usize,
+    spp: u32,
+    seed: u64,
+) -> anyhow::Result<(Vec<f64>, f64)> {
     let opts = RenderOptions {
         width: side,
         height: side,
@@ -112,7 +119,7 @@ fn ours(scene: &Scene, side: usize, spp: u32, seed: u64) -> anyhow::Result<(Vec<
     };
     let settings = opts.validate()?;
     let t0 = cpu_time::ProcessTime::now();
-    let (film, _) = render(scene, &settings)?;
+    let (film, _) = render_with(scene, body, &settings, None)?;
     let cpu = t0.elapsed().as_secs_f64();
     let img = (0..side * side)
         .map(|i| f64::from(film.linear_srgb(i % side, i / side)[1]))

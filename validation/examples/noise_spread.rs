@@ -9,17 +9,18 @@
 //!
 //! `cargo run --release -p validation --features studies --example noise_spread -- [SPP] [SEED]`
 
+use render::material::SkinKnobs;
 use render::noise::lit_threshold;
 use render::passes::Passes;
 use render::renderer::{RenderOptions, render};
-use render::scene::{Scene, SceneOptions};
+use render::scene::Scene;
 
 fn main() -> anyhow::Result<()> {
     let args: Vec<String> = std::env::args().collect();
     let spp: u32 = args.get(1).map_or(Ok(32), |s| s.parse())?;
     let seed: u64 = args.get(2).map_or(Ok(1), |s| s.parse())?;
     let (w, h) = (768, 384);
-    let scene = Scene::load("builtin:three-heads", &SceneOptions::default())?;
+    let scene = Scene::load("builtin:three-heads", &SkinKnobs::default())?;
     let skin = Passes::first_hit(&scene, w, h).skin;
     let settings = RenderOptions {
         width: w,

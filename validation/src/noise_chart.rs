@@ -40,7 +40,7 @@ pub fn variants() -> Vec<Variant> {
     let before = PathSettings {
         sampler: SamplerKind::Independent,
         wavelengths: WavelengthSampling::Uniform,
-        probe_axes: ProbeAxes::DEFAULT,
+        probe_axes: ProbeAxes::PBRT,
         exit_light_samples: 1,
         split_subsurface: false,
         subsurface_probes: 1,
@@ -61,7 +61,7 @@ pub fn variants() -> Vec<Variant> {
         ..visible
     };
     let normal = PathSettings {
-        probe_axes: ProbeAxes::RENDER,
+        probe_axes: ProbeAxes::DEFAULT,
         ..split
     };
     let two_lights = PathSettings {

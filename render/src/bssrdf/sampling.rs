@@ -38,10 +38,10 @@ impl Default for ProbeAxes {
 }
 
 impl ProbeAxes {
+    /// The normal with [`RENDER_P_NORMAL_AXIS`]: what renders use.
+    pub const DEFAULT: Self = Self::constant(RENDER_P_NORMAL_AXIS);
     /// The normal with [`P_NORMAL_AXIS`] (pbrt's choice).
-    pub const DEFAULT: Self = Self::constant(P_NORMAL_AXIS);
-    /// The normal with [`RENDER_P_NORMAL_AXIS`] (the renderer's default).
-    pub const RENDER: Self = Self::constant(RENDER_P_NORMAL_AXIS);
+    pub const PBRT: Self = Self::constant(P_NORMAL_AXIS);
 
     const fn constant(p: f32) -> Self {
         Self {
@@ -276,7 +276,7 @@ mod tests {
     #[test]
     fn axis_choice_has_the_documented_probabilities() {
         let n = 100_000;
-        for axes in [ProbeAxes::default(), ProbeAxes::new(0.8).unwrap()] {
+        for axes in [ProbeAxes::PBRT, ProbeAxes::new(0.8).unwrap()] {
             let mut count = [0usize; 3];
             for i in 0..n {
                 let (a, v) = axes.choose((i as f32 + 0.5) / n as f32);
@@ -323,7 +323,7 @@ mod tests {
             .map(|i| {
                 let r = (i as f32 + 0.5) * h;
                 let p = pdf_exit(
-                    &ProbeAxes::default(),
+                    &ProbeAxes::PBRT,
                     &f,
                     Vec3::ZERO,
                     Vec3::new(r, 0.0, 0.0),

@@ -25,12 +25,6 @@ use serde::{Deserialize, Serialize};
 use skin_optics::{SkinParams, WavelengthGrid};
 use std::f32::consts::PI;
 
-/// Escaping photons per Monte Carlo shape in the render's tables (`Method::Exact`). With
-/// [`RENDER_SHAPE_STEP_NM`], the energy-weighted shape error against a 16,000-escape shape is at most
-/// 9.1% (light), 8.6% (medium), 6.0% (dark), for 0.4 / 0.9 / 2.6 s of table building on 2 cores
-/// (4,000 escapes every 10 nm: ≤ 5.3%, 3 / 7 / 20 s; `cargo run --release -p validation --example
-/// shape_step`, BENCHMARKS.md `## Renderer`).
-pub const RENDER_SHAPE_ESCAPES: u64 = 1_000;
 /// Wavelength step between Monte Carlo shapes in the render's tables, nm (rows between mix the
 /// neighbouring shapes; each keeps its exact total): 40 nm would add up to 2% to the light skin's
 /// worst shape error.
@@ -60,8 +54,7 @@ pub struct TableOptions {
     /// (0, 0.1]; `None`: exactly `radii` radii; docs/physics.md §16).
     pub radial_error: Option<f64>,
     /// Knobs of each profile: the multipole's, and the exact method's shape (default: the universal
-    /// table; a Monte Carlo shape, e.g. [`RENDER_SHAPE_ESCAPES`] escapes, is traced every
-    /// [`RENDER_SHAPE_STEP_NM`]).
+    /// table; a Monte Carlo shape is traced every [`RENDER_SHAPE_STEP_NM`]).
     pub profile: ProfileOptions,
 }
 
@@ -140,13 +133,10 @@ impl ProfileTable {
             )
         })?;
         let profiles = SpectralProfiles::new(skin, &grid, method, &opts.profile)?;
-        let ends =
-            crate::fidelity::extent::row_ends_mm(profiles.profiles(), opts.energy_tolerance)?;
+        let ends = super::extent::row_ends_mm(profiles.profiles(), opts.energy_tolerance)?;
         let radii = match opts.radial_error {
             None => opts.radii,
-            Some(target) => {
-                crate::fidelity::extent::radii_for_error(profiles.profiles(), &ends, target)?
-            }
+            Some(target) => super::extent::radii_for_error(profiles.profiles(), &ends, target)?,
         };
         Self::from_profiles_to(
             opts.from_nm as f32,

@@ -16,7 +16,7 @@ use std::fmt::Write;
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum TransportChoice {
     /// The separable BSSRDF, and the volumetric walk where the body under a hit is thinner than
-    /// `walk_below_mm` (`super::transport`); `transport_mfp_mm` is the dermis' largest transport
+    /// `walk_below_mm` (`crate::volumetric::thin`); `transport_mfp_mm` is the dermis' largest transport
     /// mean free path 1/(σa + σs') over 380–780 nm, for scale.
     Bssrdf {
         /// Largest transport mean free path, mm.
@@ -279,22 +279,10 @@ pub fn explain_table(skins: &[(&str, &SkinChoices)]) -> String {
     s
 }
 
-/// After a scene loads: the `--explain` table on stdout when `explain`, and (always) one warning on
-/// stderr naming the materials, wavelengths and layers where `--method multipole` is inside
-/// diffusion's failure region.
-pub fn report(scene: &crate::scene::Scene, explain: bool) {
-    let skins: Vec<(&str, &SkinChoices)> = scene
-        .material_names
-        .iter()
-        .zip(&scene.materials)
-        .filter_map(|(name, m)| match m {
-            crate::material::Material::Skin(s) => s.choices.as_deref().map(|c| (name.as_str(), c)),
-            crate::material::Material::Diffuse(_) => None,
-        })
-        .collect();
-    if explain {
-        print!("{}", explain_table(&skins));
-    }
+/// The one warning to show after a scene loads when `--method multipole` is inside diffusion's
+/// failure region for some skin: the materials, wavelengths and layers (`None`: no such skin).
+#[must_use]
+pub fn diffusion_warning(skins: &[(&str, &SkinChoices)]) -> Option<String> {
     let failing: Vec<String> = skins
         .iter()
         .filter_map(|(name, c)| {
@@ -308,36 +296,14 @@ pub fn report(scene: &crate::scene::Scene, explain: bool) {
             })
         })
         .collect();
-    if !failing.is_empty() {
-        eprintln!(
+    (!failing.is_empty()).then(|| {
+        format!(
             "warning: --method multipole misses the exact total by ≥ {:.0}% for skin {}: \
              diffusion fails there (BENCHMARKS.md, stability map); --method exact is right",
             100.0 * DIFFUSION_OK,
             failing.join("; ")
-        );
-    }
-}
-
-/// After a render: per skin material with a thin-part walk, the share of its subsurface hits
-/// that took the walk (`super::transport`); `None` when no material has one.
-#[must_use]
-pub fn thin_walk_report(scene: &crate::scene::Scene) -> Option<String> {
-    let parts = scene.thin_parts.as_ref()?;
-    let mut s = String::new();
-    for (index, name) in scene.material_names.iter().enumerate() {
-        let Some(part) = parts.part(index as u32) else {
-            continue;
-        };
-        let (tested, walked) = part.counts();
-        let _ = writeln!(
-            s,
-            "skin '{name}': volumetric walk at {:.2}% of {tested} subsurface hits (thinner than \
-             {:.2} mm), the BSSRDF at the rest",
-            100.0 * walked as f64 / tested.max(1) as f64,
-            part.walk_below_mm
-        );
-    }
-    Some(s)
+        )
+    })
 }
 
 #[cfg(test)]

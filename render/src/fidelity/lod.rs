@@ -13,7 +13,6 @@
 //! collapse more than their true footprint would allow.
 
 use super::FidelityError;
-use crate::material::Material;
 use serde::{Deserialize, Serialize};
 
 /// The band of x = footprint / r₉₉ over which the BSSRDF blends into the diffuse body.
@@ -93,28 +92,6 @@ impl Lod {
             self.band.full_below * self.r99_mm,
             self.band.diffuse_above * self.r99_mm,
         )
-    }
-}
-
-/// Whether this hit on `material` shades skin with its diffuse body instead of the BSSRDF, at a
-/// pixel footprint of `footprint_mm`; `u` (uniform in [0, 1)) decides inside the band.
-pub fn collapse(material: &Material, footprint_mm: f32, u: f32) -> bool {
-    let Material::Skin(skin) = material else {
-        return false;
-    };
-    let Some(lod) = skin.lod() else {
-        return false;
-    };
-    if skin.subsurface.is_none() {
-        return false;
-    }
-    let p = lod.diffuse_probability(footprint_mm);
-    if p <= 0.0 {
-        false
-    } else if p >= 1.0 {
-        true
-    } else {
-        u < p
     }
 }
 

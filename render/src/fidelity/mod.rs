@@ -2,8 +2,6 @@
 //! tables and of its shading from what the scene needs, and reports every choice with its measured
 //! error (`skin render --explain`).
 //!
-//! - [`extent`]: where a profile row ends (energy left beyond it below a tolerance) and how many
-//!   radii the table needs for an interpolation error target.
 //! - [`wavelengths`]: the widest wavelength step whose interpolated reflectance keeps the skin's
 //!   colour within a CIEDE2000 target and its luminance within a relative target of a 1-nm grid.
 //! - [`lod`]: subsurface scattering blended into a Fresnel-weighted diffuse surface where a pixel
@@ -13,8 +11,6 @@
 //! - [`tables`]: a skin's tables with the choices applied, through the cache.
 //! - [`photons`]: the Monte Carlo shape's photon count from the smallest pixel footprint on the
 //!   skin and the measured error-vs-photons law.
-//! - [`transport`]: the volumetric walk instead of the BSSRDF where the body under a hit is
-//!   thinner than the profile's reach.
 //!
 //! `Fidelity::Full` keeps every table knob at its fixed default (10-nm rows, 128 radii, each
 //! profile's own 99.9% extent) and shades every skin hit with the full BSSRDF: the reference the
@@ -27,11 +23,9 @@
 //! error names its own knob and valid values.
 
 pub mod explain;
-pub mod extent;
 pub mod lod;
 pub mod photons;
 pub mod tables;
-pub mod transport;
 pub mod wavelengths;
 
 pub use explain::{SkinChoices, TransportChoice};
@@ -42,6 +36,13 @@ use std::fmt;
 use std::str::FromStr;
 use thiserror::Error;
 
+/// Factor of r₉₉ below which a hit's local thickness takes the volumetric walk
+/// (`crate::volumetric::thin`), as measured on the backlit slabs (`--thin-walk 1`; the walk is
+/// off unless asked for).
+pub const DEFAULT_THIN_WALK_R99: f64 = 1.0;
+/// Wavelength step of the skin reflectance tables in `Fidelity::Full` and without a BSSRDF, nm
+/// (interpolated to 5 nm).
+pub const SKIN_TABLE_STEP_NM: f64 = 10.0;
 /// Energy left beyond a profile row's end in `Fidelity::Auto`, a fraction of its total.
 pub const DEFAULT_ENERGY_TOLERANCE: f64 = 1e-3;
 /// Energy-weighted interpolation error target of the radius grid in `Fidelity::Auto`.
@@ -251,7 +252,7 @@ impl FidelityKnobs {
                 max_delta_e: DEFAULT_MAX_DELTA_E,
                 max_luminance_error: DEFAULT_MAX_LUMINANCE_ERROR,
             },
-            None => StepChoice::Fixed(crate::material::SKIN_TABLE_STEP_NM),
+            None => StepChoice::Fixed(SKIN_TABLE_STEP_NM),
         };
         let lod = match self.lod {
             LodSetting::ByFidelity => auto.then(LodBand::default),

@@ -38,7 +38,7 @@ use std::f32::consts::FRAC_1_PI;
 mod skin;
 mod surface;
 
-pub use skin::{SKIN_TABLE_STEP_NM, SkinBuildError, SkinKnobs, SkinMaterial};
+pub use skin::{SkinBuildError, SkinKnobs, SkinMaterial};
 use surface::Surface;
 pub use surface::SurfaceKind;
 
@@ -112,6 +112,30 @@ pub struct BsdfSample {
 }
 
 impl Material {
+    /// Whether a hit on this material shades skin with its diffuse body instead of the BSSRDF
+    /// at a pixel footprint of `footprint_mm` (the level of detail, `crate::fidelity::lod`);
+    /// `u` (uniform in [0, 1)) decides inside the blend band.
+    #[must_use]
+    pub fn collapses(&self, footprint_mm: f32, u: f32) -> bool {
+        let Material::Skin(skin) = self else {
+            return false;
+        };
+        let Some(lod) = skin.lod() else {
+            return false;
+        };
+        if skin.subsurface.is_none() {
+            return false;
+        }
+        let p = lod.diffuse_probability(footprint_mm);
+        if p <= 0.0 {
+            false
+        } else if p >= 1.0 {
+            true
+        } else {
+            u < p
+        }
+    }
+
     /// The BSDF at a point with shading normal `n` (facing the viewer) and texture coordinate `uv`.
     #[must_use]
     pub fn bsdf<'a>(

@@ -12,6 +12,7 @@
 //! the workspace's other records; the fields differ in meaning, so nothing is shared.
 
 use crate::bssrdf::{Directional, EnergySplit, Subsurface};
+use crate::fidelity::SKIN_TABLE_STEP_NM;
 use crate::material::{SurfaceKind, TextureRef};
 use crate::spectrum::SpectrumTable;
 use crate::texture::Texture;
@@ -21,9 +22,6 @@ use rayon::prelude::*;
 use skin_optics::{SkinParams, Wavelength};
 use std::sync::Arc;
 use thiserror::Error;
-
-/// Wavelength step of the skin reflectance tables computed at load, nm (interpolated to 5 nm).
-pub const SKIN_TABLE_STEP_NM: f64 = 10.0;
 
 /// Knobs of every skin material of a scene, chosen once when it is loaded (default: exact
 /// method, subsurface on, table shapes).

@@ -278,7 +278,7 @@ impl Loader<'_> {
             .map(|e| self.environment(e))
             .transpose()?;
 
-        let mut scene = Scene {
+        Ok(Scene {
             name: self.file.to_string(),
             camera,
             lights,
@@ -288,12 +288,7 @@ impl Loader<'_> {
             textures,
             geometry: Geometry::new(meshes),
             exposure_stops: desc.film.exposure_stops,
-            volumetric: None,
-            thin_parts: None,
-        };
-        scene.thin_parts = crate::fidelity::transport::ThinParts::build(&scene)
-            .map_err(|e| self.err("fidelity.thin_walk", e.to_string()))?;
-        Ok(scene)
+        })
     }
 
     fn mesh(

@@ -11,17 +11,15 @@ mod materials;
 use crate::builtin;
 use crate::camera::Camera;
 use crate::error::RenderError;
+use crate::fidelity::SkinChoices;
 use crate::geometry::{Geometry, SurfaceHit};
 use crate::light::{Environment, Light};
-use crate::material::Material;
+use crate::material::{Material, SkinKnobs};
 use crate::scene_file::SceneDesc;
 use crate::texture::Texture;
 use glam::Vec3;
 use load::Loader;
 use std::path::{Path, PathBuf};
-
-/// The choices made when a scene is loaded (today, the knobs of its skin materials).
-pub use crate::material::SkinKnobs as SceneOptions;
 
 /// What a ray hit first: a surface or an area light.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -57,15 +55,11 @@ pub struct Scene {
     pub geometry: Geometry,
     /// PNG exposure, stops.
     pub exposure_stops: f32,
-    /// The skin media of the volumetric reference integrator (None = skin by its BSSRDF).
-    pub volumetric: Option<crate::volumetric::Volumetric>,
-    /// The volumetric walk at thin parts of skin (`crate::fidelity::transport`; None = off).
-    pub thin_parts: Option<crate::fidelity::transport::ThinParts>,
 }
 
 impl Scene {
     /// Load a scene file, or a built-in scene named `builtin:NAME` (see [`builtin::SCENES`]).
-    pub fn load(spec: &str, opts: &SceneOptions) -> Result<Scene, RenderError> {
+    pub fn load(spec: &str, opts: &SkinKnobs) -> Result<Scene, RenderError> {
         if let Some(name) = spec.strip_prefix(builtin::PREFIX) {
             let text = builtin::scene(name).ok_or_else(|| RenderError::MissingFile {
                 what: "scene",
@@ -90,7 +84,7 @@ impl Scene {
         text: &str,
         file: &str,
         base_dir: Option<&Path>,
-        opts: &SceneOptions,
+        opts: &SkinKnobs,
     ) -> Result<Scene, RenderError> {
         let desc: SceneDesc =
             crate::scene_file::parse(text).map_err(|message| RenderError::SceneSyntax {
@@ -105,10 +99,17 @@ impl Scene {
         .load(desc)
     }
 
-    /// Render skin with the volumetric random walk instead of its BSSRDF from now on.
-    pub fn use_volumetric(&mut self) -> Result<(), crate::volumetric::VolumetricError> {
-        self.volumetric = Some(crate::volumetric::Volumetric::build(self)?);
-        Ok(())
+    /// Each skin material with a BSSRDF, by name, with what the fidelity chose for its tables.
+    #[must_use]
+    pub fn skin_choices(&self) -> Vec<(&str, &SkinChoices)> {
+        self.material_names
+            .iter()
+            .zip(&self.materials)
+            .filter_map(|(name, m)| match m {
+                Material::Skin(s) => s.choices.as_deref().map(|c| (name.as_str(), c)),
+                Material::Diffuse(_) => None,
+            })
+            .collect()
     }
 
     /// First thing hit along (`o`, unit `d`) within (`tmin`, `tmax`): triangles and area lights.

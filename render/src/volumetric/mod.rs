@@ -10,6 +10,7 @@
 
 pub mod distance;
 pub mod shapes;
+pub mod thin;
 pub mod walk;
 
 use crate::material::Material;
@@ -19,24 +20,10 @@ use distance::SurfaceDistance;
 use multipole::exact::montecarlo::HgSampler;
 use multipole::{LayeredMedium, MultipoleError};
 use skin_optics::Wavelength;
-use thiserror::Error;
 
+pub use crate::error::VolumetricError;
+pub use thin::{ThinPart, ThinParts};
 pub use walk::{Exit, Walk, walk};
-
-/// Why the volumetric media could not be built.
-#[derive(Debug, Error)]
-pub enum VolumetricError {
-    /// A skin's layers at one wavelength were refused by the layered-medium description.
-    #[error("material {material}: layers at {nm} nm: {source}")]
-    Layers {
-        /// The material's name.
-        material: String,
-        /// The wavelength, nm.
-        nm: f64,
-        /// What `multipole::layered` reported.
-        source: MultipoleError,
-    },
-}
 
 /// One layer's coefficients over the visible range, mm⁻¹.
 #[derive(Debug, Clone)]

@@ -11,8 +11,7 @@
 
 use super::SkinVolume;
 use crate::bssrdf::Directional;
-use crate::geometry::offset_origin;
-use crate::scene::Scene;
+use crate::geometry::{Geometry, offset_origin};
 use glam::{DVec3, Vec3};
 use multipole::exact::montecarlo::{ROULETTE_SURVIVAL, ROULETTE_THRESHOLD, scatter_direction};
 use rand::{Rng, RngCore};
@@ -62,7 +61,7 @@ pub fn refract(d: Vec3, n: Vec3, eta: f32) -> Option<Vec3> {
 /// refracted direction `dir` (pointing in), at wavelength `nm`; `rays` counts the rays cast.
 #[allow(clippy::too_many_arguments)] // the walk's medium, start and random state
 pub fn walk<R: RngCore>(
-    scene: &Scene,
+    geometry: &Geometry,
     vol: &SkinVolume,
     directional: &Directional,
     p: Vec3,
@@ -89,7 +88,7 @@ pub fn walk<R: RngCore>(
     let mut w = 1.0f64;
     while out.collisions < MAX_COLLISIONS {
         *rays += 1;
-        let Some(hit) = scene.geometry.intersect(x, d, 0.0, f32::INFINITY) else {
+        let Some(hit) = geometry.intersect(x, d, 0.0, f32::INFINITY) else {
             // Not a closed mesh around x: the light is lost.
             return out;
         };

@@ -526,7 +526,8 @@ fn run_noise(args: &NoiseArgs) -> anyhow::Result<()> {
 }
 
 fn run_noise_chart(args: &NoiseChartArgs) -> anyhow::Result<()> {
-    use render::scene::{Scene, SceneOptions};
+    use render::material::SkinKnobs;
+    use render::scene::Scene;
     use validation::noise_chart;
     let all = noise_chart::variants();
     let chosen: Vec<_> = if args.variants.is_empty() {
@@ -545,13 +546,13 @@ fn run_noise_chart(args: &NoiseChartArgs) -> anyhow::Result<()> {
         anyhow::bail!("--variants: none chosen");
     };
     let size = (args.width, args.height);
-    let mut scene = Scene::load(&args.scene, &SceneOptions::default())?;
+    let mut scene = Scene::load(&args.scene, &SkinKnobs::default())?;
     if args.breakdown {
         let lambert = Scene::load(
             &args.scene,
-            &SceneOptions {
+            &SkinKnobs {
                 no_subsurface: true,
-                ..SceneOptions::default()
+                ..SkinKnobs::default()
             },
         )?;
         let spp = args.spp.first().copied().unwrap_or(16);

@@ -24,9 +24,11 @@
 
 use anyhow::Context;
 use render::film::Film;
+use render::integrator::{BodyIntegrator, IntegratorKind};
+use render::material::SkinKnobs;
 use render::passes::Passes;
-use render::renderer::{RenderOptions, render};
-use render::scene::{Scene, SceneOptions};
+use render::renderer::{RenderOptions, render_with};
+use render::scene::Scene;
 use render::volumetric::shapes::box_obj;
 use skin_plot::{HeatMap, LineChart, Panel, Series, SeriesStyle, save_png};
 use std::fmt::Write as _;
@@ -212,7 +214,7 @@ fn untextured(toml: &str) -> String {
 
 /// A render of `scene` and the CPU seconds it took.
 fn timed(
-    scene: &Scene,
+    case: &Loaded,
     w: usize,
     h: usize,
     spp: u32,
@@ -229,7 +231,7 @@ fn timed(
     };
     let settings = opts.validate()?;
     let t0 = cpu_time::ProcessTime::now();
-    let (film, _) = render(scene, &settings)?;
+    let (film, _) = render_with(&case.scene, &case.body, &settings, None)?;
     Ok((film, t0.elapsed().as_secs_f64()))
 }
 
@@ -312,12 +314,21 @@ fn stem(c: &Case) -> String {
         .collect()
 }
 
-fn load(toml: &str, volumetric: bool) -> anyhow::Result<Scene> {
-    let mut scene = Scene::from_toml(toml, "study.toml", None, &SceneOptions::default())?;
-    if volumetric {
-        scene.use_volumetric()?;
-    }
-    Ok(scene)
+/// A loaded case: its scene and the state of the integrator of skin's body.
+struct Loaded {
+    scene: Scene,
+    body: BodyIntegrator,
+}
+
+fn load(toml: &str, volumetric: bool) -> anyhow::Result<Loaded> {
+    let scene = Scene::from_toml(toml, "study.toml", None, &SkinKnobs::default())?;
+    let kind = if volumetric {
+        IntegratorKind::Volumetric
+    } else {
+        IntegratorKind::Bssrdf
+    };
+    let body = BodyIntegrator::build(&scene, kind)?;
+    Ok(Loaded { scene, body })
 }
 
 /// Pixels compared: skin at the first hit, lit above 15% of the 95th percentile of `pilot`, a
@@ -456,7 +467,7 @@ pub fn run_render(study: RenderStudy, run: &StudyRun, out: &Path) -> anyhow::Res
         let key_text = c.toml.replace(&mesh_dir, "<meshes>");
         let (reference, t_v) = reference(c, &key_text, ref_spp, 2, run)?;
         let (pilot, _) = timed(&bssrdf, c.width, c.height, study.bssrdf_spp, 3, run.threads)?;
-        let skin = Passes::first_hit(&bssrdf, c.width, c.height).skin;
+        let skin = Passes::first_hit(&bssrdf.scene, c.width, c.height).skin;
         let pixels = compared_pixels(&pilot, &skin);
         let map = error_map(&test, &reference, &pixels);
         let r = measure(&test, &reference, &pixels, &map);
@@ -533,7 +544,7 @@ fn time_chart(
         3,
         threads,
     )?;
-    let skin = Passes::first_hit(&bssrdf, case.width, case.height).skin;
+    let skin = Passes::first_hit(&bssrdf.scene, case.width, case.height).skin;
     let pixels = compared_pixels(&pilot, &skin);
     let mut csv = String::from("integrator,spp,cpu_s,rms_relative_error,paths_per_cpu_s\n");
     let mut lines = format!(

@@ -5,7 +5,7 @@
 //! Each knob's range check is spelled out where the knob is read (the shape repeats across the
 //! workspace's option checks): the error then names that knob and its range.
 
-use crate::bssrdf::table::{MAX_RADII, R_MIN_MM};
+use super::table::{MAX_RADII, R_MIN_MM};
 use multipole::{MultipoleError, Profile};
 
 /// Radii the search of [`radii_for_error`] starts from (doubling from here).

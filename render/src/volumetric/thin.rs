@@ -4,8 +4,8 @@
 //! BSSRDF returns 60–85% too little of a backlit 1–3-mm slab of light or medium skin (BENCHMARKS.md,
 //! "BSSRDF against the volumetric reference"). The criterion: a probe ray from the hit along the
 //! inward normal; when it meets the same material's surface within `walk_below_mm` — the skin's
-//! largest 99% energy radius r₉₉ (over the table's wavelengths) times a factor (default 1,
-//! `--thin-walk`) — the hit is thin and the path takes the volumetric walk (`crate::volumetric`,
+//! largest 99% energy radius r₉₉ (over the table's wavelengths) times a factor
+//! (`crate::fidelity::DEFAULT_THIN_WALK_R99`, `--thin-walk`) — the hit is thin and the path takes the volumetric walk (`crate::volumetric`,
 //! §15) through the mesh instead of the BSSRDF. r₉₉ is the profile's own reach: a slab thicker
 //! than it holds 99% of the half-space's light within its depth, so the BSSRDF's answer stands;
 //! measured, the dark preset's 3-mm slab (r₉₉ 2.2 mm) agrees with the walk within noise
@@ -20,19 +20,16 @@
 //! summed with that of the thick skin around it, thin hits are a small share of the pixel
 //! (1.3% of light-skin hits in `builtin:three-heads-far`), and the walk costs about fifty BSSRDF
 //! paths. There the hit keeps the BSSRDF and no probe ray is traced, as the level of detail
-//! (`super::lod`) keeps no profile the footprint cannot resolve.
+//! (`crate::fidelity::lod`) keeps no profile the footprint cannot resolve.
 
-use crate::geometry::{SurfaceHit, offset_origin};
+use super::{LayerTables, SkinVolume, VolumetricError, layer_tables};
+use crate::geometry::{Geometry, SurfaceHit, offset_origin};
 use crate::material::Material;
 use crate::scene::Scene;
-use crate::volumetric::{LayerTables, SkinVolume, VolumetricError, layer_tables};
 use glam::Vec3;
+use std::fmt::Write;
 use std::sync::OnceLock;
 use std::sync::atomic::{AtomicU64, Ordering};
-
-/// Factor of r₉₉ below which a hit's local thickness takes the walk, as measured on the backlit
-/// slabs (`--thin-walk 1`; the walk is off unless asked for).
-pub const DEFAULT_THIN_WALK_R99: f64 = 1.0;
 
 /// One skin material's thin-part walk: its threshold, its medium (built at first use) and the
 /// counts of the hits tested and walked.
@@ -106,7 +103,7 @@ impl ThinParts {
     /// resolves it; `None` to keep the BSSRDF. Counts the probe ray in `rays`.
     pub fn walk_at(
         &self,
-        scene: &Scene,
+        geometry: &Geometry,
         si: &SurfaceHit,
         ng: Vec3,
         footprint_mm: f32,
@@ -119,7 +116,7 @@ impl ThinParts {
         part.tested.fetch_add(1, Ordering::Relaxed);
         *rays += 1;
         let inward = -ng;
-        let far = scene.geometry.intersect(
+        let far = geometry.intersect(
             offset_origin(si.p, ng, inward),
             inward,
             0.0,
@@ -136,9 +133,32 @@ impl ThinParts {
                 part.phase_g,
                 part.eta,
                 part.d_epi_mm,
-                scene.geometry.triangles_of(si.material),
+                geometry.triangles_of(si.material),
             )
         }))
+    }
+}
+
+impl ThinParts {
+    /// Per skin material with a walk, the share of its subsurface hits that took it, one line
+    /// each (`names`: the scene's material names).
+    #[must_use]
+    pub fn report(&self, names: &[String]) -> String {
+        let mut s = String::new();
+        for (index, name) in names.iter().enumerate() {
+            let Some(part) = self.part(index as u32) else {
+                continue;
+            };
+            let (tested, walked) = part.counts();
+            let _ = writeln!(
+                s,
+                "skin '{name}': volumetric walk at {:.2}% of {tested} subsurface hits (thinner than \
+                 {:.2} mm), the BSSRDF at the rest",
+                100.0 * walked as f64 / tested.max(1) as f64,
+                part.walk_below_mm
+            );
+        }
+        s
     }
 }
 

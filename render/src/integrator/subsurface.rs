@@ -1,0 +1,222 @@
+//! The BSSRDF branch of the path at a skin hit (`crate::bssrdf`): light leaving here entered at an
+//! exit point sampled with a probe ([`super::probe`]); light at the exit point is gathered by
+//! next-event estimation with S_ω, and the path may continue from there. With
+//! `split_subsurface` the light at the exit point is gathered at every skin hit (weight 1) and
+//! only the continuation is chosen between the two branches (weight 1/q); without it the whole
+//! branch is chosen (weight 1/q). Both are unbiased; splitting removes the variance of skipping
+//! the exit's light whenever the surface branch is taken.
+
+use super::lights::{PrevVertex, Receiver, direct_light, light_probabilities};
+use super::{Path, PathTracer, Random, Shading, Step, dims, probe, russian_roulette};
+use crate::bssrdf::{Exit, ProbeFrame, Subsurface, texture_modulation};
+use crate::material::{Material, SkinMaterial};
+use crate::sampler::PathSampler;
+use crate::sampling::cosine_hemisphere;
+use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use brdf::Frame;
+use std::f32::consts::FRAC_1_PI;
+
+impl PathTracer<'_> {
+    /// The BSSRDF branch at `hit` (a skin with a BSSRDF): the first probe's exit, the light at
+    /// the further probes' exits (splitting), the light at the first exit and, when the branch
+    /// was taken, the cosine-weighted continuation from it.
+    pub(super) fn bssrdf_branch(
+        &self,
+        path: &mut Path,
+        hit: &Shading<'_>,
+        wl: &SampledWavelengths,
+        (sampler, rays): Random<'_>,
+    ) -> Step {
+        let Material::Skin(skin) = hit.material else {
+            return Step::Surface;
+        };
+        let Some(ss) = &skin.subsurface else {
+            return Step::Surface;
+        };
+        let found = self.subsurface_exit(skin, ss, hit, wl, (&mut *sampler, &mut *rays));
+        // Further probes at the same skin hit (splitting): each gathers the light at its own exit
+        // point from its own scrambled sequence; the mean over the probes is the estimate, and
+        // the continuation keeps the first probe's exit.
+        let probes = if self.settings.split_subsurface {
+            self.settings.subsurface_probes.max(1)
+        } else {
+            1
+        };
+        let light_scale = if self.settings.split_subsurface {
+            1.0
+        } else {
+            1.0 / hit.q_sss
+        } / probes as f32;
+        if probes > 1 && hit.q_sss > 0.0 {
+            for k in 1..probes {
+                let mut fork = sampler.fork(k);
+                if let Some((exit, w)) =
+                    self.subsurface_exit(skin, ss, hit, wl, (&mut fork, &mut *rays))
+                {
+                    let (direct, _) = self.exit_light(
+                        ss,
+                        &exit,
+                        wl,
+                        (&mut fork, &mut *rays),
+                        &mut path.exit_pick,
+                    );
+                    path.l += path.beta * w * direct * light_scale;
+                }
+            }
+        }
+        let Some((exit, weight)) = found else {
+            return if hit.take_sss {
+                Step::Stop
+            } else {
+                Step::Surface
+            };
+        };
+        let beta_exit = path.beta * weight;
+        // At the exit point: next-event estimation with S_ω, then a cosine-weighted continuation
+        // (weight S_ω cos / (cos / π) = T / c).
+        let (direct, lit_exit) = self.exit_light(
+            ss,
+            &exit,
+            wl,
+            (&mut *sampler, &mut *rays),
+            &mut path.exit_pick,
+        );
+        path.l += beta_exit * direct * light_scale;
+        if !hit.take_sss {
+            return Step::Surface;
+        }
+        let (eng, ens) = (exit.ng, exit.ns);
+        sampler.seek(dims::EXIT_CONTINUATION);
+        let local = cosine_hemisphere(sampler.get_2d());
+        let wi = Frame::from_normal(ens).to_world(local);
+        if local.z <= 0.0 || wi.dot(eng) <= 0.0 {
+            return Step::Stop;
+        }
+        path.beta = beta_exit * (ss.directional.cosine_sample_weight(local.z) / hit.q_sss);
+        let vertex = (exit.p, ens, local.z * FRAC_1_PI);
+        PrevVertex::record(
+            &mut path.prev,
+            &mut path.exit_pick,
+            lit_exit,
+            path.n_lights,
+            vertex,
+        );
+        if !russian_roulette(&mut path.beta, path.depth, self.settings, sampler) {
+            return Step::Stop;
+        }
+        path.go(exit.p, eng, wi);
+        Step::Continue
+    }
+
+    /// Sample where the light leaving skin at `hit` entered (a probe, [`probe::sample_exit`]),
+    /// and the throughput factor of the path through the skin: T(θ_o) · R(r) · N / pdf ·
+    /// √(m_o m_i), the texture's modulation capped so that no wavelength's R_tot · m exceeds 1
+    /// (`bssrdf::separable`). None when the probe found nothing or the factor is 0 or not finite.
+    fn subsurface_exit(
+        &self,
+        skin: &SkinMaterial,
+        ss: &Subsurface,
+        hit: &Shading<'_>,
+        wl: &SampledWavelengths,
+        (sampler, rays): Random<'_>,
+    ) -> Option<(Exit, SampledSpectrum)> {
+        let scene = self.scene;
+        let f = &hit.bsdf.frame;
+        let frame = ProbeFrame {
+            x: f.x,
+            y: f.y,
+            n: f.z,
+        };
+        sampler.seek(dims::PROBE);
+        let u = [
+            sampler.get_1d(),
+            sampler.get_1d(),
+            sampler.get_1d(),
+            sampler.get_1d(),
+        ];
+        let si = &hit.si;
+        let flipped = hit.ns.dot(si.ns) < 0.0;
+        let exit = probe::sample_exit(
+            &scene.geometry,
+            ss,
+            si.material,
+            si.p,
+            &frame,
+            &self.settings.probe_axes,
+            self.settings.radius_wavelength,
+            flipped,
+            wl,
+            u,
+            rays,
+        )?;
+        let m_o = skin.texture_factor(si.uv, &scene.textures);
+        let m_i = exit
+            .hit
+            .map_or(m_o, |h| skin.texture_factor(h.uv, &scene.textures));
+        let m = texture_modulation(m_o, m_i);
+        let t_o = ss.directional.transmittance(hit.wo.dot(hit.ns));
+        let cap = SampledSpectrum(std::array::from_fn(|k| {
+            m.min(1.0 / ss.table.total(wl.nm(k)).max(1e-6))
+        }));
+        let weight = exit.weight * cap * t_o;
+        (!weight.is_black() && weight.is_finite()).then_some((exit, weight))
+    }
+
+    /// Next-event estimation at a subsurface exit point with S_ω (MIS against the cosine-weighted
+    /// continuation): the mean of `settings.exit_light_samples` light samples sharing the exit
+    /// (splitting), and whether any light can reach the point (`pick` gets its light
+    /// probabilities).
+    fn exit_light(
+        &self,
+        ss: &Subsurface,
+        exit: &Exit,
+        wl: &SampledWavelengths,
+        (sampler, rays): (&mut PathSampler, &mut u64),
+        pick: &mut Vec<f32>,
+    ) -> (SampledSpectrum, bool) {
+        let scene = self.scene;
+        let n_lights = scene.lights.len() + usize::from(scene.environment.is_some());
+        let (eng, ens) = (exit.ng, exit.ns);
+        sampler.seek(dims::EXIT_LIGHT);
+        let lit = n_lights > 0 && light_probabilities(scene, exit.p, ens, pick);
+        if !lit {
+            return (SampledSpectrum::zero(), false);
+        }
+        let n = self.settings.exit_light_samples.max(1);
+        let mut direct = SampledSpectrum::zero();
+        let mut u_first = 0.0;
+        for j in 0..n {
+            sampler.seek(dims::EXIT_LIGHT + 4 * j.min(1));
+            let drawn = sampler.get_1d();
+            // Stratified light choice: the j-th sample picks at u₀ + j/n (mod 1), each uniform, so
+            // the n samples spread over the lights in proportion to their probabilities.
+            let u_pick = if j == 0 {
+                u_first = drawn;
+                drawn
+            } else if self.settings.stratified_exit_lights {
+                (u_first + j as f32 / n as f32).fract()
+            } else {
+                drawn
+            };
+            direct += direct_light(
+                scene,
+                Receiver {
+                    p: exit.p,
+                    ng: eng,
+                    ns: ens,
+                },
+                wl,
+                (pick, u_pick),
+                (&mut *sampler, &mut *rays),
+                |wi| {
+                    let c = wi.dot(ens);
+                    (
+                        SampledSpectrum::splat(ss.directional.s_omega(c) * c.max(0.0)),
+                        c.max(0.0) * FRAC_1_PI,
+                    )
+                },
+            );
+        }
+        (direct / n as f32, true)
+    }
+}
