@@ -40,13 +40,37 @@ pub enum MultipoleError {
     UnknownMethod(String),
     /// Invalid input to the exact (adding-doubling) transport solver.
     #[error(transparent)]
-    Exact(#[from] crate::exact::adding_doubling::AddingDoublingError),
+    Exact(#[from] AddingDoublingError),
     /// A profile table that is not finite and non-negative, or whose radii do not increase.
     #[error("invalid profile table: {0}")]
     Profile(&'static str),
     /// An error from the optical coefficients (wavelength, grid).
     #[error(transparent)]
     Optics(#[from] OpticsError),
+}
+
+/// Invalid input to the adding-doubling solver, naming the parameter, its value and its valid range.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum AddingDoublingError {
+    /// A parameter outside its valid range (or not a number).
+    #[error("{name} = {value} outside {range}")]
+    OutOfRange {
+        /// Parameter name.
+        name: &'static str,
+        /// The offending value.
+        value: f64,
+        /// Valid range, as text.
+        range: &'static str,
+    },
+    /// A semi-infinite layer that does not absorb has no finite answer to converge to numerically.
+    #[error("a semi-infinite layer needs sigma_a > 0 (got {sigma_a_per_mm} mm⁻¹)")]
+    SemiInfiniteWithoutAbsorption {
+        /// Its absorption coefficient, mm⁻¹.
+        sigma_a_per_mm: f64,
+    },
+    /// The adding equations met a singular matrix (a lossless loop between two layers).
+    #[error("singular matrix while {0} (a non-absorbing layer against a totally reflecting one?)")]
+    Singular(&'static str),
 }
 
 /// Check that `value` is finite and in `[min, max]`; `range` is the text shown to the user.

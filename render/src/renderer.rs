@@ -261,12 +261,46 @@ pub fn render_with(
 /// How often the image-wide noise estimate of [`Progress`] is refreshed.
 const PROGRESS_NOISE_EVERY: Duration = Duration::from_millis(500);
 
+/// One path through pixel (`x`, `y`) for pass `sample`: its colour, CIE XYZ (a grey at one
+/// wavelength with `wavelength_nm`); counts its rays in `rays`.
+fn sample_pixel(
+    tracer: &PathTracer<'_>,
+    s: &RenderSettings,
+    (x, y): (usize, usize),
+    sample: u32,
+    rays: &mut u64,
+) -> [f32; 3] {
+    let (w, h) = (s.width, s.height);
+    let aspect = w as f32 / h as f32;
+    let i = y * w + x;
+    let mut sampler = PathSampler::new(s.path.sampler, s.seed, i as u64, sample);
+    sampler.start_camera();
+    let u_wl = sampler.get_1d();
+    let wl = s.wavelength_nm.map_or_else(
+        || SampledWavelengths::sample(u_wl, s.path.wavelengths),
+        SampledWavelengths::fixed,
+    );
+    let jitter = sampler.get_2d();
+    let film_pos = Vec2::new(
+        (x as f32 + jitter.x) / w as f32,
+        (y as f32 + jitter.y) / h as f32,
+    );
+    let lens = sampler.get_2d();
+    let (o, d) = tracer.scene.camera.generate_ray(film_pos, aspect, lens);
+    let l = tracer.radiance(o, d, &wl, &mut sampler, rays);
+    // A non-finite sample is dropped and counted by the accumulator.
+    if s.wavelength_nm.is_some() {
+        wl.to_grey_xyz(&l)
+    } else {
+        wl.to_xyz(&l)
+    }
+}
+
 fn render_passes(
     tracer: &PathTracer<'_>,
     s: &RenderSettings,
     mut on_pass: Option<&mut (dyn FnMut(&Progress) + Send)>,
 ) -> Result<(Film, RenderStats), RenderError> {
-    let scene = tracer.scene;
     let (w, h) = (s.width, s.height);
     let estimate = s
         .error_estimate
@@ -279,7 +313,6 @@ fn render_passes(
         .collect();
     let rays = AtomicU64::new(0);
     let start = Instant::now();
-    let aspect = w as f32 / h as f32;
     let mut last = Duration::ZERO;
     let (mut noise, mut noise_at) = (f64::INFINITY, Duration::ZERO);
     for sample in 0..s.spp {
@@ -294,28 +327,7 @@ fn render_passes(
                         if !active[i] {
                             continue;
                         }
-                        let mut sampler =
-                            PathSampler::new(s.path.sampler, s.seed, i as u64, sample);
-                        sampler.start_camera();
-                        let u_wl = sampler.get_1d();
-                        let wl = s.wavelength_nm.map_or_else(
-                            || SampledWavelengths::sample(u_wl, s.path.wavelengths),
-                            SampledWavelengths::fixed,
-                        );
-                        let jitter = sampler.get_2d();
-                        let film_pos = Vec2::new(
-                            (x as f32 + jitter.x) / w as f32,
-                            (y as f32 + jitter.y) / h as f32,
-                        );
-                        let lens = sampler.get_2d();
-                        let (o, d) = scene.camera.generate_ray(film_pos, aspect, lens);
-                        let l = tracer.radiance(o, d, &wl, &mut sampler, &mut tile_rays);
-                        // A non-finite sample is dropped and counted by the accumulator.
-                        let xyz = if s.wavelength_nm.is_some() {
-                            wl.to_grey_xyz(&l)
-                        } else {
-                            wl.to_xyz(&l)
-                        };
+                        let xyz = sample_pixel(tracer, s, (x, y), sample, &mut tile_rays);
                         out.push((i, xyz));
                     }
                 }

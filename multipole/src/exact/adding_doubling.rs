@@ -33,13 +33,13 @@ mod split;
 pub use layer_cache::LAYER_CACHE_BYTES;
 pub use split::{LayerTotals, skin_layer_totals};
 
+pub use crate::error::AddingDoublingError;
 use crate::error::MultipoleError;
 use crate::layered::{Layer, LayeredMedium};
 use layer::{Angles, LayerBuild, Operator};
 use matrix::Mat;
 use skin_optics::{SkinParams, Wavelength, WavelengthGrid};
 use std::rc::Rc;
-use thiserror::Error;
 
 pub use crate::layered::DEFAULT_G;
 
@@ -50,30 +50,6 @@ pub const DEFAULT_QUADRATURE_POINTS: usize = 24;
 
 /// Largest supported number of quadrature directions per hemisphere.
 pub const MAX_QUADRATURE_POINTS: usize = 64;
-
-/// Invalid input to the adding-doubling solver, naming the parameter, its value and its valid range.
-#[derive(Debug, Clone, PartialEq, Error)]
-pub enum AddingDoublingError {
-    /// A parameter outside its valid range (or not a number).
-    #[error("{name} = {value} outside {range}")]
-    OutOfRange {
-        /// Parameter name.
-        name: &'static str,
-        /// The offending value.
-        value: f64,
-        /// Valid range, as text.
-        range: &'static str,
-    },
-    /// A semi-infinite layer that does not absorb has no finite answer to converge to numerically.
-    #[error("a semi-infinite layer needs sigma_a > 0 (got {sigma_a_per_mm} mm⁻¹)")]
-    SemiInfiniteWithoutAbsorption {
-        /// Its absorption coefficient, mm⁻¹.
-        sigma_a_per_mm: f64,
-    },
-    /// The adding equations met a singular matrix (a lossless loop between two layers).
-    #[error("singular matrix while {0} (a non-absorbing layer against a totally reflecting one?)")]
-    Singular(&'static str),
-}
 
 fn check(
     name: &'static str,

@@ -6,7 +6,8 @@
 //!   colour within a CIEDE2000 target and its luminance within a relative target of a 1-nm grid.
 //! - [`lod`]: subsurface scattering blended into a Fresnel-weighted diffuse surface where a pixel
 //!   covers much more than the profile's 99% radius.
-//! - [`cache`]: the tables on disk, keyed by everything they depend on, verified before use.
+//! - [`key`]: the disk-cache key of a skin's tables, the canonical bytes of everything they
+//!   depend on.
 //! - [`explain`]: what was chosen for each skin material and why; the diffusion warning.
 //! - [`tables`]: a skin's tables with the choices applied, through the cache.
 //! - [`photons`]: the Monte Carlo shape's photon count from the smallest pixel footprint on the
@@ -23,6 +24,7 @@
 //! error names its own knob and valid values.
 
 pub mod explain;
+pub mod key;
 pub mod lod;
 pub mod photons;
 pub mod tables;

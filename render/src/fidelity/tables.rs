@@ -2,6 +2,7 @@
 //! record of what was chosen ([`SkinChoices`]).
 
 use super::explain::{SkinChoices, TransportChoice, diffusion_failures};
+use super::key::table_key;
 use super::photons::{self, PhotonChoice};
 use super::wavelengths::{self, WavelengthChoice};
 use super::{FidelityKnobs, Lod, PhotonPolicy, Resolved, StepChoice};
@@ -51,16 +52,6 @@ fn table_options(resolved: &Resolved, shapes: Shapes, phase_g: f64, step_nm: f64
     opts
 }
 
-/// The cache key: everything the table depends on, as text.
-fn key(params: &SkinParams, method: Method, opts: &TableOptions, resolved: &Resolved) -> String {
-    format!(
-        "skin-tables v{} render {} | {params:?} | method {method} | {opts:?} | step {:?}",
-        cache::CACHE_VERSION,
-        env!("CARGO_PKG_VERSION"),
-        resolved.step
-    )
-}
-
 /// Build (or read from the cache) the profile table of `params` with `method`, the shape knob
 /// the layers' Henyey–Greenstein `phase_g` and the fidelity `knobs`, and record the choices.
 pub fn skin_table(
@@ -89,7 +80,7 @@ pub fn skin_table(
     let get = |shapes: Shapes| {
         // The key holds the options before the wavelength choice (the choice is part of the value).
         let probe = table_options(&resolved, shapes, phase_g, 10.0);
-        let key = key(params, method, &probe, &resolved);
+        let key = table_key(params, method, &probe, resolved.step);
         let (stored, outcome) = cache::load_or_build(dir.as_deref(), max_bytes, &key, || {
             let wavelengths = match resolved.step {
                 StepChoice::Fixed(step_nm) => WavelengthChoice::fixed(step_nm),
@@ -207,7 +198,7 @@ mod tests {
         };
         let resolved = knobs.resolve().unwrap();
         let probe = table_options(&resolved, Shapes::Table(None), multipole::DEFAULT_G, 10.0);
-        let k = key(params, Method::Exact, &probe, &resolved);
+        let k = table_key(params, Method::Exact, &probe, resolved.step);
         let build = || {
             let (t, c) = skin_table(
                 params,

@@ -72,8 +72,7 @@ impl PathTracer<'_> {
             };
         };
         let beta_exit = path.beta * weight;
-        // At the exit point: next-event estimation with S_ω, then a cosine-weighted continuation
-        // (weight S_ω cos / (cos / π) = T / c).
+        // At the exit point: next-event estimation with S_ω, then the continuation.
         let (direct, lit_exit) = self.exit_light(
             ss,
             &exit,
@@ -85,6 +84,21 @@ impl PathTracer<'_> {
         if !hit.take_sss {
             return Step::Surface;
         }
+        self.continue_from_exit(path, hit, ss, &exit, (beta_exit, lit_exit), sampler)
+    }
+
+    /// The subsurface branch was taken: continue from `exit` in a cosine-weighted direction
+    /// (weight S_ω cos / (cos / π) = T / c, times `beta_exit` / q); `lit_exit` tells whether a
+    /// light could reach the exit (its probabilities are in `Path::exit_pick`).
+    fn continue_from_exit(
+        &self,
+        path: &mut Path,
+        hit: &Shading<'_>,
+        ss: &Subsurface,
+        exit: &Exit,
+        (beta_exit, lit_exit): (SampledSpectrum, bool),
+        sampler: &mut PathSampler,
+    ) -> Step {
         let (eng, ens) = (exit.ng, exit.ns);
         sampler.seek(dims::EXIT_CONTINUATION);
         let local = cosine_hemisphere(sampler.get_2d());

@@ -71,13 +71,16 @@ pub fn walk<R: RngCore>(
     rng: &mut R,
     rays: &mut u64,
 ) -> Walk {
-    let (sa_e, ss_e) = (
+    let epidermis = (
         vol.epidermis.sigma_a.at_nm(nm),
         vol.epidermis.sigma_s.at_nm(nm),
     );
-    let (sa_d, ss_d) = (vol.dermis.sigma_a.at_nm(nm), vol.dermis.sigma_s.at_nm(nm));
-    let (st_e, st_d) = (sa_e + ss_e, sa_d + ss_d);
-    let majorant = st_e.max(st_d);
+    let dermis = (vol.dermis.sigma_a.at_nm(nm), vol.dermis.sigma_s.at_nm(nm));
+    let media = Media {
+        epidermis,
+        dermis,
+        majorant: (epidermis.0 + epidermis.1).max(dermis.0 + dermis.1),
+    };
     let mut out = Walk {
         exit: None,
         collisions: 0,
@@ -92,47 +95,10 @@ pub fn walk<R: RngCore>(
             // Not a closed mesh around x: the light is lost.
             return out;
         };
-        let mut left = hit.t;
-        let mut scattered = false;
-        loop {
-            // A clear medium (σ̄ = 0) flies straight to the surface.
-            let step = if majorant > 0.0 {
-                -(1.0 - rng.random::<f32>()).ln() / majorant
-            } else {
-                f32::INFINITY
-            };
-            if step >= left {
-                break;
-            }
-            left -= step;
-            x += d * step;
-            out.tentative += 1;
-            let (sa, ss) = if vol.epidermis_region.within(x) {
-                (sa_e, ss_e)
-            } else {
-                (sa_d, ss_d)
-            };
-            if rng.random::<f32>() * majorant >= sa + ss {
-                continue; // null collision
-            }
-            out.collisions += 1;
-            w *= f64::from(ss / (sa + ss));
-            if w == 0.0 {
-                return out;
-            }
-            if w < ROULETTE_THRESHOLD {
-                if rng.random::<f64>() >= ROULETTE_SURVIVAL {
-                    return out;
-                }
-                w /= ROULETTE_SURVIVAL;
-            }
-            let u = scatter_direction(d.as_dvec3().to_array(), &vol.hg, rng);
-            d = DVec3::from_array(u).normalize().as_vec3();
-            scattered = true;
-            break;
-        }
-        if scattered {
-            continue;
+        match fly(&mut x, &mut d, &mut w, hit.t, vol, &media, &mut out, rng) {
+            Flight::Absorbed => return out,
+            Flight::Scattered => continue,
+            Flight::Surface => {}
         }
         // At the surface, from inside.
         let n_out = if hit.ng.dot(d) > 0.0 { hit.ng } else { -hit.ng };
@@ -153,6 +119,74 @@ pub fn walk<R: RngCore>(
         x = offset_origin(hit.p, -n_out, d);
     }
     out
+}
+
+/// The walk's two media at its wavelength, (σa, σs) in mm⁻¹, and the majorant σ̄ of σt.
+struct Media {
+    epidermis: (f32, f32),
+    dermis: (f32, f32),
+    majorant: f32,
+}
+
+/// How a flight towards the surface ended.
+enum Flight {
+    /// It reached the surface `left` mm ahead.
+    Surface,
+    /// It scattered at a real collision (`x`, `d` and `w` updated).
+    Scattered,
+    /// The light was absorbed (weight 0, or lost at roulette).
+    Absorbed,
+}
+
+/// Delta-track from `x` along `d` towards the surface `left` mm ahead: null collisions pass, the
+/// first real one scatters (implicit capture in `w`, roulette below its threshold).
+#[allow(clippy::too_many_arguments)] // the walk's state, its media and its random state
+fn fly<R: RngCore>(
+    x: &mut Vec3,
+    d: &mut Vec3,
+    w: &mut f64,
+    mut left: f32,
+    vol: &SkinVolume,
+    media: &Media,
+    out: &mut Walk,
+    rng: &mut R,
+) -> Flight {
+    loop {
+        // A clear medium (σ̄ = 0) flies straight to the surface.
+        let step = if media.majorant > 0.0 {
+            -(1.0 - rng.random::<f32>()).ln() / media.majorant
+        } else {
+            f32::INFINITY
+        };
+        if step >= left {
+            return Flight::Surface;
+        }
+        left -= step;
+        *x += *d * step;
+        out.tentative += 1;
+        let (sa, ss) = if vol.epidermis_region.within(*x) {
+            media.epidermis
+        } else {
+            media.dermis
+        };
+        if rng.random::<f32>() * media.majorant >= sa + ss {
+            continue; // null collision
+        }
+        out.collisions += 1;
+        *w *= f64::from(ss / (sa + ss));
+        if *w == 0.0 {
+            return Flight::Absorbed;
+        }
+        if *w < ROULETTE_THRESHOLD {
+            if rng.random::<f64>() >= ROULETTE_SURVIVAL {
+                return Flight::Absorbed;
+            }
+            *w /= ROULETTE_SURVIVAL;
+        }
+        let u = scatter_direction(d.as_dvec3().to_array(), &vol.hg, rng);
+        *d = DVec3::from_array(u).normalize().as_vec3();
+        return Flight::Scattered;
+    }
 }
 
 #[cfg(test)]
