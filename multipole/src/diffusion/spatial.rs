@@ -228,6 +228,15 @@ fn window_estimate(stack: &Stack, fraction: f64) -> f64 {
 /// The spatial profile of a stack with the knobs `opts` (module doc).
 pub fn stack_profile(stack: &Stack, opts: &ProfileOptions) -> Result<Profile, MultipoleError> {
     opts.validate()?;
+    stack_profile_checked(stack, opts)
+}
+
+/// [`stack_profile`] with `opts` already validated (a caller computing many profiles checks its
+/// knobs once).
+pub(crate) fn stack_profile_checked(
+    stack: &Stack,
+    opts: &ProfileOptions,
+) -> Result<Profile, MultipoleError> {
     let total = stack.total_reflectance(opts.poles);
     let cum = |rem: &Remainder, r: f64| head_cumulative(stack, r) + rem.cumulative(r);
     let (rem, r_max) = match opts.r_max_mm {

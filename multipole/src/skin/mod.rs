@@ -4,7 +4,9 @@
 use crate::diffusion::boundary::observable_reflectance;
 use crate::diffusion::profile::Profile;
 use crate::diffusion::slab::Poles;
-use crate::diffusion::spatial::{ProfileOptions, reference_reflectance, stack_profile};
+use crate::diffusion::spatial::{
+    ProfileOptions, reference_reflectance, stack_profile, stack_profile_checked,
+};
 use crate::diffusion::stack::Stack;
 use crate::error::MultipoleError;
 use crate::layered::{DEFAULT_G, LayeredMedium};
@@ -121,9 +123,20 @@ pub fn profile(
     method: Method,
     opts: &ProfileOptions,
 ) -> Result<Profile, MultipoleError> {
+    opts.validate()?;
+    profile_checked(skin, lambda, method, opts)
+}
+
+/// [`profile`] with `opts` already validated.
+fn profile_checked(
+    skin: &SkinParams,
+    lambda: Wavelength,
+    method: Method,
+    opts: &ProfileOptions,
+) -> Result<Profile, MultipoleError> {
     match method {
         Method::Exact => exact_profile(skin, lambda, opts.exact_shape, opts),
-        Method::Multipole => stack_profile(&stack(skin, lambda)?, opts),
+        Method::Multipole => stack_profile_checked(&stack(skin, lambda)?, opts),
     }
 }
 
@@ -153,7 +166,7 @@ impl SpectralProfiles {
             }
             _ => lambdas
                 .par_iter()
-                .map(|&l| profile(skin, l, method, opts))
+                .map(|&l| profile_checked(skin, l, method, opts))
                 .collect::<Result<Vec<_>, _>>()?,
         };
         Ok(Self {

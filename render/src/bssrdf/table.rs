@@ -20,6 +20,7 @@
 //! R_tot / ∫table so the table integrates to the model's total R_tot (exact, from q = 0): the 0.1%
 //! tail is redistributed over the table instead of being lost.
 
+use crate::spectrum::{LAMBDA_MAX_NM, LAMBDA_MIN_NM};
 use multipole::{Method, MultipoleError, Profile, ProfileOptions, SpectralProfiles, sampling};
 use serde::{Deserialize, Serialize};
 use skin_optics::{SkinParams, WavelengthGrid};
@@ -61,8 +62,8 @@ pub struct TableOptions {
 impl Default for TableOptions {
     fn default() -> Self {
         Self {
-            from_nm: 380.0,
-            to_nm: 780.0,
+            from_nm: f64::from(LAMBDA_MIN_NM),
+            to_nm: f64::from(LAMBDA_MAX_NM),
             step_nm: 10.0,
             radii: 128,
             energy_tolerance: None,

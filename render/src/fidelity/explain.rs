@@ -5,9 +5,10 @@
 //! workspace's other result records (fits, spectra) by design.
 
 use super::photons::PhotonChoice;
+use super::wavelengths::FROM_NM;
 use super::{Fidelity, Lod, WavelengthChoice};
 use multipole::skin::DIFFUSION_OK;
-use multipole::{DEFAULT_G, LayeredMedium, Method};
+use multipole::{LayeredMedium, Method, MultipoleError};
 use skin_io::cache::CacheOutcome;
 use skin_optics::{SkinParams, Wavelength};
 use std::fmt::Write;
@@ -38,23 +39,26 @@ impl TransportChoice {
         }
     }
 
-    /// The BSSRDF with the dermis' largest transport mean free path of `params` (every 10 nm), and
-    /// the walk below `walk_below_mm`.
-    #[must_use]
-    pub fn bssrdf(params: &SkinParams, walk_below_mm: Option<f32>) -> Self {
-        let transport_mfp_mm = (0..=40)
-            .filter_map(|i| Wavelength::new(380.0 + 10.0 * f64::from(i)).ok())
-            .filter_map(|l| LayeredMedium::skin(params, l, DEFAULT_G).ok())
-            .filter_map(|m| {
-                m.layers()
-                    .last()
-                    .map(|d| 1.0 / (d.sigma_a() + d.sigma_s_prime()))
-            })
-            .fold(0.0, f64::max);
-        Self::Bssrdf {
+    /// The BSSRDF with the dermis' largest transport mean free path of `params` (every 10 nm,
+    /// the layers at the material's Henyey–Greenstein `phase_g`), and the walk below
+    /// `walk_below_mm`.
+    pub fn bssrdf(
+        params: &SkinParams,
+        phase_g: f64,
+        walk_below_mm: Option<f32>,
+    ) -> Result<Self, MultipoleError> {
+        let mut transport_mfp_mm = 0.0f64;
+        for i in 0..=40 {
+            let lambda = Wavelength::new(FROM_NM + 10.0 * f64::from(i))?;
+            let medium = LayeredMedium::skin(params, lambda, phase_g)?;
+            if let Some(d) = medium.layers().last() {
+                transport_mfp_mm = transport_mfp_mm.max(1.0 / (d.sigma_a() + d.sigma_s_prime()));
+            }
+        }
+        Ok(Self::Bssrdf {
             transport_mfp_mm,
             walk_below_mm,
-        }
+        })
     }
 }
 
@@ -80,7 +84,7 @@ pub fn diffusion_failures(params: &SkinParams) -> Option<DiffusionFailures> {
         layers: Vec::new(),
     };
     for i in 0..=40 {
-        let nm = 380.0 + 10.0 * f64::from(i);
+        let nm = FROM_NM + 10.0 * f64::from(i);
         let Ok(l) = Wavelength::new(nm) else { continue };
         let (Ok(m), Ok(e)) = (
             multipole::skin::total_reflectance(params, l, Method::Multipole),

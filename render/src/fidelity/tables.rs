@@ -147,8 +147,9 @@ pub fn skin_table(
         }),
         transport: TransportChoice::bssrdf(
             params,
+            phase_g,
             resolved.thin_walk_r99.map(|k| k as f32 * r99_mm),
-        ),
+        )?,
         cache: outcome,
         build_ms: 1e3 * t0.elapsed().as_secs_f64(),
         diffusion_failures: (method == Method::Multipole)

@@ -7,6 +7,7 @@
 //! luminance bound is there because ΔE2000 weighs lightness by S_L, which lets a dark colour's Y
 //! drift by percents inside ΔE 0.5: a brightness error a renderer's image comparison sees.
 
+use crate::spectrum::{LAMBDA_MAX_NM, LAMBDA_MIN_NM};
 use multipole::{Method, MultipoleError};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -18,9 +19,9 @@ use skin_optics::{SkinParams, Wavelength, WavelengthGrid, color};
 /// Steps tried, nm, widest first: every step dividing the 400-nm range into whole intervals.
 pub const STEPS_NM: [f64; 10] = [100.0, 80.0, 50.0, 40.0, 25.0, 20.0, 16.0, 10.0, 8.0, 5.0];
 /// First wavelength of the tables, nm.
-pub const FROM_NM: f64 = 380.0;
+pub const FROM_NM: f64 = LAMBDA_MIN_NM as f64;
 /// Last wavelength of the tables, nm.
-pub const TO_NM: f64 = 780.0;
+pub const TO_NM: f64 = LAMBDA_MAX_NM as f64;
 
 /// The chosen step and the colour error it costs.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

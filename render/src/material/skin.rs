@@ -13,8 +13,9 @@
 
 use crate::bssrdf::{Directional, EnergySplit, Subsurface};
 use crate::fidelity::SKIN_TABLE_STEP_NM;
+use crate::fidelity::wavelengths::{FROM_NM, TO_NM};
 use crate::material::{SurfaceKind, TextureRef};
-use crate::spectrum::SpectrumTable;
+use crate::spectrum::{LAMBDA_MIN_NM, SpectrumTable};
 use crate::texture::Texture;
 use brdf::TorranceSparrow;
 use glam::Vec2;
@@ -123,7 +124,7 @@ impl SkinMaterial {
         .map_err(SkinBuildError::Profiles)?;
         let step_nm = choices.wavelengths.step_nm as f32;
         if let Some(bad) = (0..table.wavelengths())
-            .map(|j| f64::from(table.total(380.0 + j as f32 * step_nm)))
+            .map(|j| f64::from(table.total(LAMBDA_MIN_NM + j as f32 * step_nm)))
             .find(|r| !(r.is_finite() && (0.0..=1.0).contains(r)))
         {
             return Err(SkinBuildError::OutOfRange(bad));
@@ -219,11 +220,11 @@ fn total_table(
     method: multipole::Method,
     g: f64,
 ) -> Result<SpectrumTable, SkinBuildError> {
-    let n = ((780.0 - 380.0) / SKIN_TABLE_STEP_NM) as usize + 1;
+    let n = ((TO_NM - FROM_NM) / SKIN_TABLE_STEP_NM) as usize + 1;
     let rd = (0..n)
         .into_par_iter()
         .map(|i| {
-            let nm = 380.0 + SKIN_TABLE_STEP_NM * i as f64;
+            let nm = FROM_NM + SKIN_TABLE_STEP_NM * i as f64;
             let lambda =
                 Wavelength::new(nm).map_err(|e| SkinBuildError::Wavelength(e.to_string()))?;
             multipole::skin::total_reflectance_at_g(params, lambda, method, g)
@@ -237,7 +238,7 @@ fn total_table(
         return Err(SkinBuildError::OutOfRange(bad));
     }
     Ok(SpectrumTable::from_fn(|nm| {
-        let x = ((nm - 380.0) / SKIN_TABLE_STEP_NM).clamp(0.0, (n - 1) as f64);
+        let x = ((nm - FROM_NM) / SKIN_TABLE_STEP_NM).clamp(0.0, (n - 1) as f64);
         let i = (x as usize).min(n - 2);
         rd[i] + (x - i as f64) * (rd[i + 1] - rd[i])
     }))

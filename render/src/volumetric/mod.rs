@@ -15,7 +15,9 @@ pub mod walk;
 
 use crate::material::Material;
 use crate::scene::Scene;
-use crate::spectrum::{N_WAVELENGTHS, SampledSpectrum, SpectrumTable};
+use crate::spectrum::{
+    LAMBDA_MAX_NM, LAMBDA_MIN_NM, N_WAVELENGTHS, SampledSpectrum, SpectrumTable,
+};
 use distance::SurfaceDistance;
 use multipole::exact::montecarlo::HgSampler;
 use multipole::{LayeredMedium, MultipoleError};
@@ -144,10 +146,11 @@ pub(crate) fn layer_tables(
     g: f64,
 ) -> Result<(LayerTables, LayerTables), (f64, MultipoleError)> {
     let step = f64::from(SpectrumTable::STEP_NM);
-    let n = ((780.0 - 380.0) / step) as usize + 1;
+    let (from, to) = (f64::from(LAMBDA_MIN_NM), f64::from(LAMBDA_MAX_NM));
+    let n = ((to - from) / step) as usize + 1;
     let mut rows = Vec::with_capacity(n);
     for i in 0..n {
-        let nm = 380.0 + step * i as f64;
+        let nm = from + step * i as f64;
         let lambda = Wavelength::new(nm).map_err(|e| (nm, MultipoleError::from(e)))?;
         let medium = LayeredMedium::skin(params, lambda, g).map_err(|e| (nm, e))?;
         let layers = medium.layers();
@@ -155,7 +158,7 @@ pub(crate) fn layer_tables(
         rows.push([e.sigma_a(), e.sigma_s(), d.sigma_a(), d.sigma_s()]);
     }
     let table = |k: usize| {
-        SpectrumTable::from_fn(|nm| rows[(((nm - 380.0) / step).round() as usize).min(n - 1)][k])
+        SpectrumTable::from_fn(|nm| rows[(((nm - from) / step).round() as usize).min(n - 1)][k])
     };
     Ok((
         LayerTables {
