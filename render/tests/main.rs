@@ -3,6 +3,7 @@
 
 mod adaptive;
 mod fidelity;
+mod module_graph;
 mod passes;
 mod sampler;
 mod scene_presets;

@@ -17,9 +17,9 @@
 //! estimate; most of the image's variance is this first-hit subsurface light (BENCHMARKS.md).
 //!
 //! Skin's body is rendered by one of two sibling integrators, each holding its own state
-//! ([`BodyIntegrator`], built once per scene): the BSSRDF branch ([`subsurface`]: the BSSRDF
+//! ([`BodyIntegrator`], built once per scene): the BSSRDF branch (`subsurface`: the BSSRDF
 //! samples a probe segment, [`probe`] intersects it) with the volumetric walk at thin parts, or
-//! the volumetric reference walk at every skin hit ([`walk`], `crate::volumetric`).
+//! the volumetric reference walk at every skin hit (`walk`, `crate::volumetric`).
 
 mod lights;
 pub mod probe;
@@ -40,7 +40,7 @@ use lights::{PrevVertex, Receiver, direct_light, light_probabilities};
 /// [`PathSampler`] (sets of four dimensions: light choice and position at the hit with the
 /// subsurface decision; the probe, or the BSDF sample and roulette; light at the exit point (two
 /// sets: up to two light samples stratified); the continuation from the exit point and roulette).
-pub(crate) mod dims {
+mod dims {
     pub const SUBSURFACE_CHOICE: u32 = 3;
     pub const PROBE: u32 = 4;
     pub const CONTINUATION: u32 = 4;
