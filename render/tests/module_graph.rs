@@ -100,7 +100,9 @@ fn graph(src: &Path) -> BTreeMap<String, BTreeSet<String>> {
     }
     for f in &files {
         let Some(m) = top(f) else { continue };
-        if f.file_name().is_some_and(|n| n.to_string_lossy().ends_with("tests.rs")) {
+        if f.file_name()
+            .is_some_and(|n| n.to_string_lossy().ends_with("tests.rs"))
+        {
             continue;
         }
         let deps: BTreeSet<String> = references(&code(&std::fs::read_to_string(f).unwrap()))
@@ -157,7 +159,12 @@ fn find_cycle(g: &BTreeMap<String, BTreeSet<String>>) -> Option<Vec<String>> {
 fn render_modules_import_one_way() {
     let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
     let g = graph(&src);
-    assert!(g.len() > 20, "{} modules found in {}", g.len(), src.display());
+    assert!(
+        g.len() > 20,
+        "{} modules found in {}",
+        g.len(),
+        src.display()
+    );
     // The check can fail: the integrator imports the scene, so a scene importing the integrator
     // would close a circle.
     assert!(g["integrator"].contains("scene"), "{g:?}");

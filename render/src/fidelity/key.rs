@@ -13,8 +13,9 @@
 
 use super::StepChoice;
 use crate::bssrdf::TableOptions;
+use multipole::diffusion::slab::Poles;
 use multipole::skin::{ExactShape, ShapeTableOptions};
-use multipole::{Method, Poles, ProfileOptions};
+use multipole::{Method, ProfileOptions};
 use skin_io::cache::CACHE_VERSION;
 use skin_optics::SkinParams;
 use skin_optics::physiology::Extension;
