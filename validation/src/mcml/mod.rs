@@ -72,17 +72,15 @@ pub struct Case {
 }
 
 /// The reference cases: [DJ06] skin (`LayeredMedium::skin`, g = 0.9, n = 1.4 in air) for the light
-/// preset at 450/550/650 nm and the dark preset at 450/650 nm, and a homogeneous half-space
-/// (σa 0.01, σs' 1 mm⁻¹, g 0.9, n 1.4), each dermis or half-space [`HALF_SPACE_DEPTH_MM`] deep.
+/// preset at 450/550/650 nm, the dark preset at 450/650 nm and the darkest skins of the parameter box
+/// in the blue ([`DARK_BLUE_CASES`]), and a homogeneous half-space (σa 0.01, σs' 1 mm⁻¹, g 0.9,
+/// n 1.4), each dermis or half-space [`HALF_SPACE_DEPTH_MM`] deep.
 pub fn cases() -> Result<Vec<Case>, McmlError> {
-    let skin = |preset, nm| -> Result<LayeredMedium, McmlError> {
+    let stack = |skin: &SkinParams, nm| -> Result<LayeredMedium, McmlError> {
         let lambda = Wavelength::new(nm).map_err(|e| McmlError::Output(e.to_string()))?;
-        Ok(finite(&LayeredMedium::skin(
-            &SkinParams::preset(preset),
-            lambda,
-            DEFAULT_G,
-        )?)?)
+        Ok(finite(&LayeredMedium::skin(skin, lambda, DEFAULT_G)?)?)
     };
+    let skin = |preset, nm| stack(&SkinParams::preset(preset), nm);
     let half_space = LayeredMedium::new(
         vec![Layer::from_reduced(0.01, 1.0, DEFAULT_G, 1.4, None)?],
         1.0,
@@ -105,6 +103,15 @@ pub fn cases() -> Result<Vec<Case>, McmlError> {
             })
         })
         .collect::<Result<Vec<_>, McmlError>>()?;
+    for &(name, description, (c_m, beta_m, c_h), nm) in DARK_BLUE_CASES {
+        let params = SkinParams::new(c_m, beta_m, c_h, 0.25)
+            .map_err(|e| McmlError::Output(e.to_string()))?;
+        cases.push(Case {
+            name,
+            description,
+            stack: stack(&params, nm)?,
+        });
+    }
     cases.push(Case {
         name: "half-space",
         description: "half-space σa 0.01, σs' 1 mm⁻¹",
@@ -112,6 +119,35 @@ pub fn cases() -> Result<Vec<Case>, McmlError> {
     });
     Ok(cases)
 }
+
+/// Dark skins in the blue, where the epidermis absorbs a quarter to half of σs: (name,
+/// description, (C_m, β_m, C_h), wavelength nm); default epidermis 0.25 mm, ρ_s 0.25.
+pub const DARK_BLUE_CASES: &[(&str, &str, (f64, f64, f64), f64)] = &[
+    (
+        "cm50-400",
+        "C_m 0.5, β_m 0.9, C_h 0.07, 400 nm",
+        (0.5, 0.9, 0.07),
+        400.0,
+    ),
+    (
+        "cm50-450",
+        "C_m 0.5, β_m 0.9, C_h 0.07, 450 nm",
+        (0.5, 0.9, 0.07),
+        450.0,
+    ),
+    (
+        "cm25-400",
+        "C_m 0.25, β_m 0.9, C_h 0.04, 400 nm",
+        (0.25, 0.9, 0.04),
+        400.0,
+    ),
+    (
+        "cm25-500",
+        "C_m 0.25, β_m 0.9, C_h 0.04, 500 nm",
+        (0.25, 0.9, 0.04),
+        500.0,
+    ),
+];
 
 /// The case named `name`.
 pub fn case(name: &str) -> Result<Case, McmlError> {
