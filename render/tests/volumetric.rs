@@ -252,9 +252,13 @@ fn the_walk_is_independent_of_the_mesh_scale() {
              [[meshes]]\nfile = \"cube.obj\"\nmaterial = \"skin\"\n",
             half_mm + 400.0
         );
-        let mut scene =
-            Scene::from_toml(&text, "cube.toml", Some(dir.path()), &SceneOptions::default())
-                .unwrap();
+        let mut scene = Scene::from_toml(
+            &text,
+            "cube.toml",
+            Some(dir.path()),
+            &SceneOptions::default(),
+        )
+        .unwrap();
         scene.use_volumetric().unwrap();
         let opts = RenderOptions {
             width: 4,

@@ -4,7 +4,7 @@
 //! annuli (`validation::shape_error`, with the reference's own noise term) and, on a geometric
 //! grid from 0.001 mm, the table's energy per radial band relative to the reference's.
 //!
-//! `cargo run --release -p validation --example dark_table -- [REF_PHOTONS [TABLE_PHOTONS
+//! `cargo run --release -p validation --features studies --example dark_table -- [REF_PHOTONS [TABLE_PHOTONS
 //! [DEPTHS_PER_OCTAVE [RADIAL_PER_DECADE [ALPHA_PER_DECADE]]]]]` (defaults 2·10⁶ and the table's
 //! defaults; set `SKIN_CACHE_DIR` to keep other tables apart).
 use multipole::ProfileOptions;
@@ -36,14 +36,30 @@ fn main() -> anyhow::Result<()> {
         let c = skin.coefficients(lambda);
         let ss = c.epidermis.sigma_s_prime / (1.0 - DEFAULT_G);
         let t = std::time::Instant::now();
-        let tp = exact_profile(&skin, lambda, ExactShape::Table(opts), &ProfileOptions::default())?;
+        let tp = exact_profile(
+            &skin,
+            lambda,
+            ExactShape::Table(opts),
+            &ProfileOptions::default(),
+        )?;
         let dt = t.elapsed().as_secs_f64();
-        let mcp = exact_profile(&skin, lambda, ExactShape::MonteCarlo { escapes: 4000 }, &ProfileOptions::default())?;
+        let mcp = exact_profile(
+            &skin,
+            lambda,
+            ExactShape::MonteCarlo { escapes: 4000 },
+            &ProfileOptions::default(),
+        )?;
         let stack = LayeredMedium::skin(&skin, lambda, DEFAULT_G)?;
-        let mc = run(&stack, &McOptions::new(photons, 16, 7)?.with_grid(RadialGrid::new(0.02, 300)?));
+        let mc = run(
+            &stack,
+            &McOptions::new(photons, 16, 7)?.with_grid(RadialGrid::new(0.02, 300)?),
+        );
         let (e, n) = energy_error(&tp, &mc);
         let (e2, _) = energy_error(&mcp, &mc);
-        let fine = run(&stack, &McOptions::new(photons, 16, 7)?.with_grid(RadialGrid::geometric(0.001, 6.0, 60)?));
+        let fine = run(
+            &stack,
+            &McOptions::new(photons, 16, 7)?.with_grid(RadialGrid::geometric(0.001, 6.0, 60)?),
+        );
         let enter = 1.0 - fine.specular_reflectance;
         let tot = fine.diffuse_reflectance.mean;
         let bands = [0.0, 0.005, 0.01, 0.02, 0.05, 0.1, 0.2, 0.5, 1.0, 6.0];
@@ -64,7 +80,13 @@ fn main() -> anyhow::Result<()> {
                     mm += enter * annulus_energy(&tp, g.inner_mm(i), g.outer_mm(i));
                 }
             }
-            s += &format!(" [{}-{}] mc {:.3} tab {:+.1}%", w[0], w[1], m / tot, 100.0 * (mm / m - 1.0));
+            s += &format!(
+                " [{}-{}] mc {:.3} tab {:+.1}%",
+                w[0],
+                w[1],
+                m / tot,
+                100.0 * (mm / m - 1.0)
+            );
         }
         println!(
             "C_m {c_m} b {b} C_h {c_h} {nm} nm: a1 {:.4} a2 {:.4} tau {:.2} sigma_s {:.1}/mm | table {:.2}% mc4000 {:.2}% (noise {:.2}%) first profile (table build or read included) {:.1} ms\n  {s}",

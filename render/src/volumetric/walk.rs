@@ -83,7 +83,10 @@ pub fn walk<R: RngCore>(
         collisions: 0,
         tentative: 0,
     };
-    debug_assert!(dir.dot(ng_out) <= 1e-4, "the walk starts with light going in");
+    debug_assert!(
+        dir.dot(ng_out) <= 1e-4,
+        "the walk starts with light going in"
+    );
     // The walk starts on the surface itself: an origin offset into the skin would skip medium,
     // and the offset that clears a triangle grows with the coordinates (2·10⁻⁵ of them: 0.02 mm,
     // two mean free paths in the blue, on a 1 m mesh). Leaving the surface, the ray ignores hits

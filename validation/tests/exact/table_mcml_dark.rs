@@ -77,7 +77,12 @@ fn check(case: &str) {
         100.0 * inner,
         100.0 * outer
     );
-    assert!(err <= bound, "{case}: error {:.2}% > {:.2}%", 100.0 * err, 100.0 * bound);
+    assert!(
+        err <= bound,
+        "{case}: error {:.2}% > {:.2}%",
+        100.0 * err,
+        100.0 * bound
+    );
     assert!(
         inner.abs() <= inner_bound,
         "{case}: first annulus off by {:+.2}% of R_d (bound ±{:.2}%)",
