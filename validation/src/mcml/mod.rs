@@ -103,13 +103,13 @@ pub fn cases() -> Result<Vec<Case>, McmlError> {
             })
         })
         .collect::<Result<Vec<_>, McmlError>>()?;
-    for &(name, description, (c_m, beta_m, c_h), nm) in DARK_BLUE_CASES {
-        let params = SkinParams::new(c_m, beta_m, c_h, 0.25)
+    for c in DARK_BLUE_CASES {
+        let params = SkinParams::new(c.c_m, c.beta_m, c.c_h, 0.25)
             .map_err(|e| McmlError::Output(e.to_string()))?;
         cases.push(Case {
-            name,
-            description,
-            stack: stack(&params, nm)?,
+            name: c.name,
+            description: c.description,
+            stack: stack(&params, c.nm)?,
         });
     }
     cases.push(Case {
@@ -120,33 +120,57 @@ pub fn cases() -> Result<Vec<Case>, McmlError> {
     Ok(cases)
 }
 
-/// Dark skins in the blue, where the epidermis absorbs a quarter to half of σs: (name,
-/// description, (C_m, β_m, C_h), wavelength nm); default epidermis 0.25 mm, ρ_s 0.25.
-pub const DARK_BLUE_CASES: &[(&str, &str, (f64, f64, f64), f64)] = &[
-    (
-        "cm50-400",
-        "C_m 0.5, β_m 0.9, C_h 0.07, 400 nm",
-        (0.5, 0.9, 0.07),
-        400.0,
-    ),
-    (
-        "cm50-450",
-        "C_m 0.5, β_m 0.9, C_h 0.07, 450 nm",
-        (0.5, 0.9, 0.07),
-        450.0,
-    ),
-    (
-        "cm25-400",
-        "C_m 0.25, β_m 0.9, C_h 0.04, 400 nm",
-        (0.25, 0.9, 0.04),
-        400.0,
-    ),
-    (
-        "cm25-500",
-        "C_m 0.25, β_m 0.9, C_h 0.04, 500 nm",
-        (0.25, 0.9, 0.04),
-        500.0,
-    ),
+/// A dark skin in the blue of [`DARK_BLUE_CASES`]: default epidermis 0.25 mm, ρ_s 0.25.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DarkBlueCase {
+    /// File stem.
+    pub name: &'static str,
+    /// What it is, for tables.
+    pub description: &'static str,
+    /// Melanin fraction C_m.
+    pub c_m: f64,
+    /// Eumelanin share β_m.
+    pub beta_m: f64,
+    /// Blood fraction C_h.
+    pub c_h: f64,
+    /// Wavelength, nm.
+    pub nm: f64,
+}
+
+/// Dark skins in the blue, where the epidermis absorbs a quarter to half of σs.
+pub const DARK_BLUE_CASES: &[DarkBlueCase] = &[
+    DarkBlueCase {
+        name: "cm50-400",
+        description: "C_m 0.5, β_m 0.9, C_h 0.07, 400 nm",
+        c_m: 0.5,
+        beta_m: 0.9,
+        c_h: 0.07,
+        nm: 400.0,
+    },
+    DarkBlueCase {
+        name: "cm50-450",
+        description: "C_m 0.5, β_m 0.9, C_h 0.07, 450 nm",
+        c_m: 0.5,
+        beta_m: 0.9,
+        c_h: 0.07,
+        nm: 450.0,
+    },
+    DarkBlueCase {
+        name: "cm25-400",
+        description: "C_m 0.25, β_m 0.9, C_h 0.04, 400 nm",
+        c_m: 0.25,
+        beta_m: 0.9,
+        c_h: 0.04,
+        nm: 400.0,
+    },
+    DarkBlueCase {
+        name: "cm25-500",
+        description: "C_m 0.25, β_m 0.9, C_h 0.04, 500 nm",
+        c_m: 0.25,
+        beta_m: 0.9,
+        c_h: 0.04,
+        nm: 500.0,
+    },
 ];
 
 /// The case named `name`.

@@ -60,12 +60,12 @@ fn compare(p: &Profile, mcml: &ReferenceData) -> (f64, f64, (f64, f64), (f64, f6
 }
 
 fn check(case: &str) {
-    let &(_, _, (c_m, beta_m, c_h), nm) = DARK_BLUE_CASES
+    let c = DARK_BLUE_CASES
         .iter()
-        .find(|c| c.0 == case)
+        .find(|c| c.name == case)
         .expect("a dark-blue case");
-    let skin = SkinParams::new(c_m, beta_m, c_h, 0.25).unwrap();
-    let lambda = Wavelength::new(nm).unwrap();
+    let skin = SkinParams::new(c.c_m, c.beta_m, c.c_h, 0.25).unwrap();
+    let lambda = Wavelength::new(c.nm).unwrap();
     let mcml = reference(case);
     let shape = ExactShape::Table(ShapeTableOptions::default());
     let p = exact_profile(&skin, lambda, shape, &ProfileOptions::default()).unwrap();
