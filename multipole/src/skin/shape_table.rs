@@ -11,9 +11,9 @@
 //! Weighting at build time rather than histogramming path lengths: a path bin's weight varies
 //! across the bin by e^(α l Δ), which for a strongly absorbing epidermis (dark skin in the blue,
 //! α₁ ≈ 0.3–0.6, the reflected light's paths a few to tens of scattering lengths) reaches a
-//! factor of several within one bin of 8 per decade and shifted 2–4% of the energy between radii.
-//! ln S(α) = ln Σ e^(−α l) is smooth and convex in α, so the interpolation error is small at 8
-//! nodes per decade (measured in BENCHMARKS.md, `## Exact profile table`).
+//! factor of several within one bin of 8 per decade and moved up to 3.6% of the energy between
+//! radii. ln S(α) = ln Σ e^(−α l) is smooth and convex in α, so a cubic through 8 nodes per decade
+//! follows it closely; the profile errors at the default knobs are in docs/accuracy_evidence.md.
 //!
 //! Knobs ([`ShapeTableOptions`]): photons (noise), depths per octave (interpolation), radial bins
 //! and absorption nodes per decade; errors against the run-time Monte Carlo in BENCHMARKS.md
