@@ -14,7 +14,8 @@ use serde::Serialize;
 use serde::de::DeserializeOwned;
 use std::path::{Path, PathBuf};
 
-/// Version of the tables' contents: bump it whenever what a given key builds changes.
+/// Version of an entry's file format (header, key, body); what a key builds is versioned by the
+/// key itself.
 pub const CACHE_VERSION: u32 = 2;
 /// First word of an entry's header.
 const MAGIC: &str = "skin-tables";

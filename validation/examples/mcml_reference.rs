@@ -2,8 +2,9 @@
 //! `validation::mcml::cases`, the `.mci` input (the layers our code builds, in MCML's cm units) and,
 //! after running MCML on it, the means and standard errors over its independent runs as CSV.
 //!
-//! `cargo run --release -p validation --features studies --example mcml_reference -- PATH_TO_MCML [RUNS] [PHOTONS_PER_RUN]`
-//! (defaults 20 runs × 100,000 photons; MCML is built by its own build script, outside this tree).
+//! `cargo run --release -p validation --features studies --example mcml_reference -- PATH_TO_MCML [RUNS] [PHOTONS_PER_RUN] [NAME...]`
+//! (defaults 20 runs × 100,000 photons, every case; names pick cases; MCML is built by its own
+//! build script, outside this tree).
 //! Cases run in parallel on the rayon pool. MCML seeds its generator from the clock, so a re-run
 //! gives other numbers within the stated standard errors.
 
@@ -42,13 +43,18 @@ fn main() -> anyhow::Result<()> {
     );
     let out = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/mcml");
     std::fs::create_dir_all(&out)?;
-    let cases = mcml::cases()?;
+    let only: Vec<String> = args.collect();
+    let cases: Vec<_> = mcml::cases()?
+        .into_iter()
+        .filter(|c| only.is_empty() || only.iter().any(|n| n == c.name))
+        .collect();
     let bar = ProgressBar::new(cases.len() as u64).with_style(ProgressStyle::with_template(
         "{bar:30} {pos}/{len} MCML cases {elapsed}",
     )?);
     bar.tick();
     let command = format!(
-        "cargo run --release -p validation --example mcml_reference -- MCML {runs} {photons}"
+        "cargo run --release -p validation --example mcml_reference -- MCML {runs} {photons}{}",
+        only.iter().map(|n| format!(" {n}")).collect::<String>()
     );
     cases.par_iter().try_for_each(|case| -> anyhow::Result<()> {
         let list: Vec<McmlRun> = (0..runs)

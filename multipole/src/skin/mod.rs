@@ -25,8 +25,8 @@ pub use shape::{
     shape_photons, shape_profile, shape_radii, table_profile,
 };
 pub use shape_table::{
-    ShapeTable, ShapeTableOptions, TABLE_MAX_PATH, TABLE_MIN_ALPHA, TABLE_TAU_MAX, TABLE_TAU_MIN,
-    cached_table,
+    ShapeTable, ShapeTableOptions, TABLE_MAX_ALPHA, TABLE_MAX_PATH, TABLE_MIN_ALPHA, TABLE_TAU_MAX,
+    TABLE_TAU_MIN, cached_table,
 };
 
 /// How the skin's diffuse reflectance is computed.

@@ -16,12 +16,14 @@ use crate::bssrdf::TableOptions;
 use multipole::diffusion::slab::Poles;
 use multipole::skin::{ExactShape, ShapeTableOptions};
 use multipole::{Method, ProfileOptions};
-use skin_io::cache::CACHE_VERSION;
 use skin_optics::SkinParams;
 use skin_optics::physiology::Extension;
 
 /// Version of this byte layout: bump it when the encoding below changes.
 pub const KEY_FORMAT: u32 = 1;
+/// Version of what a key builds: bump it whenever the same inputs give other tables (the exact
+/// shape table's construction, a profile's sampling, ...).
+pub const TABLES_VERSION: u32 = 3;
 
 /// Canonical bytes, appended field by field.
 #[derive(Debug, Default)]
@@ -72,7 +74,7 @@ pub fn table_key(
 ) -> String {
     let mut b = Bytes::default();
     b.u64(u64::from(KEY_FORMAT))
-        .u64(u64::from(CACHE_VERSION))
+        .u64(u64::from(TABLES_VERSION))
         .text(env!("CARGO_PKG_VERSION"));
     skin(&mut b, params);
     match method {
@@ -159,14 +161,14 @@ fn profile(b: &mut Bytes, p: &ProfileOptions) {
                 photons,
                 depths_per_octave,
                 radial_per_decade,
-                path_per_decade,
+                alpha_per_decade,
                 seed,
             } = t;
             b.tag(3)
                 .u64(*photons)
                 .u64(u64::from(*depths_per_octave))
                 .u64(u64::from(*radial_per_decade))
-                .u64(u64::from(*path_per_decade))
+                .u64(u64::from(*alpha_per_decade))
                 .u64(*seed)
         }
         // A variant added later (the enum is non-exhaustive) keys by its debug text.

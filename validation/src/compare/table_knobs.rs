@@ -83,12 +83,12 @@ fn settings() -> Vec<(&'static str, ShapeTableOptions)> {
         };
         s.push(("radial_per_decade", o));
     }
-    for path_per_decade in [4, 16] {
+    for alpha_per_decade in [4, 16] {
         let o = ShapeTableOptions {
-            path_per_decade,
+            alpha_per_decade,
             ..d
         };
-        s.push(("path_per_decade", o));
+        s.push(("alpha_per_decade", o));
     }
     s
 }
@@ -99,7 +99,7 @@ fn knob_value(knob: &str, o: &ShapeTableOptions) -> f64 {
         "photons" => o.photons as f64,
         "depths_per_octave" => f64::from(o.depths_per_octave),
         "radial_per_decade" => f64::from(o.radial_per_decade),
-        _ => f64::from(o.path_per_decade),
+        _ => f64::from(o.alpha_per_decade),
     }
 }
 
@@ -139,7 +139,7 @@ pub fn run_table_knobs(mc_photons: u64, out: &Path) -> anyhow::Result<()> {
     bar.finish_and_clear();
     let noise: Vec<f64> = cases.iter().map(|c| energy_error_noise(&c.mc)).collect();
     let mut csv = String::from(
-        "knob,photons,depths_per_octave,radial_per_decade,path_per_decade,build_cpu_s,eval_ms",
+        "knob,photons,depths_per_octave,radial_per_decade,alpha_per_decade,build_cpu_s,eval_ms",
     );
     for c in &cases {
         let _ = write!(csv, ",{}", c.name);
@@ -149,7 +149,7 @@ pub fn run_table_knobs(mc_photons: u64, out: &Path) -> anyhow::Result<()> {
         let _ = write!(
             csv,
             "{knob},{},{},{},{},{build:.2},{eval:.3}",
-            o.photons, o.depths_per_octave, o.radial_per_decade, o.path_per_decade
+            o.photons, o.depths_per_octave, o.radial_per_decade, o.alpha_per_decade
         );
         for e in errs {
             let _ = write!(csv, ",{e:.5}");
@@ -175,7 +175,7 @@ fn chart(out: &Path, rows: &[Row], noise: f64) -> anyhow::Result<()> {
         "photons",
         "depths_per_octave",
         "radial_per_decade",
-        "path_per_decade",
+        "alpha_per_decade",
     ];
     let default = rows.iter().find(|r| r.0 == "default");
     let mut panels = Vec::new();

@@ -72,17 +72,15 @@ pub struct Case {
 }
 
 /// The reference cases: [DJ06] skin (`LayeredMedium::skin`, g = 0.9, n = 1.4 in air) for the light
-/// preset at 450/550/650 nm and the dark preset at 450/650 nm, and a homogeneous half-space
-/// (σa 0.01, σs' 1 mm⁻¹, g 0.9, n 1.4), each dermis or half-space [`HALF_SPACE_DEPTH_MM`] deep.
+/// preset at 450/550/650 nm, the dark preset at 450/650 nm and the darkest skins of the parameter box
+/// in the blue ([`DARK_BLUE_CASES`]), and a homogeneous half-space (σa 0.01, σs' 1 mm⁻¹, g 0.9,
+/// n 1.4), each dermis or half-space [`HALF_SPACE_DEPTH_MM`] deep.
 pub fn cases() -> Result<Vec<Case>, McmlError> {
-    let skin = |preset, nm| -> Result<LayeredMedium, McmlError> {
+    let stack = |skin: &SkinParams, nm| -> Result<LayeredMedium, McmlError> {
         let lambda = Wavelength::new(nm).map_err(|e| McmlError::Output(e.to_string()))?;
-        Ok(finite(&LayeredMedium::skin(
-            &SkinParams::preset(preset),
-            lambda,
-            DEFAULT_G,
-        )?)?)
+        Ok(finite(&LayeredMedium::skin(skin, lambda, DEFAULT_G)?)?)
     };
+    let skin = |preset, nm| stack(&SkinParams::preset(preset), nm);
     let half_space = LayeredMedium::new(
         vec![Layer::from_reduced(0.01, 1.0, DEFAULT_G, 1.4, None)?],
         1.0,
@@ -105,6 +103,15 @@ pub fn cases() -> Result<Vec<Case>, McmlError> {
             })
         })
         .collect::<Result<Vec<_>, McmlError>>()?;
+    for c in DARK_BLUE_CASES {
+        let params = SkinParams::new(c.c_m, c.beta_m, c.c_h, 0.25)
+            .map_err(|e| McmlError::Output(e.to_string()))?;
+        cases.push(Case {
+            name: c.name,
+            description: c.description,
+            stack: stack(&params, c.nm)?,
+        });
+    }
     cases.push(Case {
         name: "half-space",
         description: "half-space σa 0.01, σs' 1 mm⁻¹",
@@ -112,6 +119,59 @@ pub fn cases() -> Result<Vec<Case>, McmlError> {
     });
     Ok(cases)
 }
+
+/// A dark skin in the blue of [`DARK_BLUE_CASES`]: default epidermis 0.25 mm, ρ_s 0.25.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DarkBlueCase {
+    /// File stem.
+    pub name: &'static str,
+    /// What it is, for tables.
+    pub description: &'static str,
+    /// Melanin fraction C_m.
+    pub c_m: f64,
+    /// Eumelanin share β_m.
+    pub beta_m: f64,
+    /// Blood fraction C_h.
+    pub c_h: f64,
+    /// Wavelength, nm.
+    pub nm: f64,
+}
+
+/// Dark skins in the blue, where the epidermis absorbs a quarter to half of σs.
+pub const DARK_BLUE_CASES: &[DarkBlueCase] = &[
+    DarkBlueCase {
+        name: "cm50-400",
+        description: "C_m 0.5, β_m 0.9, C_h 0.07, 400 nm",
+        c_m: 0.5,
+        beta_m: 0.9,
+        c_h: 0.07,
+        nm: 400.0,
+    },
+    DarkBlueCase {
+        name: "cm50-450",
+        description: "C_m 0.5, β_m 0.9, C_h 0.07, 450 nm",
+        c_m: 0.5,
+        beta_m: 0.9,
+        c_h: 0.07,
+        nm: 450.0,
+    },
+    DarkBlueCase {
+        name: "cm25-400",
+        description: "C_m 0.25, β_m 0.9, C_h 0.04, 400 nm",
+        c_m: 0.25,
+        beta_m: 0.9,
+        c_h: 0.04,
+        nm: 400.0,
+    },
+    DarkBlueCase {
+        name: "cm25-500",
+        description: "C_m 0.25, β_m 0.9, C_h 0.04, 500 nm",
+        c_m: 0.25,
+        beta_m: 0.9,
+        c_h: 0.04,
+        nm: 500.0,
+    },
+];
 
 /// The case named `name`.
 pub fn case(name: &str) -> Result<Case, McmlError> {

@@ -43,4 +43,5 @@ fn exact_matches_monte_carlo_dark_550_nm() {
 mod profile_shape;
 mod random_skins;
 mod render_table_mcml;
+mod table_mcml_dark;
 mod table_shapes;

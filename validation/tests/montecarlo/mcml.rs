@@ -56,6 +56,10 @@ pub(crate) fn reference(name: &str) -> ReferenceData {
         "dark-450" => include_str!("../../data/mcml/dark-450.csv"),
         "dark-650" => include_str!("../../data/mcml/dark-650.csv"),
         "half-space" => include_str!("../../data/mcml/half-space.csv"),
+        "cm50-400" => include_str!("../../data/mcml/cm50-400.csv"),
+        "cm50-450" => include_str!("../../data/mcml/cm50-450.csv"),
+        "cm25-400" => include_str!("../../data/mcml/cm25-400.csv"),
+        "cm25-500" => include_str!("../../data/mcml/cm25-500.csv"),
         _ => panic!("no MCML data for {name}"),
     };
     ReferenceData::parse(text).unwrap()

@@ -51,30 +51,6 @@ impl LogAxis {
         let (lo, hi) = self.edges(i);
         std::f64::consts::PI * (hi - lo) * (hi + lo)
     }
-
-    /// Mean of e^(−αx) over each bin for x spread evenly in ln x within the bin (3-point
-    /// Gauss–Legendre in ln x). The first bin counts as x = 0 (factor 1): it holds the many exact
-    /// zeros (paths that never reach a depth), and the rest are off by at most αx₀.
-    pub(super) fn mean_exp(&self, alpha: f64) -> Vec<f32> {
-        const NODES: [(f64, f64); 3] = [
-            (-0.774_596_669_241_483_4, 5.0 / 18.0),
-            (0.0, 8.0 / 18.0),
-            (0.774_596_669_241_483_4, 5.0 / 18.0),
-        ];
-        (0..self.bins)
-            .map(|i| {
-                if i == 0 {
-                    return 1.0;
-                }
-                let (lo, _) = self.edges(i);
-                let mid = lo.ln() + 0.5 * self.ln_q;
-                NODES
-                    .iter()
-                    .map(|&(u, w)| w * (-alpha * (mid + 0.5 * self.ln_q * u).exp()).exp())
-                    .sum::<f64>() as f32
-            })
-            .collect()
-    }
 }
 
 #[cfg(test)]
@@ -94,33 +70,5 @@ mod tests {
             );
         }
         assert_eq!(a.bin(2.0e4), None);
-    }
-
-    #[test]
-    fn mean_exp_matches_the_log_uniform_mean() {
-        // ∫ e^(−α e^u) du / ln q over one bin by a 2000-point midpoint rule: the 3-point rule is
-        // exact to 1e-6 relative for α·x up to 10 (the integrand is smooth in u).
-        let a = LogAxis::new(0.01, 1.0e4, 8);
-        for alpha in [1e-3, 0.1, 2.0] {
-            let f = a.mean_exp(alpha);
-            for i in [1, 10, 30, 48] {
-                let (lo, hi) = a.edges(i);
-                let (l0, l1) = (lo.ln(), hi.ln());
-                let m = 2000;
-                let brute: f64 = (0..m)
-                    .map(|k| {
-                        let u = l0 + (k as f64 + 0.5) * (l1 - l0) / m as f64;
-                        (-alpha * u.exp()).exp()
-                    })
-                    .sum::<f64>()
-                    / m as f64;
-                if alpha * hi < 10.0 {
-                    assert!(
-                        (f64::from(f[i]) - brute).abs() <= 1e-6 * brute + 1e-7,
-                        "{alpha} {i}"
-                    );
-                }
-            }
-        }
     }
 }

@@ -10,7 +10,7 @@ use std::sync::{Arc, Mutex, PoisonError};
 static TABLES: Mutex<Vec<Arc<ShapeTable>>> = Mutex::new(Vec::new());
 
 /// First bytes of a table file (format version in the last byte).
-const MAGIC: &[u8; 8] = b"SKINSHT1";
+const MAGIC: &[u8; 8] = b"SKINSHT2";
 
 use skin_io::cache::cache_dir;
 
@@ -55,8 +55,8 @@ pub fn cached_table(
 /// File name: every input of the table, so a change of knob never reads a stale file.
 fn file_name(g: f64, n: f64, o: &ShapeTableOptions) -> String {
     format!(
-        "shape-table-g{g}-n{n}-p{}-d{}-r{}-l{}-s{:x}.bin",
-        o.photons, o.depths_per_octave, o.radial_per_decade, o.path_per_decade, o.seed
+        "shape-table-g{g}-n{n}-p{}-d{}-r{}-a{}-s{:x}.bin",
+        o.photons, o.depths_per_octave, o.radial_per_decade, o.alpha_per_decade, o.seed
     )
 }
 
@@ -65,10 +65,10 @@ fn read(path: &Path, g: f64, n: f64, opts: &ShapeTableOptions) -> Option<ShapeTa
     let bytes = std::fs::read(path).ok()?;
     let mut table = ShapeTable::empty(g, n, *opts);
     let body = bytes.strip_prefix(MAGIC.as_slice())?;
-    if body.len() != 4 * table.counts.len() {
+    if body.len() != 4 * table.log_sums.len() {
         return None;
     }
-    for (c, b) in table.counts.iter_mut().zip(body.chunks_exact(4)) {
+    for (c, b) in table.log_sums.iter_mut().zip(body.chunks_exact(4)) {
         *c = f32::from_le_bytes([b[0], b[1], b[2], b[3]]);
     }
     Some(table)
@@ -76,9 +76,9 @@ fn read(path: &Path, g: f64, n: f64, opts: &ShapeTableOptions) -> Option<ShapeTa
 
 /// Write `table` to `path` whole or not at all ([`skin_io::atomic`]).
 fn write(path: &Path, table: &ShapeTable) -> Result<(), skin_io::atomic::AtomicWriteError> {
-    let mut bytes = Vec::with_capacity(MAGIC.len() + 4 * table.counts.len());
+    let mut bytes = Vec::with_capacity(MAGIC.len() + 4 * table.log_sums.len());
     bytes.extend_from_slice(MAGIC);
-    for c in &table.counts {
+    for c in &table.log_sums {
         bytes.extend_from_slice(&c.to_le_bytes());
     }
     skin_io::atomic::write_bytes(path, &bytes)
@@ -93,13 +93,13 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let opts = ShapeTableOptions::default();
         let mut table = ShapeTable::empty(0.9, 1.4, opts);
-        for (i, c) in table.counts.iter_mut().enumerate() {
+        for (i, c) in table.log_sums.iter_mut().enumerate() {
             *c = i as f32;
         }
         let path = dir.path().join("new").join(file_name(0.9, 1.4, &opts));
         write(&path, &table).unwrap();
         let back = read(&path, 0.9, 1.4, &opts).expect("a complete table");
-        assert_eq!(back.counts, table.counts);
+        assert_eq!(back.log_sums, table.log_sums);
         let files = std::fs::read_dir(path.parent().unwrap()).unwrap().count();
         assert_eq!(files, 1, "only the table itself is left");
     }

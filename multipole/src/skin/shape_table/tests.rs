@@ -82,7 +82,7 @@ fn profile_carries_the_given_total_and_same_bits_on_any_thread_count() {
     let p = t.profile(60.0, 0.5, 0.05, 0.25, 0.3).unwrap().unwrap();
     assert_eq!(p.total(), 0.3);
     assert!((0.999..=1.0).contains(&(p.table_integral() / 0.3 + 1e-12)));
-    // Integer counts: one thread gives the same table as two.
+    // Fixed-point sums: one thread gives the same table as two.
     let opts = ShapeTableOptions {
         photons: 10_000,
         ..ShapeTableOptions::default()
