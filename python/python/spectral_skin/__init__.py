@@ -422,7 +422,7 @@ def fit_colour(
     else:
         t = _real(lab, "lab")
         if t.ndim == 0 or t.shape[-1] != 3:
-            raise SkinError(f"lab: last axis must hold L*, a*, b*, got shape {t.shape}")
+            raise SkinError(f"lab: last axis must hold the 3 values L*, a*, b*, got shape {t.shape}")
         batch = t.shape[:-1]
         target = t.reshape(-1, 3)
     d = _native.fit_colour(target, method, float(step_nm), threads)
