@@ -53,8 +53,8 @@ pub fn xyz<'py>(
     let out: Vec<f64> = py.detach(|| -> Checked<Vec<f64>> {
         let mut out = Vec::with_capacity(r.len() / m.max(1) * 3);
         for row in r.chunks_exact(m) {
-            let s = GridSpectrum::new(grid, row.to_vec())
-                .map_err(|e| Bad::new("reflectance", e))?;
+            let s =
+                GridSpectrum::new(grid, row.to_vec()).map_err(|e| Bad::new("reflectance", e))?;
             out.extend(reflectance_to_xyz(&s).0);
         }
         Ok(out)

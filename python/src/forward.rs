@@ -203,3 +203,60 @@ pub fn monte_carlo<'py>(
     d.set_item("beyond_grid", res.radial.beyond_grid)?;
     Ok(d)
 }
+
+/// Columns of a slab row of [`adding_doubling`].
+const SLAB_COLUMNS: [&str; 7] = [
+    "sigma_a_per_mm",
+    "sigma_s_per_mm",
+    "g",
+    "n",
+    "thickness_mm",
+    "n_above",
+    "n_below",
+];
+
+/// Exact totals ([Prahl95], [vdH80]) of one homogeneous layer per row (σa, σs in mm⁻¹, HG g,
+/// index n, thickness in mm (inf: semi-infinite), indices above and below) for a normally incident
+/// beam: rows of (diffuse reflectance, specular reflectance, transmittance).
+#[pyfunction]
+#[pyo3(signature = (slabs, quadrature_points, threads=None))]
+pub fn adding_doubling<'py>(
+    py: Python<'py>,
+    slabs: In2<'py>,
+    quadrature_points: usize,
+    threads: Option<usize>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    use multipole::Layer;
+    use multipole::exact::adding_doubling::{AddingDoublingOptions, solve};
+    let (rows_, _) = rows(&slabs, Some(SLAB_COLUMNS.len()), "slabs")?;
+    let out = py.detach(|| {
+        on_threads(threads, || {
+            rows_
+                .par_chunks_exact(SLAB_COLUMNS.len())
+                .map(|s| -> Checked<[f64; 3]> {
+                    let [sa, ss, g, n, d, n_above, n_below] =
+                        [s[0], s[1], s[2], s[3], s[4], s[5], s[6]];
+                    let layer = if d == f64::INFINITY {
+                        Layer::semi_infinite(sa, ss, g, n)
+                    } else {
+                        Layer::slab(sa, ss, g, n, d)
+                    }
+                    .map_err(|e| {
+                        Bad::new("sigma_a_per_mm, sigma_s_per_mm, g, n, thickness_mm", e)
+                    })?;
+                    let medium = LayeredMedium::new(vec![layer], n_above, n_below)
+                        .map_err(|e| Bad::new("n_above/n_below", e))?;
+                    let opts = AddingDoublingOptions::new(quadrature_points, g.clamp(0.0, 0.99))
+                        .map_err(|e| Bad::new("quadrature_points", e))?;
+                    let t = solve(&medium, &opts).map_err(|e| Bad::new("slabs", e))?;
+                    Ok([
+                        t.diffuse_reflectance,
+                        t.specular_reflectance,
+                        t.transmittance,
+                    ])
+                })
+                .collect::<Checked<Vec<[f64; 3]>>>()
+        })
+    })??;
+    out2(py, out.concat(), 3)
+}

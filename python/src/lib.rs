@@ -36,6 +36,7 @@ fn native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(forward::diffuse_reflectance, m)?)?;
     m.add_function(wrap_pyfunction!(forward::profile, m)?)?;
     m.add_function(wrap_pyfunction!(forward::monte_carlo, m)?)?;
+    m.add_function(wrap_pyfunction!(forward::adding_doubling, m)?)?;
     m.add_function(wrap_pyfunction!(fit::fit_spectrum, m)?)?;
     m.add_function(wrap_pyfunction!(fit::fit_colour, m)?)?;
     m.add_function(wrap_pyfunction!(colour::xyz, m)?)?;

@@ -83,13 +83,19 @@ def test_sci_adds_a_surface_term_linear_in_oil():
     ],
 )
 def test_profile_matches_skin_profile(cli, method, extra, kwargs):
-    out, _ = cli("profile", *FLAGS, "--lambda", "560", "--method", method, "--samples", "12", *extra)
+    out, _ = cli("profile", *FLAGS, "--lambda", "560", "--method", method, *extra)
     _, rows = _rows(out)
     r_mm, printed = rows[:, 0], rows[:, 1]
     got = ss.profile(r_mm, 560.0, method=method, **kwargs, **SKIN)
-    assert got.shape == r_mm.shape
-    # 7 significant digits printed for r and R(r); R varies at most like r⁻³ near the origin.
-    np.testing.assert_allclose(got, printed, rtol=2e-5, atol=0)
+    assert got.shape == r_mm.shape == (256,)
+    # 7 significant digits printed for r and R(r): R's own rounding, plus the rounding of r times
+    # the steepest neighbouring segment of the piecewise-linear table (the Monte Carlo shape is
+    # jagged, so this term is the larger one there).
+    slope = np.abs(np.diff(printed) / np.diff(r_mm))
+    steepest = np.maximum(np.r_[slope[:1], slope], np.r_[slope, slope[-1:]])
+    tol = 5e-7 * np.abs(printed) + steepest * 5e-7 * r_mm + 1e-12
+    excess = np.abs(got - printed) - tol
+    assert np.all(excess <= 0), f"worst excess {excess.max():.3g} at r = {r_mm[excess.argmax()]}"
 
 
 def _write_spectrum(path, wl, r):
@@ -112,9 +118,12 @@ def test_fit_spectrum_matches_skin_fit(cli, tmp_path):
 
 
 def test_fit_colour_matches_skin_fit(cli):
-    out, _ = cli("fit", "--srgb", "#c08a70", "--method", "multipole", "--json")
+    # A colour inside the multipole model's gamut: a skin's own, rounded to 8-bit sRGB.
+    wl = np.arange(400.0, 701.0, 10.0)
+    hex_ = ss.srgb(ss.lab(wl, ss.diffuse_reflectance(wl, method="multipole", melanin=0.06, hemoglobin=0.02)))
+    out, _ = cli("fit", "--srgb", hex_, "--method", "multipole", "--json")
     ref = json.loads(out)
-    fit = ss.fit_colour("#c08a70", method="multipole")
+    fit = ss.fit_colour(hex_, method="multipole")
     assert float(fit.melanin) == pytest.approx(ref["parameters"]["melanin"], rel=1e-9, abs=1e-12)
     assert float(fit.eumelanin) == pytest.approx(ref["parameters"]["eumelanin_blend"], rel=1e-9, abs=1e-12)
     assert float(fit.hemoglobin) == pytest.approx(ref["parameters"]["hemoglobin"], rel=1e-9, abs=1e-12)
@@ -122,7 +131,7 @@ def test_fit_colour_matches_skin_fit(cli):
     lab = ref["fitted"]["lab"]
     np.testing.assert_allclose(fit.lab, [lab["l"], lab["a"], lab["b"]], rtol=1e-9)
     # The same colour given as CIELAB (the CLI's --lab takes L,a,b).
-    target = ss.lab(srgb="#c08a70")
+    target = ss.lab(srgb=hex_)
     t = ref["target"]["lab"]
     np.testing.assert_allclose(target, [t["l"], t["a"], t["b"]], rtol=1e-12)
 

@@ -87,3 +87,18 @@ def test_exact_is_darker_than_diffusion_for_dark_skin():
     ex = float(ss.diffuse_reflectance(450.0, preset="dark", method="exact"))
     mp = float(ss.diffuse_reflectance(450.0, preset="dark", method="multipole"))
     assert 1.5 < mp / ex < 4.0
+
+
+def test_adding_doubling_limits():
+    # Index-matched, purely absorbing: Beer–Lambert, T = e^{−σa d}, nothing reflected.
+    t = ss.adding_doubling([0.5, 2.0], 0.0, 0.9, 1.0, n=1.0)
+    np.testing.assert_allclose(t.transmittance, np.exp(-np.array([0.5, 2.0])), rtol=1e-9)
+    np.testing.assert_allclose(t.diffuse_reflectance, 0.0, atol=1e-12)
+    # Index 1.4 in air: the specular term is Fresnel's F(0) = ((n − 1)/(n + 1))².
+    slab = ss.adding_doubling(0.1, 1.0, 0.0, 1.0, n=1.4)
+    assert float(slab.specular_reflectance) == pytest.approx((0.4 / 2.4) ** 2, rel=1e-9)
+    # No absorption: all light comes out (R + T = 1); a semi-infinite layer transmits nothing.
+    cons = ss.adding_doubling(0.0, [1.0, 10.0], [0.0, 0.9], 1.0, n=1.4)
+    np.testing.assert_allclose(cons.diffuse_reflectance + cons.specular_reflectance + cons.transmittance, 1.0, atol=1e-6)
+    semi = ss.adding_doubling(0.1, 10.0, 0.9, np.inf)
+    assert float(semi.transmittance) == 0.0 and 0 < float(semi.diffuse_reflectance) < 1

@@ -53,6 +53,9 @@ def monte_carlo(
 ) -> dict[str, Any]:
     """Layered Monte Carlo of one skin: totals with standard errors and R(r)."""
 
+def adding_doubling(slabs: _In, quadrature_points: int, threads: int | None = None) -> _F:
+    """(N, 7) slab rows (σa, σs, g, n, d, n_above, n_below) → (N, 3) diffuse R, specular R, T."""
+
 def fit_spectrum(
     lambda_nm: _In,
     reflectance: _In,
