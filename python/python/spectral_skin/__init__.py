@@ -104,7 +104,7 @@ def _skin(preset: str | None, skin: dict[str, Any]) -> tuple[list[Array], tuple[
         )
     base = _native.preset_row(preset)
     arrays = [
-        _real(skin[k], k) if k in skin else np.float64(base[i]) * np.ones(())
+        _real(skin[k], k) if k in skin else np.asarray(base[i], dtype=np.float64)
         for i, k in enumerate(SKIN_PARAMETERS)
     ]
     try:
@@ -133,8 +133,8 @@ def _points(
                 f"{pshape} plus a trailing wavelength axis"
             ) from None
         params = [np.broadcast_to(np.broadcast_to(a, pshape)[..., None], shape) for a in arrays]
-    rows = np.stack([p.reshape(-1) for p in params], axis=-1) if params else np.empty((0, 10))
-    return np.broadcast_to(lam, shape).reshape(-1), rows.reshape(-1, len(SKIN_PARAMETERS)), shape
+    rows = np.stack([p.reshape(-1) for p in params], axis=-1)
+    return np.broadcast_to(lam, shape).reshape(-1), rows, shape
 
 
 def _one_skin(preset: str | None, skin: dict[str, Any]) -> Array:
