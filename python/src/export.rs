@@ -35,7 +35,7 @@ pub fn export(
         colour_space: colour_space
             .parse::<ColourSpace>()
             .map_err(|e| Bad::new("colour_space", e))?,
-        mcx_lambda_nm,
+        lambda_nm: mcx_lambda_nm,
         ..ExportOptions::default()
     };
     opts.validate().map_err(|e| Bad::new("export options", e))?;

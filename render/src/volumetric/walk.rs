@@ -201,6 +201,12 @@ fn fly<R: RngCore>(
     }
 }
 
+/// Distance along a ray leaving the surface at `p` within which hits are its own triangle's:
+/// a few hundred f32 ulps of the coordinates (the scale of `geometry::offset_origin`).
+fn surface_clearance(p: Vec3) -> f32 {
+    2e-5 * (1.0 + p.abs().max_element())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -216,10 +222,4 @@ mod tests {
         let t = refract(Vec3::new(0.6, 0.0, -0.8), n, 1.4).unwrap();
         assert!((t.x - 0.84).abs() < 1e-6, "{t}");
     }
-}
-
-/// Distance along a ray leaving the surface at `p` within which hits are its own triangle's:
-/// a few hundred f32 ulps of the coordinates (the scale of `geometry::offset_origin`).
-fn surface_clearance(p: Vec3) -> f32 {
-    2e-5 * (1.0 + p.abs().max_element())
 }
