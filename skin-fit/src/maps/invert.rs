@@ -20,11 +20,22 @@ pub const PRIOR_WEIGHT_DE: f64 = 0.01;
 /// Most interpolant evaluations per texel.
 const MAX_EVALS: usize = 12;
 
-/// A slice with its seed grid.
+/// Lower corner of the inverse lookup grid in CIELAB (the seed grid's box).
+const LOOKUP_MIN: [f64; 3] = SEED_MIN;
+/// Inverse-lookup spacing along L*, a*, b* (ΔE76 units).
+const LOOKUP_STEP: [f64; 3] = [1.0, 1.25, 1.25];
+/// Inverse-lookup nodes along L*, a*, b* (covering L* 0–100, a* and b* −30–70).
+const LOOKUP_SHAPE: [usize; 3] = [101, 81, 81];
+/// Nodes of the inverse lookup grid.
+pub const LOOKUP_NODES: usize = LOOKUP_SHAPE[0] * LOOKUP_SHAPE[1] * LOOKUP_SHAPE[2];
+
+/// A slice with its seed grid and, for whole textures, its inverse lookup grid.
 #[derive(Debug, Clone)]
 pub struct Inverter {
     slice: Slice,
     seeds: Vec<[f32; 2]>,
+    /// The full inversion's (u, v) at every node of a grid over CIELAB.
+    lookup: Vec<[f32; 2]>,
 }
 
 /// One texel's result: unit coordinates and the slice's colour there.
@@ -63,7 +74,86 @@ impl Inverter {
                     .map_or([0.5, 0.5], |(_, uv)| uv)
             })
             .collect();
-        Self { slice, seeds }
+        Self {
+            slice,
+            seeds,
+            lookup: Vec::new(),
+        }
+    }
+
+    /// [`Inverter::new`] plus the inverse lookup grid that [`Inverter::invert_fast`] reads: the
+    /// full inversion ([`Inverter::invert`]) at every node ([`LOOKUP_NODES`], on rayon's
+    /// threads).
+    #[must_use]
+    pub fn with_lookup(slice: Slice) -> Self {
+        use rayon::prelude::*;
+        let mut inv = Self::new(slice);
+        let [nl, na, nb] = LOOKUP_SHAPE;
+        inv.lookup = (0..nl * na * nb)
+            .into_par_iter()
+            .with_min_len(1024)
+            .map(|k| {
+                let node = [k % nl, (k / nl) % na, k / (nl * na)];
+                let lab: [f64; 3] =
+                    std::array::from_fn(|c| LOOKUP_MIN[c] + LOOKUP_STEP[c] * node[c] as f64);
+                let r = inv.invert(&lab);
+                [r.u as f32, r.v as f32]
+            })
+            .collect();
+        inv
+    }
+
+    /// The inversion of `target` from the inverse lookup grid (trilinear in CIELAB, clamped to
+    /// the grid's box) and one Gauss–Newton step on the slice, kept only if it lowers the cost.
+    /// Falls back to [`Inverter::invert`] without the grid.
+    #[must_use]
+    pub fn invert_fast(&self, target: &[f64; 3]) -> Inverted {
+        if self.lookup.is_empty() {
+            return self.invert(target);
+        }
+        let [nl, na, _] = LOOKUP_SHAPE;
+        let mut base = [0usize; 3];
+        let mut frac = [0.0f64; 3];
+        for c in 0..3 {
+            let x = ((target[c] - LOOKUP_MIN[c]) / LOOKUP_STEP[c])
+                .clamp(0.0, (LOOKUP_SHAPE[c] - 1) as f64);
+            let i = (x as usize).min(LOOKUP_SHAPE[c] - 2);
+            base[c] = i;
+            frac[c] = x - i as f64;
+        }
+        let (mut u, mut v) = (0.0, 0.0);
+        for corner in 0..8 {
+            let d = [corner & 1, (corner >> 1) & 1, corner >> 2];
+            let w: f64 = (0..3)
+                .map(|c| if d[c] == 1 { frac[c] } else { 1.0 - frac[c] })
+                .product();
+            let node = self.lookup[((base[2] + d[2]) * na + base[1] + d[1]) * nl + base[0] + d[0]];
+            u += w * f64::from(node[0]);
+            v += w * f64::from(node[1]);
+        }
+        let (f, fu, fv) = self.slice.lab_and_gradient(u, v);
+        let r: [f64; 3] = std::array::from_fn(|k| f[k] - target[k]);
+        let a11 = dot(&fu, &fu) + 1e-12;
+        let a12 = dot(&fu, &fv);
+        let a22 = dot(&fv, &fv) + PRIOR_WEIGHT_DE * PRIOR_WEIGHT_DE + 1e-12;
+        let g1 = dot(&fu, &r);
+        let g2 = dot(&fv, &r) + PRIOR_WEIGHT_DE * PRIOR_WEIGHT_DE * (v - 0.5);
+        let det = a11 * a22 - a12 * a12;
+        let cost =
+            |lab: &[f64; 3], v: f64| dist2(lab, target) + (PRIOR_WEIGHT_DE * (v - 0.5)).powi(2);
+        if det > 0.0 {
+            let nu = (u - (a22 * g1 - a12 * g2) / det).clamp(0.0, 1.0);
+            let nv = (v - (a11 * g2 - a12 * g1) / det).clamp(0.0, 1.0);
+            let nf = self.slice.lab(nu, nv);
+            if cost(&nf, nv) < cost(&f, v) {
+                return Inverted {
+                    u: nu,
+                    v: nv,
+                    lab: nf,
+                };
+            }
+        }
+        Inverted { u, v, lab: f }
     }
 
     /// The slice inverted.

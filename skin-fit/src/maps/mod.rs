@@ -32,7 +32,7 @@ mod table;
 mod tests;
 
 pub use edit::{EDIT_SYNTAX, Edit, apply as apply_edits};
-pub use invert::{Inverted, Inverter, PRIOR_WEIGHT_DE};
+pub use invert::{Inverted, Inverter, LOOKUP_NODES, PRIOR_WEIGHT_DE};
 pub use table::{
     ForwardTable, MELANIN_KNEE, STEP_NM, Slice, TableSize, cache_key, hemoglobin_of_v,
     melanin_of_u, u_of_melanin, v_of_hemoglobin,
@@ -98,6 +98,20 @@ pub enum Eumelanin {
     Fit,
 }
 
+/// Whether texels are inverted through the inverse lookup grid ([`Inverter::invert_fast`]) or
+/// each by the full inversion ([`Inverter::invert`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Lookup {
+    /// The grid when there are more fitted texels than it has nodes (it costs one full
+    /// inversion per node to build), else the full inversion.
+    #[default]
+    Auto,
+    /// Always through the grid.
+    Always,
+    /// Always the full inversion.
+    Never,
+}
+
 /// Knobs of [`fit_maps`]. `Default` gives the documented values.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MapsOptions {
@@ -117,6 +131,8 @@ pub struct MapsOptions {
     pub beta_steps: usize,
     /// β_m is allowed where the sample's RMS capped ΔE2000 is within this of the best (default 0.25).
     pub beta_tolerance_de: f64,
+    /// The inverse lookup grid or the full inversion per texel (default [`Lookup::Auto`]).
+    pub lookup: Lookup,
 }
 
 impl Default for MapsOptions {
@@ -130,6 +146,7 @@ impl Default for MapsOptions {
             beta_samples: 4096,
             beta_steps: 21,
             beta_tolerance_de: 0.25,
+            lookup: Lookup::Auto,
         }
     }
 }
@@ -234,6 +251,19 @@ pub struct MapsModel {
     outcome: CacheOutcome,
 }
 
+/// Slots of the per-worker memo of recent texel values.
+const MEMO_SLOTS: usize = 1 << 12;
+
+/// The memo slot of a texel's bits (a multiplicative hash).
+#[inline]
+fn memo_slot(bits: [u32; 3]) -> usize {
+    let h = (u64::from(bits[0])
+        ^ u64::from(bits[1]).rotate_left(21)
+        ^ u64::from(bits[2]).rotate_left(42))
+    .wrapping_mul(0x9E37_79B9_7F4A_7C15);
+    (h >> (64 - MEMO_SLOTS.trailing_zeros())) as usize
+}
+
 /// CIELAB of a linear Rec.709 texel, and whether it had to be replaced (module doc).
 #[inline]
 fn texel_lab(t: [f32; 3]) -> ([f64; 3], bool) {
@@ -327,7 +357,13 @@ impl MapsModel {
             Eumelanin::Fixed(b) => (b, None),
             Eumelanin::Fit => self.fit_eumelanin(texels, &fitted, opts),
         };
-        let inverter = Inverter::new(self.table.slice(beta));
+        let count = fitted.iter().filter(|f| **f).count();
+        let slice = self.table.slice(beta);
+        let inverter = match opts.lookup {
+            Lookup::Always => Inverter::with_lookup(slice),
+            Lookup::Auto if count > LOOKUP_NODES => Inverter::with_lookup(slice),
+            _ => Inverter::new(slice),
+        };
         let n = texels.len();
         let mut melanin = vec![0.0f32; n];
         let mut hemoglobin = vec![0.0f32; n];
@@ -341,18 +377,35 @@ impl MapsModel {
             .zip(texels.par_chunks(CHUNK).zip(fitted.par_chunks(CHUNK)))
             .map(|((((m, h), de), g), (t, f))| {
                 let mut invalid = 0;
+                // Textures decoded from 8- or 16-bit files repeat colours, mostly nearby: a
+                // small direct-mapped memo of exact texel values skips the repeats.
+                let mut memo = vec![None; MEMO_SLOTS];
                 for k in 0..t.len() {
                     if !f[k] {
                         continue;
                     }
-                    let (lab, bad) = texel_lab(t[k]);
+                    let bits = t[k].map(f32::to_bits);
+                    let slot = memo_slot(bits);
+                    let (mk, hk, dk, bad) = match memo[slot] {
+                        Some((b, out)) if b == bits => out,
+                        _ => {
+                            let (lab, bad) = texel_lab(t[k]);
+                            let r = inverter.invert_fast(&lab);
+                            let out = (
+                                melanin_of_u(r.u) as f32,
+                                hemoglobin_of_v(r.v) as f32,
+                                delta_e_2000(lab_of(lab), lab_of(r.lab)) as f32,
+                                bad,
+                            );
+                            memo[slot] = Some((bits, out));
+                            out
+                        }
+                    };
                     invalid += usize::from(bad);
-                    let r = inverter.invert(&lab);
-                    let d = delta_e_2000(lab_of(lab), lab_of(r.lab));
-                    m[k] = melanin_of_u(r.u) as f32;
-                    h[k] = hemoglobin_of_v(r.v) as f32;
-                    de[k] = d as f32;
-                    g[k] = !bad && d <= IN_GAMUT_DE;
+                    m[k] = mk;
+                    h[k] = hk;
+                    de[k] = dk;
+                    g[k] = !bad && f64::from(dk) <= IN_GAMUT_DE;
                 }
                 progress(t.len());
                 invalid
@@ -364,7 +417,6 @@ impl MapsModel {
             .filter(|(_, f)| **f)
             .map(|(d, _)| *d)
             .collect();
-        let count = residuals.len();
         let median = |v: &mut Vec<f32>| -> f32 {
             if v.is_empty() {
                 return 0.0;
