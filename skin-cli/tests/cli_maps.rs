@@ -240,7 +240,7 @@ fn bad_exr_texels_are_flagged() {
     assert!(maps.values().flatten().all(|v| v.is_finite()));
 }
 
-/// A PNG whose header declares `w` × `h` (valid signature, IHDR and CRC; no image data).
+/// A PNG whose header declares `w` × `h` (valid signature, IHDR and CRCs; no image data).
 fn png_header(w: u32, h: u32) -> Vec<u8> {
     fn crc32(bytes: &[u8]) -> u32 {
         let mut c = !0u32;
@@ -264,6 +264,10 @@ fn png_header(w: u32, h: u32) -> Vec<u8> {
     out.extend_from_slice(&13u32.to_be_bytes());
     out.extend_from_slice(&chunk);
     out.extend_from_slice(&crc32(&chunk).to_be_bytes());
+    // An empty IDAT: the decoder reads the header up to the first image data chunk.
+    out.extend_from_slice(&0u32.to_be_bytes());
+    out.extend_from_slice(b"IDAT");
+    out.extend_from_slice(&crc32(b"IDAT").to_be_bytes());
     out
 }
 

@@ -479,11 +479,15 @@ impl MapsModel {
         if chosen.is_empty() {
             return (0.6, None);
         }
-        let stride = chosen.len().div_ceil(opts.beta_samples);
-        let sample: Vec<[f64; 3]> = chosen
-            .iter()
-            .step_by(stride)
-            .map(|&k| texel_lab(texels[k]).0)
+        // Golden-ratio (Weyl) positions spread the sample over the texture without lining up
+        // with its rows, as a plain stride of a multiple of the width would.
+        let count = opts.beta_samples.min(chosen.len());
+        let golden = 0.5 * (5f64.sqrt() - 1.0);
+        let sample: Vec<[f64; 3]> = (0..count)
+            .map(|i| {
+                let at = ((i as f64 * golden).fract() * chosen.len() as f64) as usize;
+                texel_lab(texels[chosen[at.min(chosen.len() - 1)]]).0
+            })
             .collect();
         let steps = opts.beta_steps;
         let betas: Vec<f64> = (0..steps).map(|i| i as f64 / (steps - 1) as f64).collect();

@@ -192,7 +192,7 @@ impl ForwardTable {
     }
 }
 
-/// A (u, v) slice at one β_m: Catmull–Rom bicubic interpolation of CIELAB, with one ghost node
+/// A (u, v) slice at one β_m: Catmull–Rom bicubic interpolation ([CR74]) of CIELAB, with one ghost node
 /// (linear extrapolation) on every side so that a lookup needs no bounds checks.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Slice {
