@@ -90,7 +90,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 .sum::<f64>()
         },
     );
-    timed("PROBE lab only", n, || {
+    timed("texel → CIELAB only", n, || {
         use rayon::prelude::*;
         texels
             .par_iter()
@@ -101,7 +101,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             })
             .sum::<f64>()
     });
-    timed("PROBE lab + invert", n, || {
+    timed("texel → CIELAB → inversion (no ΔE2000)", n, || {
         use rayon::prelude::*;
         texels
             .par_iter()
