@@ -231,8 +231,8 @@ fn non_skin_and_bad_texels_are_flagged_and_finite() {
     };
     let maps = model().fit(&texels, None, &opts, &|_| {}).unwrap();
     assert!(maps.in_gamut[0], "the skin texel: ΔE {}", maps.delta_e[0]);
-    for k in 1..texels.len() {
-        assert!(!maps.in_gamut[k], "texel {k} {:?} in gamut", texels[k]);
+    for (k, t) in texels.iter().enumerate().skip(1) {
+        assert!(!maps.in_gamut[k], "texel {k} {t:?} in gamut");
         assert!(
             maps.delta_e[k].is_finite() && maps.delta_e[k] > 1.0,
             "{k}: {}",
