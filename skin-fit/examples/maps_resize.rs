@@ -1,7 +1,7 @@
 //! Resize an image to SIDE pixels wide (height in proportion; bilinear) and save it as 8-bit PNG:
 //! the 4096 × 4096 head texture that times `skin maps` at production size, and the small copies
 //! of its outputs in docs/images/maps/.
-//! Run: `cargo run --release -p skin-fit --example maps_resize -- IN OUT.png SIDE`.
+//! Run: `cargo run --release -p skin-fit --features studies --example maps_resize -- IN OUT.png SIDE`.
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().collect();

@@ -1,6 +1,6 @@
 //! Build the maps' forward table (no cache) and report its wall and process CPU time, and the
 //! interpolant's error against the exact model between the nodes.
-//! Run: `cargo run --release -p skin-fit --example maps_table`.
+//! Run: `cargo run --release -p skin-fit --features studies --example maps_table`.
 
 use cpu_time::ProcessTime;
 use skin_fit::maps::{ForwardTable, TableSize, u_of_melanin, v_of_hemoglobin};

@@ -2,7 +2,7 @@
 //! inversion of every texel, and the forward albedo, each in wall and process CPU seconds (on a
 //! shared machine CPU time is the steadier figure; texels per CPU-second times the core count is
 //! the rate an idle machine reaches).
-//! Run: `cargo run --release -p skin-fit --example maps_throughput [-- TEXELS]`.
+//! Run: `cargo run --release -p skin-fit --features studies --example maps_throughput [-- TEXELS]`.
 
 use cpu_time::ProcessTime;
 use skin_fit::maps::{
