@@ -5,6 +5,7 @@ pub mod brdf;
 pub mod export;
 pub mod fit;
 mod fit_measured;
+pub mod maps;
 pub mod presets;
 pub mod profile;
 pub mod render;

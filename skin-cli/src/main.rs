@@ -26,6 +26,8 @@ enum Command {
     Fit(cli::fit::FitArgs),
     /// Write the skin for another renderer or simulator (OpenPBR, Unreal, HDRP, pbrt, Mitsuba, MCML, ...).
     Export(cli::export::ExportArgs),
+    /// Chromophore maps (melanin, eumelanin, blood, residual) from an albedo texture, with edits.
+    Maps(cli::maps::MapsArgs),
     /// The named skins (paper, medium, dark, measured group/site and ITA° presets) with colour and ITA°.
     Presets(cli::presets::PresetsArgs),
 }
@@ -44,6 +46,7 @@ fn main() -> ExitCode {
         Command::Fit(a) => cli::fit::run(a),
         Command::Export(a) => cli::export::run(a),
         Command::Presets(a) => cli::presets::run(a),
+        Command::Maps(a) => cli::maps::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -4,6 +4,7 @@ mod bad_scenes;
 mod cli_brdf;
 mod cli_explain;
 mod cli_fit;
+mod cli_maps;
 mod cli_measured;
 mod cli_profile;
 mod cli_render;

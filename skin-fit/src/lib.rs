@@ -6,6 +6,7 @@ mod extended;
 mod forward;
 pub mod geometry;
 mod least_squares;
+pub mod maps;
 mod measured;
 pub mod model;
 mod nelder_mead;

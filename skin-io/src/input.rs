@@ -66,6 +66,13 @@ pub const TEXTURE: InputKind = InputKind {
     extensions: &["jpg", "jpeg", "png"],
     max_bytes: 64 * MIB,
 };
+/// An albedo texture or mask for `skin maps`: sRGB JPEG or PNG (8 or 16 bit) or linear OpenEXR,
+/// at most 256 MiB.
+pub const ALBEDO: InputKind = InputKind {
+    what: "albedo texture",
+    extensions: &["jpg", "jpeg", "png", "exr"],
+    max_bytes: 256 * MIB,
+};
 /// A lat-long OpenEXR environment map, at most 256 MiB.
 pub const ENVIRONMENT: InputKind = InputKind {
     what: "environment map",
@@ -163,7 +170,7 @@ mod tests {
 
     #[test]
     fn dev_zero_is_refused_as_every_kind_of_input() {
-        for kind in [SCENE, MESH, TEXTURE, ENVIRONMENT, SPECTRUM] {
+        for kind in [SCENE, MESH, TEXTURE, ALBEDO, ENVIRONMENT, SPECTRUM] {
             // The extension is checked before anything is opened.
             let e = message(kind.read(Path::new("/dev/zero")));
             assert!(e.contains("expected a ."), "{e}");

@@ -1,0 +1,312 @@
+//! `skin maps`: chromophore maps (C_m, β_m, C_h, the residual ΔE2000 and the in-gamut flag) from
+//! an albedo texture, through [`skin_fit::maps`]; optional edits of the maps; the maps as one
+//! EXR, PNG previews and the albedo the (edited) maps reproduce.
+
+pub mod image_file;
+
+use anyhow::{Context, bail};
+use clap::Args;
+use image_file::{LinearImage, SrgbEncoder};
+use indicatif::{ProgressBar, ProgressStyle};
+use rayon::prelude::*;
+use skin_fit::maps::{Edit, Eumelanin, Maps, MapsModel, MapsOptions, apply_edits};
+use skin_plot::{HeatMap, Panel};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// The channels of `maps.exr`, in the order written (the EXR stores them sorted by name).
+pub const CHANNELS: [&str; 5] = ["melanin", "eumelanin", "hemoglobin", "delta_e", "in_gamut"];
+
+/// Longest side of a preview map, cells (each the mean of a block of texels).
+pub const PREVIEW_CELLS: usize = 256;
+
+/// Arguments of `skin maps`.
+#[derive(Args, Debug, Clone)]
+pub struct MapsArgs {
+    /// The albedo texture: PNG or JPEG (sRGB-encoded, 8 or 16 bit) or OpenEXR (linear). A texel is
+    /// the skin's diffuse albedo: diffuse reflectance with the specular excluded (the SCE of `skin
+    /// fit`) under D65, CIE 1931 2°, as linear Rec.709 with a perfect white diffuser at 1 — the
+    /// colour `skin spectrum` prints.
+    #[arg(long, value_name = "FILE")]
+    pub albedo: PathBuf,
+    /// Texels to fit: an image of the same size, fitted where its luminance is at least 0.5; the
+    /// other texels are copied through to albedo.png and flagged (in_gamut 0).
+    #[arg(long, value_name = "FILE")]
+    pub mask: Option<PathBuf>,
+    /// Folder for maps.exr, albedo.png and the previews (created if missing).
+    #[arg(long, value_name = "DIR", default_value = "out/maps")]
+    pub out: PathBuf,
+    /// Eumelanin blend β_m of the whole texture, [0, 1], instead of fitting it.
+    #[arg(long, value_name = "B", value_parser = crate::args::Checked(crate::args::parse_fraction), conflicts_with = "fit_eumelanin")]
+    pub eumelanin: Option<f64>,
+    /// Fit β_m over the texels (the default), and report the range the data allow.
+    #[arg(long)]
+    pub fit_eumelanin: bool,
+    /// Edit the maps before writing them, in order (repeatable): melanin*S, melanin+D,
+    /// melanin-D (tanning, pallor), hemoglobin*S, hemoglobin+D, hemoglobin-D (flush; under
+    /// --edit-mask if given), eumelanin=B. albedo.png is then the forward model of the edited maps.
+    #[arg(long = "edit", value_name = "OP", value_parser = crate::args::Checked(parse_edit), allow_hyphen_values = true)]
+    pub edits: Vec<Edit>,
+    /// Weight of the hemoglobin edits per texel: an image of the same size whose luminance (0 to 1)
+    /// blends each texel between its fitted and its edited C_h (e.g. a blush).
+    #[arg(long, value_name = "FILE")]
+    pub edit_mask: Option<PathBuf>,
+    /// Build the forward table in memory instead of reading it from (or storing it in) the cache.
+    #[arg(long)]
+    pub no_cache: bool,
+}
+
+/// Parse one `--edit` (clap value parser).
+pub fn parse_edit(s: &str) -> Result<Edit, String> {
+    s.parse()
+        .map_err(|e: skin_fit::maps::MapsError| e.to_string())
+}
+
+/// Luminance (Rec.709 Y) of the sRGB-encoded value of a linear texel, in [0, 1]: how a mask
+/// painted in an image editor reads.
+fn mask_value(t: [f32; 3]) -> f32 {
+    let y = 0.2126 * t[0] + 0.7152 * t[1] + 0.0722 * t[2];
+    if y.is_nan() {
+        return 0.0;
+    }
+    skin_optics::color::srgb_encode(f64::from(y.clamp(0.0, 1.0))) as f32
+}
+
+/// A mask or weight image of the texture's size.
+fn read_same_size(path: &Path, flag: &str, texture: &LinearImage) -> anyhow::Result<Vec<f32>> {
+    let img = image_file::read(path).with_context(|| format!("{flag} {}", path.display()))?;
+    if (img.width, img.height) != (texture.width, texture.height) {
+        bail!(
+            "{flag} {} is {}×{}, the albedo texture {}×{} (they must match)",
+            path.display(),
+            img.width,
+            img.height,
+            texture.width,
+            texture.height
+        );
+    }
+    Ok(img.texels.into_iter().map(mask_value).collect())
+}
+
+/// Run `skin maps`.
+pub fn run(args: &MapsArgs) -> anyhow::Result<()> {
+    let start = Instant::now();
+    let texture = image_file::read(&args.albedo)
+        .with_context(|| format!("--albedo {}", args.albedo.display()))?;
+    let mask: Option<Vec<bool>> = args
+        .mask
+        .as_ref()
+        .map(|p| read_same_size(p, "--mask", &texture))
+        .transpose()?
+        .map(|v| v.into_iter().map(|m| m >= 0.5).collect());
+    let weight = args
+        .edit_mask
+        .as_ref()
+        .map(|p| read_same_size(p, "--edit-mask", &texture))
+        .transpose()?;
+    let read_s = start.elapsed().as_secs_f64();
+
+    let opts = MapsOptions {
+        eumelanin: args.eumelanin.map_or(Eumelanin::Fit, Eumelanin::Fixed),
+        cache_dir: if args.no_cache {
+            None
+        } else {
+            skin_io::cache::cache_dir()
+        },
+        cache_max_bytes: skin_io::cache::max_bytes()?,
+        ..MapsOptions::default()
+    };
+    let t = Instant::now();
+    let model = MapsModel::load(&opts).context("forward table")?;
+    let table_s = t.elapsed().as_secs_f64();
+
+    let t = Instant::now();
+    let n = texture.texels.len();
+    let bar = ProgressBar::new(n as u64);
+    bar.set_style(
+        ProgressStyle::with_template("{elapsed_precise} [{bar:30}] {percent:>3}% {msg}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar())
+            .progress_chars("=> "),
+    );
+    bar.set_message("fitting texels");
+    let mut maps = model.fit(&texture.texels, mask.as_deref(), &opts, &|k| {
+        bar.inc(k as u64);
+    })?;
+    bar.finish_and_clear();
+    let fit_s = t.elapsed().as_secs_f64();
+    let fitted = maps.summary.clone();
+    let beta = maps.eumelanin;
+    apply_edits(&mut maps, &args.edits, weight.as_deref())?;
+
+    let t = Instant::now();
+    let mut albedo = model.albedo(&maps.melanin, maps.eumelanin, &maps.hemoglobin)?;
+    for (a, (t, f)) in albedo
+        .iter_mut()
+        .zip(texture.texels.iter().zip(&maps.fitted))
+    {
+        if !f {
+            *a = *t;
+        }
+    }
+    write_outputs(&args.out, &texture, &maps, &albedo)?;
+    let write_s = t.elapsed().as_secs_f64();
+
+    let s = &fitted;
+    let pct = |k: usize| 100.0 * k as f64 / s.fitted.max(1) as f64;
+    eprintln!(
+        "maps: {}×{} texels, {} fitted, {} in gamut (ΔE2000 ≤ 1: {:.1}%), {} bad values replaced",
+        texture.width,
+        texture.height,
+        s.fitted,
+        s.in_gamut,
+        pct(s.in_gamut),
+        s.invalid
+    );
+    eprintln!(
+        "residual ΔE2000 over fitted texels: median {:.3}, p95 {:.3}, max {:.3}",
+        s.median_de, s.p95_de, s.max_de
+    );
+    match &s.eumelanin_spread {
+        Some(r) => eprintln!(
+            "eumelanin β_m {:.3} (fitted; the texels allow {:.2}-{:.2}: RMS capped ΔE2000 within {} of the best {:.3})",
+            beta, r.min, r.max, r.tolerance_de, r.best_rms_de
+        ),
+        None => eprintln!("eumelanin β_m {beta:.3} (given)"),
+    }
+    if !args.edits.is_empty() {
+        let list: Vec<String> = args.edits.iter().map(ToString::to_string).collect();
+        eprintln!(
+            "edits: {} (albedo.png is the edited maps' forward model)",
+            list.join(", ")
+        );
+    }
+    eprintln!("forward table: {}", model.cache_outcome());
+    eprintln!(
+        "time: read {read_s:.2} s, table {table_s:.2} s, fit {fit_s:.2} s, write {write_s:.2} s, total {:.2} s",
+        start.elapsed().as_secs_f64()
+    );
+    eprintln!(
+        "wrote {}: maps.exr, albedo.png, melanin.png, hemoglobin.png, delta_e.png",
+        args.out.display()
+    );
+    Ok(())
+}
+
+/// Write maps.exr, albedo.png and the previews as one group (all or none).
+fn write_outputs(
+    out: &Path,
+    texture: &LinearImage,
+    maps: &Maps,
+    albedo: &[[f32; 3]],
+) -> anyhow::Result<()> {
+    let (w, h) = (texture.width, texture.height);
+    let n = w * h;
+    let flag: Vec<f32> = maps
+        .in_gamut
+        .iter()
+        .map(|g| f32::from(u8::from(*g)))
+        .collect();
+    let exr = image_file::exr_bytes(
+        w,
+        h,
+        vec![
+            (CHANNELS[0], maps.melanin.clone()),
+            (CHANNELS[1], vec![maps.eumelanin as f32; n]),
+            (CHANNELS[2], maps.hemoglobin.clone()),
+            (CHANNELS[3], maps.delta_e.clone()),
+            (CHANNELS[4], flag),
+        ],
+    )?;
+    let encoder = SrgbEncoder::default();
+    let rgb: Vec<u8> = albedo
+        .par_iter()
+        .with_min_len(1 << 14)
+        .flat_map_iter(|t| t.map(|c| encoder.encode(c)))
+        .collect();
+    let albedo_png = image_file::png_bytes(w, h, &rgb)?;
+    let preview = |values: &[f32], title: &str, label: &str, range: Option<(f64, f64)>| {
+        preview_png(w, h, values, &maps.fitted, title, label, range)
+    };
+    // Both fractions span decades: their previews show log₁₀ (C_m 0 shows as −4).
+    let log = |v: &[f32]| -> Vec<f32> { v.iter().map(|x| x.max(1e-4).log10()).collect() };
+    let melanin = preview(
+        &log(&maps.melanin),
+        "Melanin: log₁₀ C_m",
+        "log₁₀ C_m (volume fraction)",
+        None,
+    )?;
+    let hemoglobin = preview(
+        &log(&maps.hemoglobin),
+        "Hemoglobin: log₁₀ C_h",
+        "log₁₀ C_h (volume fraction)",
+        None,
+    )?;
+    let delta_e = preview(
+        &maps.delta_e,
+        "Residual ΔE2000 (grey: not fitted)",
+        "ΔE2000",
+        Some((0.0, 5.0)),
+    )?;
+    let staged = [
+        ("maps.exr", exr),
+        ("albedo.png", albedo_png),
+        ("melanin.png", melanin),
+        ("hemoglobin.png", hemoglobin),
+        ("delta_e.png", delta_e),
+    ]
+    .into_iter()
+    .map(|(name, bytes)| skin_io::atomic::stage_bytes(&out.join(name), &bytes))
+    .collect::<Result<Vec<_>, _>>()?;
+    skin_io::atomic::commit(staged)?;
+    Ok(())
+}
+
+/// A heat map of `values` (block means over fitted texels, grey where a block has none) with a
+/// colour bar, as PNG bytes.
+fn preview_png(
+    w: usize,
+    h: usize,
+    values: &[f32],
+    fitted: &[bool],
+    title: &str,
+    label: &str,
+    range: Option<(f64, f64)>,
+) -> anyhow::Result<Vec<u8>> {
+    let block = w.max(h).div_ceil(PREVIEW_CELLS).max(1);
+    let (nx, ny) = (w.div_ceil(block), h.div_ceil(block));
+    let mut cells = vec![f64::NAN; nx * ny];
+    for cy in 0..ny {
+        for cx in 0..nx {
+            let (mut sum, mut count) = (0.0, 0usize);
+            for y in cy * block..((cy + 1) * block).min(h) {
+                for x in cx * block..((cx + 1) * block).min(w) {
+                    if fitted[y * w + x] {
+                        sum += f64::from(values[y * w + x]);
+                        count += 1;
+                    }
+                }
+            }
+            // Row 0 of a heat map is at the bottom; image rows run top down.
+            if count > 0 {
+                cells[(ny - 1 - cy) * nx + cx] = sum / count as f64;
+            }
+        }
+    }
+    let heat = HeatMap {
+        title: title.into(),
+        x_label: "x (texels)".into(),
+        y_label: "y (texels from the bottom)".into(),
+        value_label: label.into(),
+        x_range: (0.0, w as f64),
+        y_range: (0.0, h as f64),
+        nx,
+        ny,
+        values: cells,
+        value_range: range,
+        ..HeatMap::default()
+    };
+    let width = 760u32;
+    let height = ((f64::from(width - 110) * h as f64 / w as f64) as u32 + 110).clamp(200, 1400);
+    let rgb = skin_plot::render_rgb(&[Panel::Heat(heat)], width, height)?;
+    image_file::png_bytes(width as usize, height as usize, &rgb)
+}

@@ -1,0 +1,587 @@
+//! Chromophore maps from an albedo texture: every texel's melanin C_m and blood C_h (with one
+//! eumelanin blend β_m for the texture), the residual ΔE2000 and whether the model reaches the
+//! texel (docs/physics.md §18).
+//!
+//! **Texels.** A texel is the skin's diffuse albedo: the model's diffuse reflectance (specular
+//! excluded, the SCE of `skin fit`) under D65 with the CIE 1931 2° observer, as linear Rec.709
+//! (sRGB primaries) with a perfect white diffuser at 1 — the colour `skin spectrum` prints,
+//! through the same path ([`crate::ColourModel`], 400–700 nm every 10 nm).
+//!
+//! **Inversion.** A [`ForwardTable`] holds the exact model's CIELAB colour on a grid over
+//! (C_m, β_m, C_h), built once and kept in the disk cache ([`skin_io::cache`]). For the texture's
+//! β_m its slice is interpolated (cubic along β_m), and each texel is inverted on the slice's
+//! bicubic interpolant: a seed from a grid over CIELAB, then damped Gauss–Newton steps minimising
+//! the CIELAB distance (ΔE76) plus the tiny C_h prior of `skin fit` ([`PRIOR_WEIGHT_DE`]).
+//! The reported residual is ΔE2000 between the texel and the fitted skin on the interpolant;
+//! a texel is in gamut when it is at most [`IN_GAMUT_DE`].
+//!
+//! **β_m.** Three colour numbers per texel cannot pin three parameters well, so β_m is one value
+//! per texture: given ([`Eumelanin::Fixed`]) or fitted ([`Eumelanin::Fit`]) as the β_m whose slice
+//! passes closest to a sample of the texels (RMS of ΔE2000 capped at [`BETA_CAP_DE`], so hair and
+//! other non-skin texels weigh no more than a poor skin fit). [`EumelaninSpread`] reports the β_m
+//! range the data allow.
+//!
+//! **Bad texels.** A non-finite, negative or huge component ([`MAX_TEXEL`]) is replaced (NaN by 0,
+//! then clamped to [0, `MAX_TEXEL`]), fitted like any other and flagged out of gamut. Texels
+//! outside the mask are not fitted: they get the median of the fitted maps, ΔE 0 and the flag 0.
+
+mod edit;
+mod invert;
+mod table;
+#[cfg(test)]
+mod tests;
+
+pub use edit::{EDIT_SYNTAX, Edit, apply as apply_edits};
+pub use invert::{Inverted, Inverter, LOOKUP_NODES, PRIOR_WEIGHT_DE};
+pub use table::{
+    ForwardTable, MELANIN_KNEE, STEP_NM, Slice, TableSize, cache_key, hemoglobin_of_v,
+    melanin_of_u, u_of_melanin, v_of_hemoglobin,
+};
+
+use crate::FitError;
+use rayon::prelude::*;
+use skin_io::cache::CacheOutcome;
+use skin_optics::SkinParams;
+use skin_optics::color::LinearSrgb;
+use skin_optics::lab::{Lab, delta_e_2000};
+use std::path::PathBuf;
+
+/// A texel is in gamut when the fitted skin reproduces it within this ΔE2000.
+pub const IN_GAMUT_DE: f64 = 1.0;
+/// Largest texel component accepted as is (linear albedo; a white diffuser is 1).
+pub const MAX_TEXEL: f32 = 16.0;
+/// ΔE2000 cap of one texel's contribution to the β_m objective.
+pub const BETA_CAP_DE: f64 = 3.0;
+/// Texels handed to one worker at a time (and the granularity of progress reports).
+const CHUNK: usize = 1 << 14;
+
+/// Why maps could not be made or edited.
+#[derive(Debug, thiserror::Error)]
+pub enum MapsError {
+    /// An option or edit value outside its range.
+    #[error("maps option {name} = {} outside {range}", skin_optics::echo::Num(*.value))]
+    Option {
+        /// The option.
+        name: &'static str,
+        /// The value given.
+        value: f64,
+        /// Its valid range.
+        range: &'static str,
+    },
+    /// A per-texel input whose length is not the texture's.
+    #[error("{what} has {found} values for {expected} texels")]
+    Length {
+        /// Which input.
+        what: &'static str,
+        /// Values given.
+        found: usize,
+        /// Texels in the texture.
+        expected: usize,
+    },
+    /// An edit that does not parse.
+    #[error("edit '{text}' is not one of {EDIT_SYNTAX}")]
+    Edit {
+        /// The text given.
+        text: String,
+    },
+    /// The forward table could not be built.
+    #[error("forward table: {0}")]
+    Model(#[from] FitError),
+}
+
+/// How the texture's eumelanin blend β_m is chosen.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Eumelanin {
+    /// This β_m, in [0, 1].
+    Fixed(f64),
+    /// Fitted over the texels (module doc).
+    Fit,
+}
+
+/// Whether texels are inverted through the inverse lookup grid ([`Inverter::invert_fast`]) or
+/// each by the full inversion ([`Inverter::invert`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Lookup {
+    /// The grid when there are more fitted texels than it has nodes (it costs one full
+    /// inversion per node to build), else the full inversion.
+    #[default]
+    Auto,
+    /// Always through the grid.
+    Always,
+    /// Always the full inversion.
+    Never,
+}
+
+/// Knobs of [`fit_maps`]. `Default` gives the documented values.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MapsOptions {
+    /// β_m given or fitted (default fitted).
+    pub eumelanin: Eumelanin,
+    /// Nodes of the forward table (default 24 × 11 × 16).
+    pub table: TableSize,
+    /// Skin supplying everything not mapped (ρ_s, γ, thicknesses, η): default `skin fit`'s.
+    pub base: SkinParams,
+    /// Folder of the table cache; `None` builds the table in memory.
+    pub cache_dir: Option<PathBuf>,
+    /// Size limit of the cache folder, bytes ([`skin_io::cache::DEFAULT_MAX_BYTES`]).
+    pub cache_max_bytes: u64,
+    /// Texels sampled (evenly over the fitted ones) for the β_m fit, in [1, 10⁶] (default 4096).
+    pub beta_samples: usize,
+    /// β_m candidates evenly over [0, 1] in the fit, in [3, 101] (default 21: steps of 0.05).
+    pub beta_steps: usize,
+    /// β_m is allowed where the sample's RMS capped ΔE2000 is within this of the best (default 0.25).
+    pub beta_tolerance_de: f64,
+    /// The inverse lookup grid or the full inversion per texel (default [`Lookup::Auto`]).
+    pub lookup: Lookup,
+}
+
+impl Default for MapsOptions {
+    fn default() -> Self {
+        Self {
+            eumelanin: Eumelanin::Fit,
+            table: TableSize::default(),
+            base: crate::FitOptions::default().base,
+            cache_dir: None,
+            cache_max_bytes: skin_io::cache::DEFAULT_MAX_BYTES,
+            beta_samples: 4096,
+            beta_steps: 21,
+            beta_tolerance_de: 0.25,
+            lookup: Lookup::Auto,
+        }
+    }
+}
+
+impl MapsOptions {
+    /// Check every knob against its range.
+    pub fn validate(&self) -> Result<(), MapsError> {
+        let check = |name, value: f64, ok: bool, range| {
+            if ok && value.is_finite() {
+                Ok(())
+            } else {
+                Err(MapsError::Option { name, value, range })
+            }
+        };
+        if let Eumelanin::Fixed(b) = self.eumelanin {
+            check("eumelanin", b, (0.0..=1.0).contains(&b), "[0, 1]")?;
+        }
+        for (name, n) in [
+            ("table.melanin", self.table.melanin),
+            ("table.eumelanin", self.table.eumelanin),
+            ("table.hemoglobin", self.table.hemoglobin),
+        ] {
+            check(name, n as f64, (4..=256).contains(&n), "[4, 256] nodes")?;
+        }
+        check(
+            "beta_samples",
+            self.beta_samples as f64,
+            (1..=1_000_000).contains(&self.beta_samples),
+            "[1, 1000000]",
+        )?;
+        check(
+            "beta_steps",
+            self.beta_steps as f64,
+            (3..=101).contains(&self.beta_steps),
+            "[3, 101]",
+        )?;
+        check(
+            "beta_tolerance_de",
+            self.beta_tolerance_de,
+            self.beta_tolerance_de >= 0.0,
+            "[0, ∞)",
+        )
+    }
+}
+
+/// The β_m range the texels allow: the connected candidates around the fit whose RMS capped
+/// ΔE2000 stays within `tolerance_de` of the best.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EumelaninSpread {
+    /// Lowest allowed β_m.
+    pub min: f64,
+    /// Highest allowed β_m.
+    pub max: f64,
+    /// The tolerance, ΔE2000.
+    pub tolerance_de: f64,
+    /// RMS capped ΔE2000 of the sample at the fitted β_m.
+    pub best_rms_de: f64,
+}
+
+/// What a fit did, for the summary line.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MapsSummary {
+    /// Texels fitted (inside the mask).
+    pub fitted: usize,
+    /// Fitted texels in gamut (ΔE2000 ≤ [`IN_GAMUT_DE`]).
+    pub in_gamut: usize,
+    /// Texels whose value was replaced (non-finite, negative or above [`MAX_TEXEL`]).
+    pub invalid: usize,
+    /// Median ΔE2000 over the fitted texels (0 when none).
+    pub median_de: f64,
+    /// 95th percentile ΔE2000 over the fitted texels.
+    pub p95_de: f64,
+    /// Largest ΔE2000 over the fitted texels.
+    pub max_de: f64,
+    /// The β_m range the data allow (`None` when β_m was given or nothing was fitted).
+    pub eumelanin_spread: Option<EumelaninSpread>,
+}
+
+/// The maps of a texture, one value per texel (row-major, as the texels given).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Maps {
+    /// Melanin volume fraction C_m, [0, 0.5].
+    pub melanin: Vec<f32>,
+    /// Hemoglobin volume fraction C_h, [0.001, 0.1].
+    pub hemoglobin: Vec<f32>,
+    /// Eumelanin blend β_m of the whole texture, [0, 1].
+    pub eumelanin: f64,
+    /// ΔE2000 between the texel and the fitted skin (0 outside the mask).
+    pub delta_e: Vec<f32>,
+    /// Whether the texel was fitted and reproduced within [`IN_GAMUT_DE`].
+    pub in_gamut: Vec<bool>,
+    /// Whether the texel was fitted (inside the mask).
+    pub fitted: Vec<bool>,
+    /// Counts and residual statistics.
+    pub summary: MapsSummary,
+}
+
+/// The forward table, loaded or built: fits texels and turns maps back into albedo.
+#[derive(Debug, Clone)]
+pub struct MapsModel {
+    table: ForwardTable,
+    outcome: CacheOutcome,
+}
+
+/// Slots of the per-worker memo of recent texel values.
+const MEMO_SLOTS: usize = 1 << 12;
+
+/// The memo slot of a texel's bits (a multiplicative hash).
+#[inline]
+fn memo_slot(bits: [u32; 3]) -> usize {
+    let h = (u64::from(bits[0])
+        ^ u64::from(bits[1]).rotate_left(21)
+        ^ u64::from(bits[2]).rotate_left(42))
+    .wrapping_mul(0x9E37_79B9_7F4A_7C15);
+    (h >> (64 - MEMO_SLOTS.trailing_zeros())) as usize
+}
+
+/// CIELAB of a linear Rec.709 texel, and whether it had to be replaced (module doc).
+#[inline]
+fn texel_lab(t: [f32; 3]) -> ([f64; 3], bool) {
+    let bad = t
+        .iter()
+        .any(|c| !(c.is_finite() && (0.0..=MAX_TEXEL).contains(c)));
+    let rgb = t.map(|c| {
+        if c.is_nan() {
+            0.0
+        } else {
+            f64::from(c.clamp(0.0, MAX_TEXEL))
+        }
+    });
+    let lab = Lab::from_xyz(LinearSrgb(rgb).to_xyz());
+    ([lab.l, lab.a, lab.b], bad)
+}
+
+#[inline]
+fn lab_of(x: [f64; 3]) -> Lab {
+    Lab {
+        l: x[0],
+        a: x[1],
+        b: x[2],
+    }
+}
+
+impl MapsModel {
+    /// The table of `opts` from the cache, or built (about 5000 exact colours) and stored.
+    pub fn load(opts: &MapsOptions) -> Result<Self, MapsError> {
+        opts.validate()?;
+        let key = cache_key(opts.table, &opts.base);
+        let build = || ForwardTable::build(opts.table, opts.base);
+        let (table, outcome) = skin_io::cache::load_or_build(
+            opts.cache_dir.as_deref(),
+            opts.cache_max_bytes,
+            &key,
+            build,
+        )?;
+        if table.is_whole() && table.size() == opts.table {
+            return Ok(Self { table, outcome });
+        }
+        // A readable entry of the wrong shape: rebuilt, not trusted.
+        Ok(Self {
+            table: build()?,
+            outcome: CacheOutcome::Off,
+        })
+    }
+
+    /// A model around a table already built.
+    #[must_use]
+    pub fn from_table(table: ForwardTable) -> Self {
+        Self {
+            table,
+            outcome: CacheOutcome::Off,
+        }
+    }
+
+    /// What the cache did for the table.
+    #[must_use]
+    pub fn cache_outcome(&self) -> &CacheOutcome {
+        &self.outcome
+    }
+
+    /// The forward table.
+    #[must_use]
+    pub fn table(&self) -> &ForwardTable {
+        &self.table
+    }
+
+    /// Fit the maps of `texels` (linear Rec.709 diffuse albedo), only where `mask` is true if
+    /// given. `progress` is called from worker threads with the number of texels just finished.
+    pub fn fit(
+        &self,
+        texels: &[[f32; 3]],
+        mask: Option<&[bool]>,
+        opts: &MapsOptions,
+        progress: &(dyn Fn(usize) + Sync),
+    ) -> Result<Maps, MapsError> {
+        opts.validate()?;
+        if let Some(m) = mask
+            && m.len() != texels.len()
+        {
+            return Err(MapsError::Length {
+                what: "mask",
+                found: m.len(),
+                expected: texels.len(),
+            });
+        }
+        let fitted: Vec<bool> = mask.map_or_else(|| vec![true; texels.len()], <[bool]>::to_vec);
+        let (beta, spread) = match opts.eumelanin {
+            Eumelanin::Fixed(b) => (b, None),
+            Eumelanin::Fit => self.fit_eumelanin(texels, &fitted, opts),
+        };
+        let count = fitted.iter().filter(|f| **f).count();
+        let slice = self.table.slice(beta);
+        let inverter = match opts.lookup {
+            Lookup::Always => Inverter::with_lookup(slice),
+            Lookup::Auto if count > LOOKUP_NODES => Inverter::with_lookup(slice),
+            _ => Inverter::new(slice),
+        };
+        let n = texels.len();
+        let mut melanin = vec![0.0f32; n];
+        let mut hemoglobin = vec![0.0f32; n];
+        let mut delta_e = vec![0.0f32; n];
+        let mut in_gamut = vec![false; n];
+        let invalid = melanin
+            .par_chunks_mut(CHUNK)
+            .zip(hemoglobin.par_chunks_mut(CHUNK))
+            .zip(delta_e.par_chunks_mut(CHUNK))
+            .zip(in_gamut.par_chunks_mut(CHUNK))
+            .zip(texels.par_chunks(CHUNK).zip(fitted.par_chunks(CHUNK)))
+            .map(|((((m, h), de), g), (t, f))| {
+                let mut invalid = 0;
+                // Textures decoded from 8- or 16-bit files repeat colours, mostly nearby: a
+                // small direct-mapped memo of exact texel values skips the repeats.
+                let mut memo = vec![None; MEMO_SLOTS];
+                for k in 0..t.len() {
+                    if !f[k] {
+                        continue;
+                    }
+                    let bits = t[k].map(f32::to_bits);
+                    let slot = memo_slot(bits);
+                    let (mk, hk, dk, bad) = match memo[slot] {
+                        Some((b, out)) if b == bits => out,
+                        _ => {
+                            let (lab, bad) = texel_lab(t[k]);
+                            let r = inverter.invert_fast(&lab);
+                            let out = (
+                                melanin_of_u(r.u) as f32,
+                                hemoglobin_of_v(r.v) as f32,
+                                delta_e_2000(lab_of(lab), lab_of(r.lab)) as f32,
+                                bad,
+                            );
+                            memo[slot] = Some((bits, out));
+                            out
+                        }
+                    };
+                    invalid += usize::from(bad);
+                    m[k] = mk;
+                    h[k] = hk;
+                    de[k] = dk;
+                    g[k] = !bad && f64::from(dk) <= IN_GAMUT_DE;
+                }
+                progress(t.len());
+                invalid
+            })
+            .sum();
+        let mut residuals: Vec<f32> = delta_e
+            .iter()
+            .zip(&fitted)
+            .filter(|(_, f)| **f)
+            .map(|(d, _)| *d)
+            .collect();
+        let median = |v: &mut Vec<f32>| -> f32 {
+            if v.is_empty() {
+                return 0.0;
+            }
+            let mid = v.len() / 2;
+            *v.select_nth_unstable_by(mid, f32::total_cmp).1
+        };
+        let (fill_m, fill_h) = {
+            let pick = |x: &[f32]| -> Vec<f32> {
+                x.iter()
+                    .zip(&fitted)
+                    .filter(|(_, f)| **f)
+                    .map(|(v, _)| *v)
+                    .collect()
+            };
+            let m = median(&mut pick(&melanin));
+            let h = median(&mut pick(&hemoglobin));
+            if count == 0 { (0.0, 0.01) } else { (m, h) }
+        };
+        for k in (0..n).filter(|&k| !fitted[k]) {
+            melanin[k] = fill_m;
+            hemoglobin[k] = fill_h;
+        }
+        let quantile = |v: &mut Vec<f32>, q: f64| -> f64 {
+            if v.is_empty() {
+                return 0.0;
+            }
+            let i = ((q * (v.len() - 1) as f64).round() as usize).min(v.len() - 1);
+            f64::from(*v.select_nth_unstable_by(i, f32::total_cmp).1)
+        };
+        let summary = MapsSummary {
+            fitted: count,
+            in_gamut: in_gamut.iter().filter(|g| **g).count(),
+            invalid,
+            median_de: quantile(&mut residuals, 0.5),
+            p95_de: quantile(&mut residuals, 0.95),
+            max_de: residuals.iter().copied().fold(0.0f32, f32::max).into(),
+            eumelanin_spread: spread,
+        };
+        Ok(Maps {
+            melanin,
+            hemoglobin,
+            eumelanin: beta,
+            delta_e,
+            in_gamut,
+            fitted,
+            summary,
+        })
+    }
+
+    /// β_m fitted over a sample of the fitted texels, and its spread (module doc); β_m 0.6 (the
+    /// medium preset's, the prior of `skin fit`) when nothing is fitted.
+    fn fit_eumelanin(
+        &self,
+        texels: &[[f32; 3]],
+        fitted: &[bool],
+        opts: &MapsOptions,
+    ) -> (f64, Option<EumelaninSpread>) {
+        let chosen: Vec<usize> = (0..texels.len()).filter(|&k| fitted[k]).collect();
+        if chosen.is_empty() {
+            return (0.6, None);
+        }
+        // Golden-ratio (Weyl) positions spread the sample over the texture without lining up
+        // with its rows, as a plain stride of a multiple of the width would.
+        let count = opts.beta_samples.min(chosen.len());
+        let golden = 0.5 * (5f64.sqrt() - 1.0);
+        let sample: Vec<[f64; 3]> = (0..count)
+            .map(|i| {
+                let at = ((i as f64 * golden).fract() * chosen.len() as f64) as usize;
+                texel_lab(texels[chosen[at.min(chosen.len() - 1)]]).0
+            })
+            .collect();
+        let steps = opts.beta_steps;
+        let betas: Vec<f64> = (0..steps).map(|i| i as f64 / (steps - 1) as f64).collect();
+        let objective = |beta: f64| -> f64 {
+            let inv = Inverter::new(self.table.slice(beta));
+            let sum: f64 = sample
+                .iter()
+                .map(|lab| {
+                    let r = inv.invert(lab);
+                    delta_e_2000(lab_of(*lab), lab_of(r.lab))
+                        .min(BETA_CAP_DE)
+                        .powi(2)
+                })
+                .sum();
+            (sum / sample.len() as f64).sqrt()
+        };
+        let rms: Vec<f64> = betas.par_iter().map(|&b| objective(b)).collect();
+        let best = (0..steps)
+            .min_by(|&a, &b| rms[a].total_cmp(&rms[b]))
+            .unwrap_or(0);
+        // A parabola through the best candidate and its neighbours places β_m between candidates.
+        let beta = if best > 0 && best + 1 < steps {
+            let (a, b, c) = (rms[best - 1], rms[best], rms[best + 1]);
+            let curvature = a - 2.0 * b + c;
+            let shift = if curvature > 0.0 {
+                (0.5 * (a - c) / curvature).clamp(-0.5, 0.5)
+            } else {
+                0.0
+            };
+            betas[best] + shift * (betas[1] - betas[0])
+        } else {
+            betas[best]
+        };
+        let limit = rms[best] + opts.beta_tolerance_de;
+        let mut lo = best;
+        while lo > 0 && rms[lo - 1] <= limit {
+            lo -= 1;
+        }
+        let mut hi = best;
+        while hi + 1 < steps && rms[hi + 1] <= limit {
+            hi += 1;
+        }
+        (
+            beta,
+            Some(EumelaninSpread {
+                min: betas[lo].min(beta),
+                max: betas[hi].max(beta),
+                tolerance_de: opts.beta_tolerance_de,
+                best_rms_de: rms[best],
+            }),
+        )
+    }
+
+    /// The linear Rec.709 diffuse albedo of the skins C_m = `melanin`, C_h = `hemoglobin`
+    /// (per texel) and β_m = `eumelanin`, on the table's interpolant.
+    pub fn albedo(
+        &self,
+        melanin: &[f32],
+        eumelanin: f64,
+        hemoglobin: &[f32],
+    ) -> Result<Vec<[f32; 3]>, MapsError> {
+        if hemoglobin.len() != melanin.len() {
+            return Err(MapsError::Length {
+                what: "hemoglobin map",
+                found: hemoglobin.len(),
+                expected: melanin.len(),
+            });
+        }
+        if !(0.0..=1.0).contains(&eumelanin) {
+            return Err(MapsError::Option {
+                name: "eumelanin",
+                value: eumelanin,
+                range: "[0, 1]",
+            });
+        }
+        let slice = self.table.slice(eumelanin);
+        Ok(melanin
+            .par_iter()
+            .zip(hemoglobin.par_iter())
+            .with_min_len(CHUNK)
+            .map(|(&m, &h)| {
+                let lab = slice.lab(u_of_melanin(f64::from(m)), v_of_hemoglobin(f64::from(h)));
+                lab_of(lab).to_xyz().to_linear_srgb().0.map(|c| c as f32)
+            })
+            .collect())
+    }
+}
+
+/// Fit maps to `texels` in one call: [`MapsModel::load`] then [`MapsModel::fit`].
+pub fn fit_maps(
+    texels: &[[f32; 3]],
+    mask: Option<&[bool]>,
+    opts: &MapsOptions,
+    progress: &(dyn Fn(usize) + Sync),
+) -> Result<Maps, MapsError> {
+    MapsModel::load(opts)?.fit(texels, mask, opts, progress)
+}

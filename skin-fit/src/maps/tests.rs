@@ -1,0 +1,417 @@
+//! The maps against the exact forward model: nodes, the interpolant between them, round trips on
+//! synthetic textures with known maps, out-of-gamut and bad texels, edits and the cache.
+
+use super::*;
+use crate::ColourModel;
+use multipole::Method;
+use std::sync::OnceLock;
+
+/// The default table, built once for all tests here (about 4 CPU-s in release).
+fn model() -> &'static MapsModel {
+    static M: OnceLock<MapsModel> = OnceLock::new();
+    M.get_or_init(|| MapsModel::load(&MapsOptions::default()).expect("table builds"))
+}
+
+/// The exact model behind the table, uncached and without the layer cache: the reference.
+fn exact() -> ColourModel {
+    ColourModel::new(STEP_NM, Method::Exact, MapsOptions::default().base).expect("model")
+}
+
+fn lab(x: [f64; 3]) -> Lab {
+    Lab {
+        l: x[0],
+        a: x[1],
+        b: x[2],
+    }
+}
+
+/// Linear Rec.709 of the exact model's skin (C_m, β_m, C_h), as `skin spectrum` computes it.
+fn exact_texel(m: &ColourModel, p: [f64; 3]) -> [f32; 3] {
+    let skin = m.skin(p[0], p[1], p[2]).expect("valid skin");
+    m.xyz(&skin)
+        .expect("colour")
+        .to_linear_srgb()
+        .0
+        .map(|c| c as f32)
+}
+
+fn texel_to_lab(t: [f32; 3]) -> Lab {
+    lab(texel_lab(t).0)
+}
+
+/// A smooth synthetic texture: C_m 0.005–0.4 along x, C_h 0.005–0.08 along y (both geometric,
+/// with a gentle cross term), one β_m.
+fn synthetic(n: usize, beta: f64) -> Vec<[f64; 3]> {
+    (0..n * n)
+        .map(|k| {
+            let (x, y) = (
+                (k % n) as f64 / (n - 1) as f64,
+                (k / n) as f64 / (n - 1) as f64,
+            );
+            let c_m = 0.005 * (0.4f64 / 0.005).powf(x);
+            let c_h = 0.005 * (0.08f64 / 0.005).powf((y + 0.1 * x * (1.0 - y)).min(1.0));
+            [c_m, beta, c_h]
+        })
+        .collect()
+}
+
+fn quantile(mut v: Vec<f64>, q: f64) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[((q * (v.len() - 1) as f64).round() as usize).min(v.len() - 1)]
+}
+
+/// A parameter is identifiable at a texel when a 3 % change of it moves the exact colour by at
+/// least this ΔE2000: the interpolant's 95th-percentile error against the exact model
+/// (`examples/maps_table.rs`), so that the table cannot trade one for the other.
+const IDENTIFIABLE_DE: f64 = 0.05;
+
+#[test]
+fn nodes_are_the_exact_model() {
+    let t = model().table();
+    let s = t.size();
+    let m = exact();
+    for (i, b, j) in [
+        (0, 0, 0),
+        (5, 6, 9),
+        (s.melanin - 1, s.eumelanin - 1, s.hemoglobin - 1),
+    ] {
+        let u = i as f64 / (s.melanin - 1) as f64;
+        let beta = b as f64 / (s.eumelanin - 1) as f64;
+        let v = j as f64 / (s.hemoglobin - 1) as f64;
+        let want = m
+            .lab(&m.skin(melanin_of_u(u), beta, hemoglobin_of_v(v)).unwrap())
+            .unwrap();
+        let got = t.slice(beta).lab(u, v);
+        for (g, w) in got.iter().zip([want.l, want.a, want.b]) {
+            assert!(
+                (g - w).abs() < 1e-9,
+                "node ({i},{b},{j}): {got:?} vs {want:?}"
+            );
+        }
+    }
+}
+
+/// Between the nodes the interpolant stays within 0.15 ΔE2000 of the exact model (measured worst
+/// 0.09 over 245 skins by `examples/maps_table.rs`); it is not the exact model (error above 1e-4).
+#[test]
+fn interpolant_follows_the_exact_model_between_nodes() {
+    let m = exact();
+    let mut worst: f64 = 0.0;
+    for p in [
+        [0.003, 0.13, 0.0023],
+        [0.021, 0.37, 0.0071],
+        [0.077, 0.58, 0.033],
+        [0.19, 0.83, 0.057],
+        [0.33, 0.94, 0.0137],
+        [0.45, 0.27, 0.088],
+    ] {
+        let want = m.lab(&m.skin(p[0], p[1], p[2]).unwrap()).unwrap();
+        let got = model()
+            .table()
+            .slice(p[1])
+            .lab(u_of_melanin(p[0]), v_of_hemoglobin(p[2]));
+        worst = worst.max(delta_e_2000(want, lab(got)));
+    }
+    assert!((1e-4..0.15).contains(&worst), "worst ΔE2000 {worst}");
+}
+
+/// Synthetic textures from known maps through the exact model: the maps' forward model
+/// reproduces them (ΔE2000 median ≤ 0.5, p95 ≤ 1 against the exact model), and C_m and C_h come
+/// back within 3 % wherever the colour can see them: C_m ≥ 0.01 (C_h ≥ 0.005 throughout) and a
+/// 3 % change of the parameter moves the exact colour by at least [`IDENTIFIABLE_DE`]. C_m always
+/// does; C_h stops doing so above C_m ≈ 0.03, where the epidermis hides the dermis.
+#[test]
+fn synthetic_round_trip_recovers_identifiable_maps() {
+    let m = exact();
+    let n = 6;
+    for beta in [0.3, 0.6, 0.9] {
+        let truth = synthetic(n, beta);
+        let texels: Vec<[f32; 3]> = truth.iter().map(|p| exact_texel(&m, *p)).collect();
+        // The middle texture goes through the inverse lookup grid, the others texel by texel.
+        let opts = MapsOptions {
+            eumelanin: Eumelanin::Fixed(beta),
+            lookup: if beta == 0.6 {
+                Lookup::Always
+            } else {
+                Lookup::Never
+            },
+            ..MapsOptions::default()
+        };
+        let maps = model().fit(&texels, None, &opts, &|_| {}).unwrap();
+        assert_eq!(
+            maps.summary.in_gamut,
+            texels.len(),
+            "β_m {beta}: {:?}",
+            maps.summary
+        );
+        let mut round = Vec::new();
+        let (mut checked_m, mut checked_h) = (0, 0);
+        for (k, p) in truth.iter().enumerate() {
+            let (fm, fh) = (f64::from(maps.melanin[k]), f64::from(maps.hemoglobin[k]));
+            let back = exact_texel(&m, [fm, beta, fh]);
+            let de = delta_e_2000(texel_to_lab(texels[k]), texel_to_lab(back));
+            round.push(de);
+            // The reported residual is the interpolant's: within its error of the exact one.
+            assert!((f64::from(maps.delta_e[k]) - de).abs() < 0.15, "{k}: {de}");
+            let moved = |q: [f64; 3]| {
+                delta_e_2000(texel_to_lab(texels[k]), texel_to_lab(exact_texel(&m, q)))
+            };
+            if p[0] >= 0.01 && moved([p[0] * 1.03, beta, p[2]]) >= IDENTIFIABLE_DE {
+                checked_m += 1;
+                assert!(
+                    (fm / p[0] - 1.0).abs() <= 0.03,
+                    "β_m {beta} C_m {} → {fm}",
+                    p[0]
+                );
+            }
+            if p[2] >= 0.005 && moved([p[0], beta, p[2] * 1.03]) >= IDENTIFIABLE_DE {
+                checked_h += 1;
+                assert!(
+                    (fh / p[2] - 1.0).abs() <= 0.03,
+                    "β_m {beta} C_h {} (C_m {}) → {fh}",
+                    p[2],
+                    p[0]
+                );
+            }
+        }
+        let (median, p95) = (quantile(round.clone(), 0.5), quantile(round, 0.95));
+        assert!(
+            median <= 0.5 && p95 <= 1.0,
+            "β_m {beta}: median {median}, p95 {p95}"
+        );
+        // Most texels are identifiable: the check is not vacuous.
+        assert!(
+            checked_m == 5 * n * n / 6 && checked_h >= n * n / 3,
+            "{checked_m} {checked_h}"
+        );
+    }
+}
+
+/// With β_m fitted, the spread the texture allows contains the true β_m, and the round trip
+/// still holds on the slice of the fitted β_m.
+#[test]
+fn fitted_eumelanin_brackets_the_truth() {
+    let m = exact();
+    for beta in [0.3, 0.9] {
+        let texels: Vec<[f32; 3]> = synthetic(5, beta)
+            .iter()
+            .map(|p| exact_texel(&m, *p))
+            .collect();
+        let maps = model()
+            .fit(&texels, None, &MapsOptions::default(), &|_| {})
+            .unwrap();
+        let s = maps.summary.eumelanin_spread.expect("fitted");
+        assert!(s.min <= beta && beta <= s.max, "β_m {beta} outside {s:?}");
+        assert!(s.max - s.min < 1.0, "the spread is the whole range: {s:?}");
+        assert!(
+            maps.summary.median_de <= 0.5 && maps.summary.p95_de <= 1.0,
+            "{:?}",
+            maps.summary
+        );
+    }
+}
+
+#[test]
+fn non_skin_and_bad_texels_are_flagged_and_finite() {
+    let skin = exact_texel(&exact(), [0.05, 0.6, 0.02]);
+    let texels = [
+        skin,
+        [0.05, 0.5, 0.05],
+        [0.18, 0.18, 0.18],
+        [0.0, 0.0, 0.0],
+        [1.0, 1.0, 1.0],
+        [f32::NAN, 0.2, 0.1],
+        [-1.0, 0.2, 0.1],
+        [f32::INFINITY, 0.2, 0.1],
+        [1e30, 1e30, 1e30],
+    ];
+    let opts = MapsOptions {
+        eumelanin: Eumelanin::Fixed(0.6),
+        ..MapsOptions::default()
+    };
+    let maps = model().fit(&texels, None, &opts, &|_| {}).unwrap();
+    assert!(maps.in_gamut[0], "the skin texel: ΔE {}", maps.delta_e[0]);
+    for (k, t) in texels.iter().enumerate().skip(1) {
+        assert!(!maps.in_gamut[k], "texel {k} {t:?} in gamut");
+        assert!(
+            maps.delta_e[k].is_finite() && maps.delta_e[k] > 1.0,
+            "{k}: {}",
+            maps.delta_e[k]
+        );
+    }
+    for k in 0..texels.len() {
+        assert!(
+            (0.0..=0.5).contains(&maps.melanin[k]),
+            "{k}: {}",
+            maps.melanin[k]
+        );
+        assert!(
+            (0.001..=0.1).contains(&maps.hemoglobin[k]),
+            "{k}: {}",
+            maps.hemoglobin[k]
+        );
+    }
+    assert_eq!(maps.summary.invalid, 4);
+    let albedo = model()
+        .albedo(&maps.melanin, maps.eumelanin, &maps.hemoglobin)
+        .unwrap();
+    assert!(albedo.iter().flatten().all(|c| c.is_finite()));
+}
+
+#[test]
+fn masked_texels_are_not_fitted_and_lengths_are_checked() {
+    let texels = vec![exact_texel(&exact(), [0.05, 0.6, 0.02]); 4];
+    let opts = MapsOptions {
+        eumelanin: Eumelanin::Fixed(0.6),
+        ..MapsOptions::default()
+    };
+    let mask = [true, false, true, false];
+    let maps = model().fit(&texels, Some(&mask), &opts, &|_| {}).unwrap();
+    assert_eq!(maps.fitted, mask);
+    assert_eq!(maps.in_gamut, mask);
+    assert_eq!(maps.summary.fitted, 2);
+    // Unfitted texels get the median of the fitted ones.
+    assert_eq!(maps.melanin[1], maps.melanin[0]);
+    let e = model()
+        .fit(&texels, Some(&mask[..3]), &opts, &|_| {})
+        .unwrap_err();
+    assert_eq!(e.to_string(), "mask has 3 values for 4 texels");
+    let bad = MapsOptions {
+        eumelanin: Eumelanin::Fixed(1.5),
+        ..MapsOptions::default()
+    };
+    let e = model().fit(&texels, None, &bad, &|_| {}).unwrap_err();
+    assert_eq!(e.to_string(), "maps option eumelanin = 1.5 outside [0, 1]");
+}
+
+/// The identity edit reproduces the texture within the round-trip error; doubling melanin
+/// darkens every texel; a hemoglobin edit under a zero weight changes nothing.
+#[test]
+fn edits_retone_through_the_forward_model() {
+    let m = exact();
+    let texels: Vec<[f32; 3]> = synthetic(5, 0.6)
+        .iter()
+        .map(|p| exact_texel(&m, *p))
+        .collect();
+    let opts = MapsOptions {
+        eumelanin: Eumelanin::Fixed(0.6),
+        ..MapsOptions::default()
+    };
+    let maps = model().fit(&texels, None, &opts, &|_| {}).unwrap();
+    let albedo = |mp: &Maps| {
+        model()
+            .albedo(&mp.melanin, mp.eumelanin, &mp.hemoglobin)
+            .unwrap()
+    };
+    let mut same = maps.clone();
+    let identity: Vec<Edit> = ["melanin*1", "melanin+0", "hemoglobin*1", "eumelanin=0.6"]
+        .iter()
+        .map(|s| s.parse().unwrap())
+        .collect();
+    apply_edits(&mut same, &identity, None).unwrap();
+    let des: Vec<f64> = albedo(&same)
+        .iter()
+        .zip(&texels)
+        .map(|(a, t)| delta_e_2000(texel_to_lab(*a), texel_to_lab(*t)))
+        .collect();
+    assert!(quantile(des.clone(), 0.5) <= 0.5 && quantile(des, 0.95) <= 1.0);
+    let mut dark = maps.clone();
+    apply_edits(&mut dark, &["melanin*2".parse().unwrap()], None).unwrap();
+    let y = |t: [f32; 3]| LinearSrgb(t.map(f64::from)).to_xyz().0[1];
+    for (k, (d, s)) in albedo(&dark).iter().zip(albedo(&same)).enumerate() {
+        assert!(y(*d) < y(s), "texel {k}: {} !< {}", y(*d), y(s));
+    }
+    let mut flushed = maps.clone();
+    let weight = vec![0.0f32; texels.len()];
+    apply_edits(
+        &mut flushed,
+        &["hemoglobin*3".parse().unwrap()],
+        Some(&weight),
+    )
+    .unwrap();
+    assert_eq!(flushed.hemoglobin, maps.hemoglobin);
+    apply_edits(&mut flushed, &["hemoglobin*3".parse().unwrap()], None).unwrap();
+    assert!(
+        flushed
+            .hemoglobin
+            .iter()
+            .zip(&maps.hemoglobin)
+            .all(|(f, o)| f > o || *f == 0.1)
+    );
+}
+
+#[test]
+fn edits_parse_or_name_the_syntax() {
+    assert_eq!(
+        "melanin*2".parse::<Edit>().unwrap(),
+        Edit::MelaninScale(2.0)
+    );
+    assert_eq!(
+        "melanin-0.01".parse::<Edit>().unwrap(),
+        Edit::MelaninOffset(-0.01)
+    );
+    assert_eq!(
+        " hemoglobin+0.02".parse::<Edit>().unwrap(),
+        Edit::HemoglobinOffset(0.02)
+    );
+    assert_eq!(
+        "eumelanin=0.8".parse::<Edit>().unwrap(),
+        Edit::Eumelanin(0.8)
+    );
+    for bad in [
+        "melanin",
+        "melanin/2",
+        "blood*2",
+        "eumelanin*2",
+        "melanin*nan",
+        "",
+    ] {
+        let e = bad.parse::<Edit>().unwrap_err().to_string();
+        assert!(e.contains("melanin*S"), "{bad}: {e}");
+    }
+    let e = "eumelanin=1.5".parse::<Edit>().unwrap_err().to_string();
+    assert_eq!(e, "maps option eumelanin = 1.5 outside [0, 1]");
+    assert_eq!(Edit::MelaninOffset(-0.01).to_string(), "melanin-0.01");
+}
+
+#[test]
+fn the_table_is_cached_on_disk() {
+    let dir = tempfile::tempdir().unwrap();
+    let opts = MapsOptions {
+        table: TableSize {
+            melanin: 4,
+            eumelanin: 4,
+            hemoglobin: 4,
+        },
+        cache_dir: Some(dir.path().to_path_buf()),
+        ..MapsOptions::default()
+    };
+    let a = MapsModel::load(&opts).unwrap();
+    assert!(
+        matches!(a.cache_outcome(), CacheOutcome::Built(_)),
+        "{:?}",
+        a.cache_outcome()
+    );
+    let b = MapsModel::load(&opts).unwrap();
+    assert!(
+        matches!(b.cache_outcome(), CacheOutcome::Hit(_)),
+        "{:?}",
+        b.cache_outcome()
+    );
+    assert_eq!(a.table(), b.table());
+}
+
+#[test]
+fn axes_map_to_the_ranges_and_back() {
+    assert_eq!(melanin_of_u(0.0), 0.0);
+    assert!((melanin_of_u(1.0) - 0.5).abs() < 1e-15);
+    assert!(
+        (hemoglobin_of_v(0.0) - 0.001).abs() < 1e-18 && (hemoglobin_of_v(1.0) - 0.1).abs() < 1e-15
+    );
+    for c in [0.0, 0.001, 0.02, 0.3] {
+        assert!((melanin_of_u(u_of_melanin(c)) - c).abs() < 1e-14);
+    }
+    for c in [0.001, 0.005, 0.08] {
+        assert!((hemoglobin_of_v(v_of_hemoglobin(c)) - c).abs() < 1e-15);
+    }
+}
