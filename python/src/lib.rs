@@ -14,6 +14,7 @@ mod error;
 mod export;
 mod fit;
 mod forward;
+mod maps;
 mod params;
 
 /// The extension module `spectral_skin._native`.
@@ -46,5 +47,6 @@ fn native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(colour::delta_e_2000, m)?)?;
     m.add_function(wrap_pyfunction!(colour::ita, m)?)?;
     m.add_function(wrap_pyfunction!(export::export, m)?)?;
+    m.add_function(wrap_pyfunction!(maps::maps, m)?)?;
     Ok(())
 }

@@ -65,6 +65,7 @@ __all__ = [
     "fit_spectrum",
     "fit_colour",
     "export",
+    "maps",
     "xyz",
     "lab",
     "srgb",
@@ -524,6 +525,87 @@ def export(
     for note in notes:
         _log.info("%s", note)
     return text
+
+
+def maps(
+    albedo_rgb: ArrayLike,
+    mask: ArrayLike | None = None,
+    *,
+    eumelanin: float | None = None,
+    cache: bool = True,
+    threads: int | None = None,
+) -> dict[str, Any]:
+    """Chromophore maps of an albedo texture: melanin C_m and blood C_h per texel, one β_m (``skin maps``).
+
+    ``albedo_rgb``: (H, W, 3) linear Rec.709 (sRGB primaries, not gamma-encoded) diffuse albedo, a
+    perfect white diffuser at 1: the skin's diffuse reflectance (specular excluded, SCE) under D65
+    with the CIE 1931 2° observer, what :func:`diffuse_reflectance` and :func:`xyz` give through
+    the XYZ → linear Rec.709 matrix. ``mask``: optional (H, W) flags (True: fit the texel); texels
+    outside it are not fitted and get the median of the fitted maps, ΔE 0 and ``in_gamut`` False.
+    ``eumelanin``: the texture's eumelanin blend β_m in [0, 1], or None to fit one β_m over the
+    texels. ``cache``: keep the forward table (built once, a few CPU-seconds) in the disk cache
+    (``$SKIN_CACHE_DIR``, else ``$XDG_CACHE_HOME/skin``, else ``~/.cache/skin``).
+
+    Non-finite, negative or huge (> 16) components are replaced (NaN by 0, then clamped), fitted
+    and flagged out of gamut. The work runs on all cores (``threads=`` limits them) with the GIL
+    released.
+
+    Returns a dict of (H, W) arrays:
+
+    ================ ==================================================================
+    ``melanin``      melanin volume fraction C_m, float64 in [0, 0.5]
+    ``eumelanin``    eumelanin blend β_m (the same for every texel), float64 in [0, 1]
+    ``hemoglobin``   hemoglobin volume fraction C_h, float64 in [0.001, 0.1]
+    ``delta_e``      CIEDE2000 between the texel and the fitted skin, float64 (0 off the mask)
+    ``in_gamut``     bool: fitted and reproduced within ΔE2000 ≤ 1
+    ``fitted``       bool: inside the mask
+    ================ ==================================================================
+
+    and ``summary``, a dict: ``eumelanin`` (β_m), ``eumelanin_fitted`` (bool),
+    ``eumelanin_min``/``eumelanin_max`` (the β_m range the texels allow: candidates whose RMS
+    ΔE2000, capped at 3 per texel, is within ``eumelanin_tolerance_de`` of the best,
+    ``eumelanin_rms_de``; both ends equal β_m and the two ΔE None when β_m was given),
+    ``texels``, ``fitted``, ``in_gamut``, ``invalid`` (counts), ``median_delta_e``,
+    ``p95_delta_e``, ``max_delta_e`` (over the fitted texels) and ``in_gamut_delta_e`` (1.0).
+
+    Example:
+        >>> wl = np.arange(400.0, 701.0, 10.0)
+        >>> r = diffuse_reflectance(wl, melanin=[[0.02, 0.1]], eumelanin=0.6, hemoglobin=0.02)
+        >>> to_rec709 = np.array([[3.2406, -1.5372, -0.4986], [-0.9689, 1.8758, 0.0415], [0.0557, -0.2040, 1.0570]])
+        >>> albedo = xyz(wl, r) @ to_rec709.T                  # (1, 2, 3) linear Rec.709
+        >>> m = maps(albedo, eumelanin=0.6)
+        >>> m["melanin"].round(2), bool(m["in_gamut"].all())
+        (array([[0.02, 0.1 ]]), True)
+    """
+    a = _real(albedo_rgb, "albedo_rgb")
+    if a.ndim != 3 or a.shape[-1] != 3:
+        raise SkinError(f"albedo_rgb: must have shape (H, W, 3) (linear Rec.709 per texel), got shape {a.shape}")
+    shape = a.shape[:2]
+    m = None
+    if mask is not None:
+        mk = np.asarray(mask)
+        if mk.dtype.kind not in "biuf":
+            raise SkinError(f"mask: not an array of flags (dtype {mk.dtype})")
+        if mk.shape != shape:
+            raise SkinError(f"mask: must have the texture's shape {shape} (H, W), got shape {mk.shape}")
+        m = (mk != 0).reshape(-1)
+    if eumelanin is not None:
+        try:
+            eumelanin = float(eumelanin)
+        except (TypeError, ValueError):
+            raise SkinError(f"eumelanin: {eumelanin!r} is not a number in [0, 1] (or None: fitted)") from None
+    d = _native.maps(a.reshape(-1, 3), m, eumelanin, bool(cache), threads)
+    summary = dict(d["summary"])
+    out: dict[str, Any] = {
+        "melanin": d["melanin"].reshape(shape),
+        "eumelanin": np.full(shape, summary["eumelanin"], dtype=np.float64),
+        "hemoglobin": d["hemoglobin"].reshape(shape),
+        "delta_e": d["delta_e"].reshape(shape),
+        "in_gamut": np.asarray(d["in_gamut"], dtype=bool).reshape(shape),
+        "fitted": np.asarray(d["fitted"], dtype=bool).reshape(shape),
+        "summary": summary,
+    }
+    return out
 
 
 def xyz(wavelength_nm: ArrayLike, reflectance: ArrayLike) -> Array:

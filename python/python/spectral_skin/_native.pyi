@@ -102,3 +102,9 @@ def export(
     mcx_lambda_nm: float,
 ) -> tuple[str, list[str]]:
     """The file text of a format for one skin, and its notes."""
+
+def maps(
+    texels: _In, mask: _In | None, eumelanin: float | None, cache: bool, threads: int | None = None
+) -> dict[str, Any]:
+    """(N, 3) linear Rec.709 albedo and (N,) flags → melanin, hemoglobin, delta_e (N,) float64,
+    in_gamut, fitted (N,) bool and a summary dict (β_m and its allowed range, counts, ΔE2000)."""

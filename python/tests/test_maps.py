@@ -1,0 +1,133 @@
+"""Chromophore maps of albedo textures: round trips on synthetic textures made by the package's own
+forward model, out-of-gamut texels, masks and bad shapes."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import spectral_skin as ss
+
+WL = np.arange(400.0, 701.0, 10.0)  # the maps' colour grid: 400-700 nm every 10 nm
+# CIE XYZ → linear Rec.709 (skin_optics::color::Xyz::to_linear_srgb).
+TO_REC709 = np.array([[3.2406, -1.5372, -0.4986], [-0.9689, 1.8758, 0.0415], [0.0557, -0.2040, 1.0570]])
+
+
+def albedo(melanin, hemoglobin, eumelanin) -> np.ndarray:
+    """Linear Rec.709 diffuse albedo (..., 3) of skins, as skin_fit::maps defines a texel's colour:
+    the exact model's SCE diffuse reflectance under D65, CIE 1931 2°, 400-700 nm every 10 nm."""
+    r = ss.diffuse_reflectance(
+        WL, method="exact", geometry="sce", melanin=melanin, eumelanin=eumelanin, hemoglobin=hemoglobin
+    )
+    return ss.xyz(WL, r) @ TO_REC709.T
+
+
+@pytest.fixture(scope="module")
+def texture():
+    """A 8 × 10 texture: C_m 0.01-0.18 along x, C_h 0.005-0.06 along y (geometric), β_m 0.6.
+
+    Under darker melanin (C_m ≳ 0.25) the blood barely changes the colour, so C_h is not
+    identifiable from three colour numbers (skin-fit's maps tests check it only where it is)."""
+    x = np.linspace(0.0, 1.0, 10)
+    y = np.linspace(0.0, 1.0, 8)
+    c_m = 0.01 * (0.18 / 0.01) ** x[None, :] * np.ones((8, 1))
+    c_h = 0.005 * (0.06 / 0.005) ** y[:, None] * np.ones((1, 10))
+    return c_m, c_h, 0.6, albedo(c_m, c_h, 0.6)
+
+
+def test_round_trip_recovers_the_maps(texture):
+    c_m, c_h, beta, rgb = texture
+    m = ss.maps(rgb, eumelanin=beta)
+    assert set(m) >= {"melanin", "eumelanin", "hemoglobin", "delta_e", "in_gamut", "summary"}
+    for k in ("melanin", "eumelanin", "hemoglobin", "delta_e"):
+        assert m[k].shape == c_m.shape and m[k].dtype == np.float64, k
+    assert m["in_gamut"].shape == c_m.shape and m["in_gamut"].all()
+    np.testing.assert_array_equal(m["eumelanin"], beta)
+    np.testing.assert_allclose(m["melanin"], c_m, rtol=0.02)
+    np.testing.assert_allclose(m["hemoglobin"], c_h, rtol=0.02)
+    assert np.median(m["delta_e"]) < 0.05 and m["delta_e"].max() < 0.2
+    s = m["summary"]
+    assert s["eumelanin"] == beta and not s["eumelanin_fitted"]
+    assert s["eumelanin_min"] == s["eumelanin_max"] == beta
+    assert s["texels"] == s["fitted"] == s["in_gamut"] == c_m.size and s["invalid"] == 0
+    assert s["max_delta_e"] == pytest.approx(m["delta_e"].max(), abs=1e-6)
+
+
+def test_fitted_eumelanin_brackets_the_truth(texture):
+    c_m, c_h, beta, rgb = texture
+    m = ss.maps(rgb)
+    s = m["summary"]
+    assert s["eumelanin_fitted"]
+    assert s["eumelanin_min"] <= beta <= s["eumelanin_max"], s
+    assert s["eumelanin_max"] - s["eumelanin_min"] < 1.0, s
+    assert s["eumelanin_tolerance_de"] > 0 and s["eumelanin_rms_de"] >= 0
+    np.testing.assert_array_equal(m["eumelanin"], s["eumelanin"])
+    assert s["median_delta_e"] < 0.5 and s["p95_delta_e"] <= 1.0, s
+
+
+def test_dtypes_and_strides_do_not_matter(texture):
+    _, _, beta, rgb = texture
+    ref = ss.maps(rgb, eumelanin=beta, threads=1)
+    f32 = ss.maps(rgb.astype(np.float32), eumelanin=beta, threads=2)
+    transposed = np.ascontiguousarray(rgb.transpose(1, 0, 2)).transpose(1, 0, 2)  # non-contiguous view
+    assert not transposed.flags.c_contiguous
+    view = ss.maps(transposed, eumelanin=beta)
+    for k in ("melanin", "hemoglobin", "delta_e", "in_gamut"):
+        np.testing.assert_array_equal(ref[k], f32[k])  # texels are f32 inside
+        np.testing.assert_array_equal(ref[k], view[k])
+    ints = ss.maps(np.zeros((2, 3, 3), dtype=np.int64), eumelanin=beta)  # black: out of gamut
+    assert ints["melanin"].shape == (2, 3) and not ints["in_gamut"].any()
+
+
+def test_non_skin_texels_are_flagged_and_finite():
+    skin = albedo(0.05, 0.02, 0.6)
+    rgb = np.array(
+        [[skin, [0.0, 1.0, 0.0], [0.0, 0.0, 0.0]], [[1.0, 1.0, 1.0], [np.nan, 0.2, 0.1], [-1.0, 0.2, 0.1]]]
+    )
+    m = ss.maps(rgb, eumelanin=0.6)
+    assert m["in_gamut"][0, 0], m["delta_e"][0, 0]
+    flagged = np.ones((2, 3), dtype=bool)
+    flagged[0, 0] = False
+    assert not m["in_gamut"][flagged].any()
+    assert (m["delta_e"][flagged] > 1.0).all(), m["delta_e"]
+    for k in ("melanin", "hemoglobin", "delta_e"):
+        assert np.isfinite(m[k]).all(), k
+    eps = 1e-6  # the maps are f32 inside
+    assert ((0.0 <= m["melanin"]) & (m["melanin"] <= 0.5 + eps)).all()
+    assert ((0.001 - eps <= m["hemoglobin"]) & (m["hemoglobin"] <= 0.1 + eps)).all()
+    assert m["summary"]["invalid"] == 2 and m["summary"]["in_gamut"] == 1
+
+
+def test_mask_leaves_texels_unfitted(texture):
+    _, _, beta, rgb = texture
+    mask = np.zeros(rgb.shape[:2], dtype=bool)
+    mask[:, :5] = True
+    m = ss.maps(rgb, mask, eumelanin=beta)
+    full = ss.maps(rgb, eumelanin=beta)
+    np.testing.assert_array_equal(m["fitted"], mask)
+    np.testing.assert_array_equal(m["melanin"][mask], full["melanin"][mask])
+    assert not m["in_gamut"][~mask].any() and (m["delta_e"][~mask] == 0).all()
+    np.testing.assert_allclose(m["melanin"][~mask], np.median(m["melanin"][mask]), rtol=0.2)
+    assert m["summary"]["fitted"] == mask.sum()
+    ints = ss.maps(rgb, mask.astype(int), eumelanin=beta)  # 0/1 flags accepted
+    np.testing.assert_array_equal(ints["melanin"], m["melanin"])
+
+
+@pytest.mark.parametrize(
+    "call,name,text",
+    [
+        (lambda: ss.maps(np.full((4, 5, 3), 0.3), np.ones((5, 4), dtype=bool)), "mask", "(4, 5)"),
+        (lambda: ss.maps(np.full((4, 5, 3), 0.3), np.ones(20, dtype=bool)), "mask", "(4, 5)"),
+        (lambda: ss.maps(np.full((4, 5, 4), 0.3)), "albedo_rgb", "(H, W, 3)"),
+        (lambda: ss.maps(np.full((20, 3), 0.3)), "albedo_rgb", "(H, W, 3)"),
+        (lambda: ss.maps(np.full((2, 2, 3), 0.3), eumelanin=1.5), "eumelanin", "[0, 1]"),
+        (lambda: ss.maps(np.full((2, 2, 3), 0.3), eumelanin=np.nan), "eumelanin", "[0, 1]"),
+        (lambda: ss.maps([["a", "b", "c"]]), "albedo_rgb", "real"),
+        (lambda: ss.maps(np.full((2, 2, 3), 0.3), threads=0), "threads", "[1, 1024]"),
+    ],
+)
+def test_bad_input_names_the_parameter(call, name, text):
+    with pytest.raises(ss.SkinError) as e:
+        call()
+    assert str(e.value).startswith(name), str(e.value)
+    assert text in str(e.value), str(e.value)
