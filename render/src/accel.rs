@@ -20,9 +20,9 @@ use obvhs::{
 use std::time::Duration;
 
 /// The CWBVH build: obvhs's `very_slow_build` (reinsertion over every node) without its spatial
-/// pre-splits, so each triangle is in exactly one leaf (the all-hits query reports it once). On
-/// the default scene its traversal takes 4% fewer instructions per path than `medium_build`
-/// for about 0.1 s more build time (BENCHMARKS.md, "Image noise: session 7").
+/// pre-splits, so each triangle is in exactly one leaf (the all-hits query reports it once). Its
+/// traversal costs fewer instructions per path than `medium_build`'s for a slower build
+/// (docs/benchmarks-archive.md, "Image noise: session 7").
 pub const BVH_BUILD: BvhBuildParams = BvhBuildParams {
     pre_split: false,
     ..BvhBuildParams::very_slow_build()

@@ -30,9 +30,8 @@
 //! r: on a sphere of radius R smaller than the profile the normal probes miss beyond planar radius
 //! R (the sphere's shadow on its tangent plane), yet the probes find the sphere's points out to
 //! chord distance 2R, and over a sphere dA = 2πd dd (Archimedes' hat-box theorem), so they already
-//! return R_tot F(2R) (F the profile's energy fraction within a radius). A fallback on every miss
-//! added R_tot (1 − F(R)) and counted the band R < r < 2R twice (light skin at R = 2 mm: 5–6%
-//! brighter in X and Y). So on a miss the fallback first traces the quarter circle of radius r
+//! return R_tot F(2R) (F the profile's energy fraction within a radius); a fallback on every miss
+//! would add R_tot (1 − F(R)) and count the band R < r < 2R twice. So on a miss the fallback first traces the quarter circle of radius r
 //! from the planar point down to p_o − r n (in the plane of n and the probe's azimuth, as
 //! [`ARC_SEGMENTS`] chords, same end points): when it crosses the material, skin lies at distance r
 //! and the probes account for that energy; the fallback fires only when it does not. On the

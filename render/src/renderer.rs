@@ -8,10 +8,6 @@
 //! index), and passes are added
 //! to the film in order, so the image for a given seed and sample count does not depend on the
 //! number of threads or on the tile schedule.
-//!
-//! The options, their error and their range checks are spelled out field by field, in the same
-//! shape as the other crates' settings and errors, so each field's valid range stands beside its
-//! name and its check.
 
 use crate::adaptive::{Accumulator, ErrorEstimate, MIN_SPP};
 use crate::error::RenderError;

@@ -1,9 +1,6 @@
 //! Profile extent and table resolution (docs/physics.md §16.1): each row ends where the energy left
 //! beyond it is below a tolerance, and the radius grid has the fewest radii whose piecewise-linear
 //! density meets an energy-weighted error target.
-//!
-//! Each knob's range check is spelled out where the knob is read (the shape repeats across the
-//! workspace's option checks): the error then names that knob and its range.
 
 use super::table::{MAX_RADII, R_MIN_MM};
 use multipole::{MultipoleError, Profile};

@@ -165,10 +165,9 @@ impl RadiusWavelength {
     }
 }
 
-/// Uniform share of the renderer's radius-wavelength choice ([`RadiusWavelength`]): of 1, 0.5,
-/// 0.25, 0.1 and 0.02 on the default scene at 16 spp, 0.1 gave the least luminance noise on skin
-/// at equal CPU time (1.45× the variance ratio of 1) with the blue channel 7% noisier and the red
-/// 13% less (BENCHMARKS.md, "Image noise: the radius wavelength").
+/// Uniform share of the renderer's radius-wavelength choice ([`RadiusWavelength`]): of the shares
+/// measured on the default scene, the one with the least luminance noise on skin at equal CPU time
+/// (docs/benchmarks-archive.md, "Image noise: the radius wavelength").
 pub const RENDER_UNIFORM_SHARE: f32 = 0.1;
 
 /// An orthonormal shading frame at the entry point (world space; `n` = outward normal).

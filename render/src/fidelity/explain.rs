@@ -1,8 +1,5 @@
 //! What was chosen for each skin material and why (`skin render --explain`), and the one warning
 //! for diffusion inside its known failure region (docs/physics.md §9, §16).
-//!
-//! [`SkinChoices`] is a plain record, one documented field per choice: its shape repeats the
-//! workspace's other result records (fits, spectra) by design.
 
 use super::photons::PhotonChoice;
 use super::wavelengths::FROM_NM;

@@ -271,8 +271,9 @@ impl FidelityKnobs {
             }
             Some(k) => (k > 0.0).then_some(k),
             // Off unless asked for: at the default scene's footprints about 1% of subsurface hits
-            // are thin, and the walk's heavy-tailed estimate (light reaches the walked body only
-            // through its exit rays) took the 60-s image from 2.6% to 8% noise (BENCHMARKS.md).
+            // are thin, and the walk's estimate is heavy-tailed (light reaches the walked body
+            // only through its exit rays), which multiplies the default image's noise at equal
+            // time (BENCHMARKS.md, "Fidelity").
             None => None,
         };
         let photons = match (self.shape_photons, self.smallest_footprint_mm) {

@@ -27,8 +27,8 @@ use crate::bssrdf::ProfileTable;
 use serde::{Deserialize, Serialize};
 
 /// Photons of the universal shape table and the worst energy-weighted shape error measured at
-/// that count (fractions; `skin-validate table-knobs`, 1 December 2026, BENCHMARKS.md "Exact
-/// profile table"), fewest first; the last is the default table.
+/// that count (fractions; `skin-validate table-knobs`, BENCHMARKS.md "Exact profile table"),
+/// fewest first; the last is the default table.
 pub const TABLE_PHOTON_LAW: [(u64, f64); 3] =
     [(50_000, 0.0645), (200_000, 0.0337), (500_000, 0.0250)];
 

@@ -1,8 +1,5 @@
 //! Emission spectra of lights: blackbody, constant or D65, each normalised to luminance Y = 1 and
 //! multiplied by the light's intensity.
-//!
-//! The tests loop over emission shapes spelled out in each test, because each test picks the shapes
-//! (and blackbody temperatures) that stress its own limit.
 
 use crate::spectrum::{SpectrumTable, luminance_of};
 

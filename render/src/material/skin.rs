@@ -7,9 +7,6 @@
 //! cap and the branch choice between surface and body both read); without one (`no_subsurface`)
 //! the Lambertian stand-in tabulates the same model's totals (`multipole::skin::total_reflectance`)
 //! on the same 10-nm grid.
-//!
-//! `SkinMaterial` is a record of documented fields (units and sources on each), alike in shape to
-//! the workspace's other records; the fields differ in meaning, so nothing is shared.
 
 use crate::bssrdf::{Directional, EnergySplit, Subsurface};
 use crate::fidelity::SKIN_TABLE_STEP_NM;

@@ -1,9 +1,5 @@
 //! Loading a scene file: the camera, meshes and their placement, lights and the environment, with
 //! every value checked and every error naming the file and key.
-//!
-//! The match over light kinds repeats one shape per kind (destructure the description, check each
-//! key through the shared `point`/`length`/`emission` checks, build the light) because every kind
-//! has its own keys and struct.
 
 use super::Scene;
 use crate::builtin;

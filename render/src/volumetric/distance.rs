@@ -5,9 +5,6 @@
 //! distance to the cell's centre is at most d + h√3/2: every triangle within d of any point of the
 //! cell is listed there (triangle inequality), so one cell's list answers the query exactly. The
 //! point–triangle distance is Ericson's closest-point test ([Ericson05] §5.1.5).
-//!
-//! The test geometry (a square of two triangles) is spelled out in full, as in the BVH's tests, so
-//! that each test shows the whole surface it measures.
 
 use glam::Vec3;
 use std::collections::HashMap;

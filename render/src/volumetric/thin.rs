@@ -1,8 +1,8 @@
 //! BSSRDF or volumetric walk, per hit (docs/physics.md §16.6). The separable BSSRDF takes the skin
 //! under a hit for a half-space (§8); where the body is thinner than the distance its light
 //! travels, light that the half-space would send back instead crosses to the far face, and the
-//! BSSRDF returns 60–85% too little of a backlit 1–3-mm slab of light or medium skin (BENCHMARKS.md,
-//! "BSSRDF against the volumetric reference"). The criterion: a probe ray from the hit along the
+//! BSSRDF returns far too little of a backlit slab a few millimetres thick (BENCHMARKS.md, "BSSRDF
+//! against the volumetric reference"). The criterion: a probe ray from the hit along the
 //! inward normal; when it meets the same material's surface within `walk_below_mm` — the skin's
 //! largest 99% energy radius r₉₉ (over the table's wavelengths) times a factor
 //! (`crate::fidelity::DEFAULT_THIN_WALK_R99`, `--thin-walk`) — the hit is thin and the path takes the volumetric walk (`crate::volumetric`,

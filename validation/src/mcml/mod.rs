@@ -282,7 +282,7 @@ mod tests {
     #[test]
     fn cases_are_finite_and_written_in_cm() {
         let cases = cases().unwrap();
-        assert_eq!(cases.len(), 6);
+        assert_eq!(cases.len(), 10);
         for c in &cases {
             let last = c.stack.layers().last().unwrap();
             assert_eq!(last.thickness_mm(), Some(HALF_SPACE_DEPTH_MM));
