@@ -8,6 +8,26 @@ use crate::renderer::{RenderOptions, render};
 use crate::scene::Scene;
 use skin_optics::color::{cie_xyz_bar, cie_y_integral};
 
+/// A 2 m slab of light skin under a distant D65 light, seen head-on from 500 mm (2° field).
+pub const LIGHT_SLAB: &str = r#"
+[camera]
+position_mm = [0, 0, 500]
+look_at_mm = [0, 0, 0]
+fov_deg = 2
+[materials.skin]
+type = "skin"
+preset = "light"
+[[meshes]]
+shape = "quad"
+material = "skin"
+scale = 1000
+[[lights]]
+type = "distant"
+direction = [0, 0, 1]
+spectrum = "d65"
+intensity = 1
+"#;
+
 /// The TOML of a test scene, assembled part by part so that no test spells out the same camera,
 /// material, mesh or light again. The camera looks at the origin with +Y up.
 #[derive(Debug, Clone)]

@@ -12,25 +12,7 @@ use render::material::SkinKnobs;
 use render::renderer::{RenderOptions, render, render_with};
 use render::scene::Scene;
 
-/// A 2 m slab of light skin under a distant D65 light, seen head-on from 500 mm (2° field).
-const SLAB: &str = r#"
-[camera]
-position_mm = [0, 0, 500]
-look_at_mm = [0, 0, 0]
-fov_deg = 2
-[materials.skin]
-type = "skin"
-preset = "light"
-[[meshes]]
-shape = "quad"
-material = "skin"
-scale = 1000
-[[lights]]
-type = "distant"
-direction = [0, 0, 1]
-spectrum = "d65"
-intensity = 1
-"#;
+use render::testing::LIGHT_SLAB as SLAB;
 
 /// Mean XYZ of the slab rendered at 32×32 with `spp` paths per pixel and pixel angle `angle`.
 fn mean_xyz(scene: &Scene, angle: f32, spp: u32, seed: u64) -> [f64; 3] {

@@ -1,24 +1,6 @@
 //! `skin render --explain` and the multipole warning, end to end.
 
-/// A 2 m slab of light skin under a distant D65 light, seen head-on from 500 mm (2° field).
-const SLAB: &str = r#"
-[camera]
-position_mm = [0, 0, 500]
-look_at_mm = [0, 0, 0]
-fov_deg = 2
-[materials.skin]
-type = "skin"
-preset = "light"
-[[meshes]]
-shape = "quad"
-material = "skin"
-scale = 1000
-[[lights]]
-type = "distant"
-direction = [0, 0, 1]
-spectrum = "d65"
-intensity = 1
-"#;
+use render::testing::LIGHT_SLAB as SLAB;
 
 /// `skin render --explain` prints one block per skin material with every choice, and
 /// `--method multipole` warns once where diffusion is off (the light preset: +4.3% at 400 nm,
