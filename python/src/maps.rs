@@ -6,23 +6,9 @@ use numpy::{AllowTypeChange, IntoPyArray, PyArrayLike1};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use skin_fit::maps::{Eumelanin, MapsError, MapsModel, MapsOptions};
-use std::path::PathBuf;
 
 /// A 1-D array-like of flags.
 type InMask<'py> = PyArrayLike1<'py, bool, AllowTypeChange>;
-
-/// The table cache folder `skin maps` uses (`skin_io::cache::cache_dir`): `$SKIN_CACHE_DIR`, else
-/// `$XDG_CACHE_HOME/skin`, else `$HOME/.cache/skin`; `None` keeps the table in memory.
-fn cache_dir() -> Option<PathBuf> {
-    let var = |k: &str| {
-        std::env::var_os(k)
-            .filter(|v| !v.is_empty())
-            .map(PathBuf::from)
-    };
-    var("SKIN_CACHE_DIR")
-        .or_else(|| var("XDG_CACHE_HOME").map(|d| d.join("skin")))
-        .or_else(|| var("HOME").map(|d| d.join(".cache").join("skin")))
-}
 
 /// A maps error as the bad input it names.
 fn bad(e: MapsError) -> Bad {
@@ -58,7 +44,11 @@ pub fn maps<'py>(
     }
     let opts = MapsOptions {
         eumelanin: eumelanin.map_or(Eumelanin::Fit, Eumelanin::Fixed),
-        cache_dir: if cache { cache_dir() } else { None },
+        cache_dir: if cache {
+            skin_io::cache::cache_dir()
+        } else {
+            None
+        },
         ..MapsOptions::default()
     };
     let maps = py.detach(|| {

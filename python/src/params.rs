@@ -3,9 +3,7 @@
 use crate::error::{Bad, Checked};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use skin_fit::ColourModel;
-use skin_optics::lab::Lab;
-use skin_optics::measured::{ita_presets, measured_presets, named_skin};
+use skin_optics::measured::named_skin;
 use skin_optics::{Extension, Preset, SkinParams, Wavelength};
 
 /// The Python keyword of each column of a parameter row, in order.
@@ -100,48 +98,29 @@ pub fn preset_row(name: Option<&str>) -> PyResult<Vec<f64>> {
 /// Every named skin: name, source, colour (exact model, 10-nm step) and parameters.
 #[pyfunction]
 pub fn presets(py: Python<'_>) -> PyResult<Vec<Bound<'_, PyDict>>> {
-    let colour = ColourModel::new(10.0, multipole::Method::Exact, SkinParams::default())
+    let rows = py
+        .detach(skin_fit::named_skins)
         .map_err(|e| Bad::new("presets", e))?;
-    let mut rows: Vec<(String, String, SkinParams, Lab)> = Vec::new();
-    for (name, p) in [
-        ("paper", Preset::Light),
-        ("medium", Preset::Medium),
-        ("dark", Preset::Dark),
-    ] {
-        let skin = SkinParams::preset(p);
-        let what = if p == Preset::Light {
-            "the paper's Figure 1 (also `light`)"
-        } else {
-            "seed model, this project's values"
-        };
-        let lab = py
-            .detach(|| colour.lab(&skin))
-            .map_err(|e| Bad::new("presets", e))?;
-        rows.push((name.to_string(), what.to_string(), skin, lab));
-    }
-    for p in measured_presets() {
-        let what = format!(
-            "ISSA {} {} median of {} (fit RMS {:.4})",
-            p.group_code, p.site, p.n_records, p.rms
-        );
-        rows.push((p.name.clone(), what, p.skin, p.lab));
-    }
-    for (name, p) in ita_presets() {
-        rows.push((name, format!("= {}", p.name), p.skin, p.lab));
-    }
     rows.into_iter()
-        .map(|(name, source, skin, lab)| {
-            let d = PyDict::new(py);
-            d.set_item("name", name)?;
-            d.set_item("source", source)?;
-            d.set_item("srgb", lab.to_srgb().to_hex())?;
-            d.set_item("lab", (lab.l, lab.a, lab.b))?;
-            d.set_item("ita_deg", lab.ita_deg())?;
-            d.set_item("ita_category", lab.ita_category().name())?;
-            for (k, v) in COLUMNS.iter().zip(row_of(&skin)) {
-                d.set_item(*k, v)?;
-            }
-            Ok(d)
-        })
+        .map(
+            |skin_fit::NamedSkin {
+                 name,
+                 source,
+                 skin,
+                 lab,
+             }| {
+                let d = PyDict::new(py);
+                d.set_item("name", name)?;
+                d.set_item("source", source)?;
+                d.set_item("srgb", lab.to_srgb().to_hex())?;
+                d.set_item("lab", (lab.l, lab.a, lab.b))?;
+                d.set_item("ita_deg", lab.ita_deg())?;
+                d.set_item("ita_category", lab.ita_category().name())?;
+                for (k, v) in COLUMNS.iter().zip(row_of(&skin)) {
+                    d.set_item(*k, v)?;
+                }
+                Ok(d)
+            },
+        )
         .collect()
 }

@@ -1,11 +1,9 @@
 //! `skin presets`: the named skins with their colour (CIELAB under D65, sRGB) and ITA°.
 
 use clap::Args;
-use multipole::Method;
-use skin_fit::ColourModel;
+use skin_fit::named_skins;
+use skin_optics::SkinParams;
 use skin_optics::lab::Lab;
-use skin_optics::measured::{ita_presets, measured_presets};
-use skin_optics::{Preset, SkinParams};
 
 /// Arguments of `skin presets`.
 #[derive(Args, Debug, Clone)]
@@ -39,31 +37,10 @@ fn json_row(name: &str, what: &str, skin: &SkinParams, lab: Lab) -> serde_json::
 
 /// Run `skin presets`.
 pub fn run(args: &PresetsArgs) -> anyhow::Result<()> {
-    let colour = ColourModel::new(10.0, Method::Exact, SkinParams::default())?;
-    let mut rows = Vec::new();
-    for (name, p) in [
-        ("paper", Preset::Light),
-        ("medium", Preset::Medium),
-        ("dark", Preset::Dark),
-    ] {
-        let skin = SkinParams::preset(p);
-        let what = if p == Preset::Light {
-            "the paper's Figure 1 (also `light`)"
-        } else {
-            "seed model, this project's values"
-        };
-        rows.push((name.to_string(), what.to_string(), skin, colour.lab(&skin)?));
-    }
-    for p in measured_presets() {
-        let what = format!(
-            "ISSA {} {} median of {} (fit RMS {:.4})",
-            p.group_code, p.site, p.n_records, p.rms
-        );
-        rows.push((p.name.clone(), what, p.skin, p.lab));
-    }
-    for (name, p) in ita_presets() {
-        rows.push((name, format!("= {}", p.name), p.skin, p.lab));
-    }
+    let rows: Vec<_> = named_skins()?
+        .into_iter()
+        .map(|r| (r.name, r.source, r.skin, r.lab))
+        .collect();
     if args.json {
         let v: Vec<_> = rows
             .iter()

@@ -9,6 +9,7 @@ mod least_squares;
 pub mod maps;
 mod measured;
 pub mod model;
+mod named;
 mod nelder_mead;
 mod spectrum;
 
@@ -22,6 +23,7 @@ pub use extended::{
 pub use geometry::Geometry;
 pub use measured::{MAX_NM, MIN_NM, MIN_POINTS, MeasuredSpectrum};
 pub use model::{ModelChoice, Parameter};
+pub use named::{NamedSkin, named_skins};
 pub use spectrum::{SpectrumFit, fit_spectrum};
 
 use multipole::Method;
