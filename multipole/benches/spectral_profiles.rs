@@ -4,6 +4,7 @@
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use multipole::ProfileOptions;
 use multipole::diffusion::slab::Poles;
+use multipole::diffusion::spatial::DiffusionOptions;
 use multipole::skin::{Method, SpectralProfiles, profile};
 use skin_optics::{Preset, SkinParams, Wavelength, WavelengthGrid};
 use std::hint::black_box;
@@ -39,10 +40,10 @@ fn spectral_profiles(c: &mut Criterion) {
     for nm in [450.0, 650.0] {
         let lambda = Wavelength::new(nm).expect("valid wavelength");
         for (name, poles) in [("exact", Poles::Exact), ("count5", Poles::Count(5))] {
-            let opts = ProfileOptions {
+            let opts = ProfileOptions::with_diffusion(DiffusionOptions {
                 poles,
-                ..ProfileOptions::default()
-            };
+                ..DiffusionOptions::default()
+            });
             g.bench_with_input(
                 BenchmarkId::new(format!("{name}_{nm}nm"), 256),
                 &lambda,

@@ -25,20 +25,20 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     type Set = fn(&mut ProfileOptions, usize);
     let counts: [(&str, &[usize], Set); 4] = [
         ("poles", &[0, 1, 2, 5, 10, 20, 50], |o, n| {
-            o.poles = Poles::Count(n)
+            o.diffusion.poles = Poles::Count(n)
         }),
         (
             "radial_samples",
             &[16, 32, 64, 128, 256, 512, 1024],
-            |o, n| o.radial_samples = n,
+            |o, n| o.diffusion.radial_samples = n,
         ),
         ("transform_nodes", &[2, 3, 4, 5, 6, 8, 12], |o, n| {
-            o.transform_nodes = n
+            o.diffusion.transform_nodes = n
         }),
         (
             "transform_radii",
             &[8, 12, 16, 24, 32, 48, 64, 96, 128],
-            |o, n| o.transform_radii = n,
+            |o, n| o.diffusion.transform_radii = n,
         ),
     ];
     let mut settings: Vec<(&str, String, ProfileOptions)> = Vec::new();
@@ -53,10 +53,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
     }
     for t in [1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-10, 1e-12] {
-        let o = ProfileOptions {
-            transform_tolerance: t,
-            ..d
-        };
+        let mut o = d;
+        o.diffusion.transform_tolerance = t;
         settings.push(("transform_tolerance", format!("{t:e}"), o));
     }
     let mut csv = String::from(

@@ -19,7 +19,7 @@ pub enum MultipoleError {
         /// Human-readable valid range, e.g. `[0, 1e6]`.
         range: &'static str,
     },
-    /// A numerical knob (`ProfileOptions`) is out of range.
+    /// A numerical knob (`ProfileOptions`, `DiffusionOptions`) is out of range.
     #[error("option {name} = {} outside {range}", skin_optics::echo::Num(*.value))]
     InvalidOption {
         /// Knob name, e.g. `"radial_samples"`.
@@ -85,5 +85,20 @@ pub(crate) fn check_range(
         Ok(value)
     } else {
         Err(MultipoleError::OutOfRange { name, value, range })
+    }
+}
+
+/// Check that the knob `value` is finite and in `[min, max]`; `range` is the text shown to the user.
+pub(crate) fn check_option(
+    name: &'static str,
+    value: f64,
+    min: f64,
+    max: f64,
+    range: &'static str,
+) -> Result<(), MultipoleError> {
+    if value.is_finite() && value >= min && value <= max {
+        Ok(())
+    } else {
+        Err(MultipoleError::InvalidOption { name, value, range })
     }
 }

@@ -8,7 +8,6 @@ pub mod sampling;
 pub mod skin;
 
 pub use diffusion::profile::Profile;
-pub use diffusion::spatial::ProfileOptions;
 pub use error::MultipoleError;
 pub use layered::{DEFAULT_G, Layer, LayeredMedium};
-pub use skin::{Method, SpectralProfiles};
+pub use skin::{Method, ProfileOptions, SpectralProfiles};

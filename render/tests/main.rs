@@ -3,7 +3,6 @@
 
 mod adaptive;
 mod fidelity;
-mod module_graph;
 mod passes;
 mod sampler;
 mod scene_presets;

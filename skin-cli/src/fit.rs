@@ -17,6 +17,8 @@ use skin_optics::echo::{Num, Text};
 use skin_optics::lab::Lab;
 use std::path::{Path, PathBuf};
 
+mod measured;
+
 /// Arguments of `skin fit`.
 #[derive(Args, Debug, Clone)]
 #[command(group(ArgGroup::new("target").required(true).args(["srgb", "lab", "spectrum"])))]
@@ -262,7 +264,7 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
     if let Some((target, text)) = colour {
         if args.geometry != Geometry::Sce || args.model != ModelChoice::Seed {
             let fit = fit_measured_colour(target, &measured_options(args, opts))?;
-            return super::fit_measured::report_colour(args, &text, &fit, &opts);
+            return measured::report_colour(args, &text, &fit, &opts);
         }
         let fit = fit_colour(target, &opts)?;
         let fitted_hex = hex_of(fit.xyz);
@@ -298,7 +300,7 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
         MeasuredSpectrum::parse_csv(&text).with_context(|| path.display().to_string())?;
     if args.geometry != Geometry::Sce || args.model != ModelChoice::Seed {
         let fit = fit_measured(&measured, &measured_options(args, opts))?;
-        return super::fit_measured::report(args, path, &measured, &fit, &opts);
+        return measured::report(args, path, &measured, &fit, &opts);
     }
     let fit = fit_spectrum(&measured, &opts)?;
     let fitted_hex = fit.lab.to_srgb().to_hex();

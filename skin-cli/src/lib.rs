@@ -4,7 +4,6 @@ pub mod args;
 pub mod brdf;
 pub mod export;
 pub mod fit;
-mod fit_measured;
 pub mod maps;
 pub mod presets;
 pub mod profile;

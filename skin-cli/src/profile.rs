@@ -6,12 +6,22 @@
 use crate::args::{Checked, SkinArgs, parse_in, parse_whole};
 use anyhow::Context;
 use clap::Args;
+use multipole::diffusion::spatial::DiffusionOptions;
 use multipole::skin::{DEFAULT_SHAPE_ESCAPES, ExactShape, Method, ShapeTableOptions, profile};
 use multipole::{Profile, ProfileOptions, SpectralProfiles};
 use skin_optics::{Wavelength, WavelengthGrid};
 use skin_plot::{LineChart, Panel, Series, palette_color, save_png};
 use std::io::{BufWriter, Write};
 use std::path::PathBuf;
+
+/// Where the exact profile's radial shape comes from (`--shape`).
+#[derive(clap::ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ShapeChoice {
+    /// The universal white Monte Carlo table, built once and cached.
+    Table,
+    /// A layered Monte Carlo run per wavelength (`--escapes`).
+    MonteCarlo,
+}
 
 /// Arguments of `skin profile`.
 #[derive(Args, Debug, Clone)]
@@ -48,8 +58,8 @@ pub struct ProfileArgs {
     pub method: Method,
     /// Shape of the exact profile: `table` (the default: the universal white Monte Carlo table,
     /// built once and cached) or `monte-carlo` (a layered Monte Carlo run per wavelength, --escapes).
-    #[arg(long, value_name = "SHAPE", default_value = "table", value_parser = ["table", "monte-carlo"])]
-    pub shape: String,
+    #[arg(long, value_name = "SHAPE", value_enum, default_value_t = ShapeChoice::Table)]
+    pub shape: ShapeChoice,
     /// Escaping photons of the exact profile's Monte Carlo shape (`--shape monte-carlo`), in
     /// [100, 1e9] (the accuracy knob: noise ∝ 1/√N; the photons traced are N divided by the skin's
     /// reflectance).
@@ -91,9 +101,10 @@ fn parse_method(s: &str) -> Result<Method, String> {
 /// `p` on `opts.radial_samples` geometric radii from 1e-3 mm to `opts.r_max_mm` (default: its own
 /// outer radius), as the diffusion tables are laid out; a Monte Carlo shape has its own grid.
 fn on_requested_radii(p: Profile, opts: &ProfileOptions) -> anyhow::Result<Profile> {
-    let n = opts.radial_samples;
+    let n = opts.diffusion.radial_samples;
     if p.radii_mm().len() == n
         && opts
+            .diffusion
             .r_max_mm
             .is_none_or(|r| (r - p.r_max_mm()).abs() < 1e-12)
     {
@@ -101,7 +112,10 @@ fn on_requested_radii(p: Profile, opts: &ProfileOptions) -> anyhow::Result<Profi
     }
     let (r0, r1) = (
         1e-3_f64,
-        opts.r_max_mm.unwrap_or_else(|| p.r_max_mm()).max(2e-3),
+        opts.diffusion
+            .r_max_mm
+            .unwrap_or_else(|| p.r_max_mm())
+            .max(2e-3),
     );
     let radii: Vec<f64> = (0..n)
         .map(|i| r0 * (r1 / r0).powf(i as f64 / (n - 1) as f64))
@@ -114,14 +128,16 @@ fn on_requested_radii(p: Profile, opts: &ProfileOptions) -> anyhow::Result<Profi
 pub fn run(args: &ProfileArgs) -> anyhow::Result<()> {
     let skin = args.skin.to_params()?;
     let opts = ProfileOptions {
-        radial_samples: args.samples,
-        r_max_mm: args.r_max,
-        exact_shape: if args.shape == "monte-carlo" {
-            ExactShape::MonteCarlo {
+        diffusion: DiffusionOptions {
+            radial_samples: args.samples,
+            r_max_mm: args.r_max,
+            ..DiffusionOptions::default()
+        },
+        exact_shape: match args.shape {
+            ShapeChoice::MonteCarlo => ExactShape::MonteCarlo {
                 escapes: args.escapes,
-            }
-        } else {
-            ExactShape::Table(ShapeTableOptions::default())
+            },
+            ShapeChoice::Table => ExactShape::Table(ShapeTableOptions::default()),
         },
         ..ProfileOptions::default()
     };

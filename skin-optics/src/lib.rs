@@ -4,6 +4,7 @@
 #![allow(rustdoc::broken_intra_doc_links)]
 
 pub mod chromophores;
+pub mod coefficients;
 pub mod color;
 pub mod echo;
 pub mod error;
@@ -17,7 +18,7 @@ mod table;
 mod test_util;
 pub mod units;
 
-pub use chromophores::{LayerCoefficients, SkinCoefficients};
+pub use coefficients::{LayerCoefficients, SkinCoefficients};
 pub use error::OpticsError;
 pub use params::{Preset, SkinParams};
 pub use physiology::{Extension, Physiology};

@@ -17,5 +17,6 @@ macro_rules! release_cases {
 
 mod exact;
 mod memory_bound;
+mod module_graph;
 mod montecarlo;
 mod properties;

@@ -1,6 +1,6 @@
 //! The inverse order-0 Hankel transform f(r) = (1/2π) ∫₀^∞ F(q) J0(qr) q dq (docs/physics.md §5).
 //!
-//! Method (chosen for speed with a measured error; see `ProfileOptions` and `skin::profile_error`):
+//! Method (chosen for speed with a measured error; see `DiffusionOptions` and `skin::profile_error`):
 //! only the *remainder* of a stack's spectrum is inverted numerically; the slowest-decaying part (the
 //! top layer's first source pair) is added back in closed form in r by `profile`. The remainder decays
 //! like e^(−a q) with a ≳ the smallest inter-layer path (≈ 0.3–0.5 mm for skin), so it needs q only up

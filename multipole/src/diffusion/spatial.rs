@@ -1,4 +1,4 @@
-//! From a layer stack's spectrum to its spatial [`Profile`]: the knobs ([`ProfileOptions`]), the
+//! From a layer stack's spectrum to its spatial [`Profile`]: the knobs ([`DiffusionOptions`]), the
 //! construction, and a converged reference to measure a knob setting's error against.
 //!
 //! R(r) = head(r) + remainder(r): the top layer's first source pair in closed form in r, plus the
@@ -12,16 +12,17 @@ use crate::diffusion::medium::pole_energy_within;
 use crate::diffusion::profile::Profile;
 use crate::diffusion::slab::Poles;
 use crate::diffusion::stack::{DiffusionLayer, Stack};
-use crate::error::{MultipoleError, check_range};
-use crate::skin::ExactShape;
+use crate::error::{MultipoleError, check_option, check_range};
 use std::f64::consts::PI;
 
 /// Smallest table radius, mm (docs/physics.md §8: from about 1e-3 mm).
 pub const R_MIN_MM: f64 = 1e-3;
 
-/// Knobs of a profile computation; every approximation here has one.
+/// Knobs of a diffusion profile computation (the multipole's poles, the radial table and the inverse
+/// Hankel transform); every approximation here has one. The exact method's knobs sit beside these in
+/// [`crate::skin::DiffusionOptions`].
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ProfileOptions {
+pub struct DiffusionOptions {
     /// Poles of each slab's multipole (default `Poles::Exact`).
     pub poles: Poles,
     /// Radial samples of the table, geometric from 1e-3 mm to the outer radius (default 256; ≥ 2).
@@ -36,21 +37,9 @@ pub struct ProfileOptions {
     pub transform_radii: usize,
     /// Spectrum cutoff: stop at Q where |F(Q)| Q² < tolerance × peak (default 1e-5; [1e-16, 0.1]).
     pub transform_tolerance: f64,
-    /// Shape of `Method::Exact` profiles (default [`ExactShape::Table`], the shape table); the other
-    /// fields are the diffusion knobs.
-    pub exact_shape: ExactShape,
-    /// Wavelength spacing of run-time Monte Carlo shapes ([`ExactShape::MonteCarlo`]) in
-    /// `SpectralProfiles`, nm (default 10; [0.01, 1000]):
-    /// rows between two shape wavelengths mix their unit-energy shapes linearly in λ, each row
-    /// scaled to its own exact total.
-    pub shape_step_nm: f64,
-    /// Henyey–Greenstein anisotropy g of both skin layers for `Method::Exact` (default
-    /// [`crate::DEFAULT_G`] = 0.9; [0, 0.99], adding-doubling's range): σs = σs'/(1 − g), the
-    /// totals and the exact shapes are computed at this g (diffusion sees only σs').
-    pub phase_g: f64,
 }
 
-impl Default for ProfileOptions {
+impl Default for DiffusionOptions {
     fn default() -> Self {
         Self {
             poles: Poles::Exact,
@@ -60,14 +49,11 @@ impl Default for ProfileOptions {
             transform_nodes: 5,
             transform_radii: 48,
             transform_tolerance: 1e-5,
-            exact_shape: ExactShape::default(),
-            shape_step_nm: 10.0,
-            phase_g: crate::DEFAULT_G,
         }
     }
 }
 
-impl ProfileOptions {
+impl DiffusionOptions {
     /// A converged setting used as the reference by `skin::profile_error` for the total and r₉₉ (Exact
     /// poles, 12 nodes per panel, 96 transform radii, tolerance 1e-13, 1024 radial samples; R(r) itself
     /// is compared with `reference_reflectance`).
@@ -84,50 +70,35 @@ impl ProfileOptions {
 
     /// Check every knob; the error names the knob and its range.
     pub fn validate(&self) -> Result<(), MultipoleError> {
-        let opt = |name, value: f64, min, max, range| {
-            if value.is_finite() && value >= min && value <= max {
-                Ok(())
-            } else {
-                Err(MultipoleError::InvalidOption { name, value, range })
-            }
-        };
-        opt("phase_g", self.phase_g, 0.0, 0.99, "[0, 0.99]")?;
-        opt(
-            "shape_step_nm",
-            self.shape_step_nm,
-            0.01,
-            1000.0,
-            "[0.01, 1000] nm",
-        )?;
-        opt(
+        check_option(
             "radial_samples",
             self.radial_samples as f64,
             2.0,
             1e6,
             "[2, 1e6]",
         )?;
-        opt(
+        check_option(
             "energy_fraction",
             self.energy_fraction,
             0.5,
             0.999_999,
             "[0.5, 0.999999]",
         )?;
-        opt(
+        check_option(
             "transform_nodes",
             self.transform_nodes as f64,
             1.0,
             64.0,
             "[1, 64]",
         )?;
-        opt(
+        check_option(
             "transform_radii",
             self.transform_radii as f64,
             2.0,
             4096.0,
             "[2, 4096]",
         )?;
-        opt(
+        check_option(
             "transform_tolerance",
             self.transform_tolerance,
             1e-16,
@@ -135,7 +106,7 @@ impl ProfileOptions {
             "[1e-16, 0.1]",
         )?;
         if let Poles::Count(n) = self.poles {
-            opt("poles", n as f64, 0.0, 1e5, "Count(0..=100000)")?;
+            check_option("poles", n as f64, 0.0, 1e5, "Count(0..=100000)")?;
         }
         if let Some(r) = self.r_max_mm {
             check_range("r_max (mm)", r, 2.0 * R_MIN_MM, 1e4, "[0.002, 1e4]")?;
@@ -153,7 +124,7 @@ struct Remainder {
 }
 
 impl Remainder {
-    fn compute(stack: &Stack, opts: &ProfileOptions, window: f64) -> Self {
+    fn compute(stack: &Stack, opts: &DiffusionOptions, window: f64) -> Self {
         let table = HankelTable::shared(opts.transform_nodes, opts.transform_radii);
         let radii: Vec<f64> = table.unit_radii().iter().map(|x| x * window).collect();
         let values = if stack.layers().len() == 1
@@ -226,7 +197,7 @@ fn window_estimate(stack: &Stack, fraction: f64) -> f64 {
 }
 
 /// The spatial profile of a stack with the knobs `opts` (module doc).
-pub fn stack_profile(stack: &Stack, opts: &ProfileOptions) -> Result<Profile, MultipoleError> {
+pub fn stack_profile(stack: &Stack, opts: &DiffusionOptions) -> Result<Profile, MultipoleError> {
     opts.validate()?;
     stack_profile_checked(stack, opts)
 }
@@ -235,7 +206,7 @@ pub fn stack_profile(stack: &Stack, opts: &ProfileOptions) -> Result<Profile, Mu
 /// knobs once).
 pub(crate) fn stack_profile_checked(
     stack: &Stack,
-    opts: &ProfileOptions,
+    opts: &DiffusionOptions,
 ) -> Result<Profile, MultipoleError> {
     let total = stack.total_reflectance(opts.poles);
     let cum = |rem: &Remainder, r: f64| head_cumulative(stack, r) + rem.cumulative(r);
@@ -337,7 +308,7 @@ mod tests {
         let d = Dipole::new(Medium::new(0.1, 1.0).unwrap(), 1.4).unwrap();
         let p = stack_profile(
             &Stack::new(vec![DiffusionLayer::SemiInfinite(d)]).unwrap(),
-            &ProfileOptions::default(),
+            &DiffusionOptions::default(),
         )
         .unwrap();
         for (r, v) in p.radii_mm().iter().zip(p.reflectance_per_mm2()) {
@@ -352,7 +323,7 @@ mod tests {
     fn default_knobs_are_within_their_stated_error_of_the_reference() {
         // Stated accuracy of the defaults (BENCHMARKS.md): energy-density error ≤ 1e-3 of the total.
         let st = skin_like(0.3, 0.05);
-        let p = stack_profile(&st, &ProfileOptions::default()).unwrap();
+        let p = stack_profile(&st, &DiffusionOptions::default()).unwrap();
         let radii: Vec<f64> = p.radii_mm().iter().step_by(8).copied().collect();
         let exact = reference_reflectance(&st, Poles::Exact, &radii);
         for (r, e) in radii.iter().zip(&exact) {
@@ -369,23 +340,23 @@ mod tests {
     fn options_are_validated() {
         let st = skin_like(0.3, 0.05);
         for bad in [
-            ProfileOptions {
+            DiffusionOptions {
                 radial_samples: 1,
                 ..Default::default()
             },
-            ProfileOptions {
+            DiffusionOptions {
                 transform_nodes: 0,
                 ..Default::default()
             },
-            ProfileOptions {
+            DiffusionOptions {
                 transform_tolerance: f64::NAN,
                 ..Default::default()
             },
-            ProfileOptions {
+            DiffusionOptions {
                 r_max_mm: Some(-1.0),
                 ..Default::default()
             },
-            ProfileOptions {
+            DiffusionOptions {
                 energy_fraction: 1.0,
                 ..Default::default()
             },
@@ -399,7 +370,7 @@ mod tests {
     fn explicit_outer_radius_is_respected() {
         let p = stack_profile(
             &skin_like(0.3, 0.05),
-            &ProfileOptions {
+            &DiffusionOptions {
                 r_max_mm: Some(3.0),
                 radial_samples: 64,
                 ..Default::default()

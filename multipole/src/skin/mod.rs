@@ -5,7 +5,7 @@ use crate::diffusion::boundary::observable_reflectance;
 use crate::diffusion::profile::Profile;
 use crate::diffusion::slab::Poles;
 use crate::diffusion::spatial::{
-    ProfileOptions, reference_reflectance, stack_profile, stack_profile_checked,
+    DiffusionOptions, reference_reflectance, stack_profile, stack_profile_checked,
 };
 use crate::diffusion::stack::Stack;
 use crate::error::MultipoleError;
@@ -16,9 +16,11 @@ use std::fmt;
 use std::str::FromStr;
 
 mod explain;
+mod options;
 mod shape;
 mod shape_table;
 pub use explain::{DIFFUSION_OK, Explanation, explain};
+pub use options::ProfileOptions;
 pub use shape::{
     DEFAULT_SHAPE_ESCAPES, ExactShape, MAX_SHAPE_PHOTONS, SHAPE_BINS, SHAPE_R_MAX_MM, SHAPE_R0_MM,
     SHAPE_SEED, exact_profile, layer_scales, medium_table_profile, monte_carlo_shape,
@@ -136,7 +138,7 @@ fn profile_checked(
 ) -> Result<Profile, MultipoleError> {
     match method {
         Method::Exact => exact_profile(skin, lambda, opts.exact_shape, opts),
-        Method::Multipole => stack_profile_checked(&stack(skin, lambda)?, opts),
+        Method::Multipole => stack_profile_checked(&stack(skin, lambda)?, &opts.diffusion),
     }
 }
 
@@ -261,8 +263,8 @@ pub fn profile_error(
 ) -> Result<KnobError, MultipoleError> {
     let _ = method;
     let st = stack(skin, lambda)?;
-    let test = stack_profile(&st, opts)?;
-    let reference = stack_profile(&st, &ProfileOptions::reference())?;
+    let test = stack_profile(&st, &opts.diffusion)?;
+    let reference = stack_profile(&st, &DiffusionOptions::reference())?;
     let r_hi = test.r_max_mm().min(reference.r_max_mm());
     let n = 400;
     let radii: Vec<f64> = (0..n)

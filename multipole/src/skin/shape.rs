@@ -7,12 +7,13 @@ use super::{Method, stack, total_reflectance_at_g};
 use crate::diffusion::boundary::observable_reflectance;
 use crate::diffusion::profile::Profile;
 use crate::diffusion::slab::Poles;
-use crate::diffusion::spatial::{ProfileOptions, stack_profile};
+use crate::diffusion::spatial::stack_profile;
 use crate::diffusion::stack::Response;
 use crate::error::MultipoleError;
 use crate::exact::adding_doubling::{AddingDoublingOptions, LayerTotals, skin_layer_totals};
 use crate::exact::montecarlo::{self, McOptions, RadialGrid};
 use crate::layered::LayeredMedium;
+use crate::skin::ProfileOptions;
 use skin_optics::{SkinParams, Wavelength};
 
 /// Escaping photons per wavelength of a run-time Monte Carlo shape, and of the fallback where the
@@ -117,13 +118,13 @@ pub fn exact_profile(
     let g = opts.phase_g;
     let (table, total) = match shape {
         ExactShape::RescaledTotal => (
-            stack_profile(&stack(skin, lambda)?, opts)?,
+            stack_profile(&stack(skin, lambda)?, &opts.diffusion)?,
             total_reflectance_at_g(skin, lambda, Method::Exact, g)?,
         ),
         ExactShape::PerLayer => {
             let (scales, exact) = layer_scales(skin, lambda)?;
             let st = stack(skin, lambda)?.with_scales(scales)?;
-            (stack_profile(&st, opts)?, exact.total)
+            (stack_profile(&st, &opts.diffusion)?, exact.total)
         }
         ExactShape::MonteCarlo { escapes } => {
             let total = total_reflectance_at_g(skin, lambda, Method::Exact, g)?;

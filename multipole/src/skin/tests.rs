@@ -152,12 +152,12 @@ fn every_preset_profile_is_finite_non_negative_and_holds_its_energy() {
 fn knob_error_shrinks_with_resolution() {
     let skin = SkinParams::preset(Preset::Light);
     let lambda = Wavelength::new(650.0).unwrap();
-    let coarse = ProfileOptions {
+    let coarse = ProfileOptions::with_diffusion(DiffusionOptions {
         radial_samples: 32,
         transform_nodes: 2,
         transform_radii: 12,
         ..Default::default()
-    };
+    });
     let e_coarse = profile_error(&skin, lambda, Method::Multipole, &coarse).unwrap();
     let e_default =
         profile_error(&skin, lambda, Method::Multipole, &ProfileOptions::default()).unwrap();
@@ -166,10 +166,10 @@ fn knob_error_shrinks_with_resolution() {
         e_coarse.max_energy_density_error > 3.0 * e_default.max_energy_density_error,
         "{e_coarse:?}"
     );
-    let few = ProfileOptions {
+    let few = ProfileOptions::with_diffusion(DiffusionOptions {
         poles: Poles::Count(0),
         ..Default::default()
-    };
+    });
     assert!(
         profile_error(&skin, lambda, Method::Multipole, &few)
             .unwrap()

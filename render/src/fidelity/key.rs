@@ -14,6 +14,7 @@
 use super::StepChoice;
 use crate::bssrdf::TableOptions;
 use multipole::diffusion::slab::Poles;
+use multipole::diffusion::spatial::DiffusionOptions;
 use multipole::skin::{ExactShape, ShapeTableOptions};
 use multipole::{Method, ProfileOptions};
 use skin_optics::SkinParams;
@@ -131,13 +132,16 @@ fn table(b: &mut Bytes, opts: &TableOptions) {
 
 fn profile(b: &mut Bytes, p: &ProfileOptions) {
     let ProfileOptions {
-        poles,
-        radial_samples,
-        r_max_mm,
-        energy_fraction,
-        transform_nodes,
-        transform_radii,
-        transform_tolerance,
+        diffusion:
+            DiffusionOptions {
+                poles,
+                radial_samples,
+                r_max_mm,
+                energy_fraction,
+                transform_nodes,
+                transform_radii,
+                transform_tolerance,
+            },
         exact_shape,
         shape_step_nm,
         phase_g,

@@ -29,15 +29,15 @@ fn multipole_settings() -> Vec<(&'static str, String, ProfileOptions)> {
     type Set = fn(&mut ProfileOptions, usize);
     let knobs: [(&str, &[usize], Set); 3] = [
         ("poles", &[0, 1, 2, 3, 5, 10], |o, n| {
-            o.poles = Poles::Count(n)
+            o.diffusion.poles = Poles::Count(n)
         }),
         (
             "radial samples",
             &[16, 32, 64, 128, 256, 512, 1024],
-            |o, n| o.radial_samples = n,
+            |o, n| o.diffusion.radial_samples = n,
         ),
         ("transform nodes", &[1, 2, 3, 5, 8, 16], |o, n| {
-            o.transform_nodes = n
+            o.diffusion.transform_nodes = n
         }),
     ];
     let mut v = Vec::new();

@@ -251,8 +251,11 @@ fn thin_slabs_are_non_negative_and_conserve_energy() {
             crate::diffusion::stack::DiffusionLayer::SemiInfinite(dermis),
         ])
         .unwrap();
-        let p = crate::diffusion::spatial::stack_profile(&st, &crate::ProfileOptions::default())
-            .unwrap();
+        let p = crate::diffusion::spatial::stack_profile(
+            &st,
+            &crate::diffusion::spatial::DiffusionOptions::default(),
+        )
+        .unwrap();
         assert_eq!(p.clamped_samples(), 0, "{mfp} mfp");
         assert!(p.total() > 0.0 && p.total() < 1.0);
         // Spatial diffuse T plus the delta equals the transform's total.

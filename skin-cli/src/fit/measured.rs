@@ -2,7 +2,7 @@
 //! or `--model full|auto`), to a spectrum or a colour: the free parameters, the surface term, the
 //! selection.
 
-use super::fit::{FitArgs, colour_line, lab_json, params_json, skin_line, within_tolerance};
+use super::{FitArgs, colour_line, lab_json, params_json, skin_line, within_tolerance};
 use skin_fit::{
     FitOptions, MeasuredColourFit, MeasuredFit, MeasuredSpectrum, Parameter, SelectionStep,
 };

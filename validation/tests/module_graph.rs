@@ -1,7 +1,7 @@
-//! No import circle between `render`'s top-level modules (the same check as
+//! No import circle between the top-level modules of any crate of the workspace (the same check as
 //! `scripts/module_graph.py`, which also prints the graph): a new circle fails here.
 //!
-//! Reads this crate's own `src/` (its manifest folder), not any outside data. Comments, string
+//! Reads the workspace's own `*/src/` folders (beside this crate's manifest), not any outside data. Comments, string
 //! literals and `#[cfg(test)]` modules at the end of a file are left out: the graph is the one the
 //! library compiles.
 
@@ -155,9 +155,17 @@ fn find_cycle(g: &BTreeMap<String, BTreeSet<String>>) -> Option<Vec<String>> {
     None
 }
 
+/// The workspace folder: this crate's manifest folder's parent.
+fn workspace() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("validation sits in the workspace")
+        .to_path_buf()
+}
+
 #[test]
 fn render_modules_import_one_way() {
-    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let src = workspace().join("render/src");
     let g = graph(&src);
     assert!(
         g.len() > 20,
@@ -172,4 +180,35 @@ fn render_modules_import_one_way() {
     closed.get_mut("scene").unwrap().insert("integrator".into());
     assert!(find_cycle(&closed).is_some());
     assert_eq!(find_cycle(&g), None, "{g:?}");
+}
+
+#[test]
+fn every_crates_modules_import_one_way() {
+    let crates = [
+        "skin-optics",
+        "brdf",
+        "skin-io",
+        "multipole",
+        "skin-fit",
+        "skin-export",
+        "skin-plot",
+        "skin-cli",
+        "validation",
+        "python",
+    ];
+    for name in crates {
+        let src = workspace().join(name).join("src");
+        let g = graph(&src);
+        assert!(
+            g.len() >= 2,
+            "{} modules found in {}",
+            g.len(),
+            src.display()
+        );
+        assert_eq!(find_cycle(&g), None, "{name}: {g:?}");
+    }
+    // multipole's methods sit side by side: the skin model builds on diffusion, never the reverse.
+    let g = graph(&workspace().join("multipole/src"));
+    assert!(g["skin"].contains("diffusion"), "{g:?}");
+    assert!(!g["diffusion"].contains("skin"), "{g:?}");
 }
