@@ -12,6 +12,7 @@ pub mod geometry;
 pub mod integrator;
 pub mod light;
 pub mod material;
+pub mod media;
 pub mod mesh;
 pub mod noise;
 pub mod passes;

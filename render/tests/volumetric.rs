@@ -204,8 +204,9 @@ fn one_wavelength_black_absorber_is_exactly_fresnel() {
             skin.surface.clone(),
             SpectrumTable::constant(0.0),
             None,
+            skin.media.clone(),
         )
-        .with_surface_kind(SurfaceKind::Smooth, 0.9);
+        .with_surface_kind(SurfaceKind::Smooth);
         scene.materials[0] = Material::Skin(black);
         let body = BodyIntegrator::build(&scene, IntegratorKind::Bssrdf).unwrap();
         let film = render_mono(&scene, &body, 4, 16, 9);

@@ -90,16 +90,27 @@ pub fn total_reflectance_at_g(
     method: Method,
     g: f64,
 ) -> Result<f64, MultipoleError> {
+    medium_total_reflectance(&LayeredMedium::skin(skin, lambda, g)?, method)
+}
+
+/// [`total_reflectance`] of a skin whose layers are already built (`LayeredMedium::skin`, at its
+/// layers' own g): adding-doubling of `medium`'s totals per unit flux entering, R_d / (1 − R_spec),
+/// or the multipole stack of its σa and σs' ([DJ06] eq. 9 at q = 0).
+pub fn medium_total_reflectance(
+    medium: &LayeredMedium,
+    method: Method,
+) -> Result<f64, MultipoleError> {
+    use crate::exact::adding_doubling::{AddingDoublingOptions, DEFAULT_QUADRATURE_POINTS, solve};
     match method {
-        Method::Exact => Ok(crate::exact::adding_doubling::skin_total_reflectance(
-            skin,
-            lambda,
-            &crate::exact::adding_doubling::AddingDoublingOptions::new(
-                crate::exact::adding_doubling::DEFAULT_QUADRATURE_POINTS,
-                g,
-            )?,
-        )?),
-        Method::Multipole => Ok(stack(skin, lambda)?.total_reflectance(Poles::Exact)),
+        Method::Exact => {
+            let g = medium.layers().first().map_or(DEFAULT_G, |l| l.g());
+            let t = solve(
+                medium,
+                &AddingDoublingOptions::new(DEFAULT_QUADRATURE_POINTS, g)?,
+            )?;
+            Ok(t.diffuse_reflectance / (1.0 - t.specular_reflectance))
+        }
+        Method::Multipole => Ok(Stack::from_medium(medium)?.total_reflectance(Poles::Exact)),
     }
 }
 

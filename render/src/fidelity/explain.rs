@@ -2,10 +2,10 @@
 //! for diffusion inside its known failure region (docs/physics.md §9, §16).
 
 use super::photons::PhotonChoice;
-use super::wavelengths::FROM_NM;
 use super::{Fidelity, Lod, WavelengthChoice};
+use crate::media::SkinMedia;
+use multipole::Method;
 use multipole::skin::DIFFUSION_OK;
-use multipole::{LayeredMedium, Method, MultipoleError};
 use skin_io::cache::CacheOutcome;
 use skin_optics::{SkinParams, Wavelength};
 use std::fmt::Write;
@@ -36,26 +36,14 @@ impl TransportChoice {
         }
     }
 
-    /// The BSSRDF with the dermis' largest transport mean free path of `params` (every 10 nm,
-    /// the layers at the material's Henyey–Greenstein `phase_g`), and the walk below
-    /// `walk_below_mm`.
-    pub fn bssrdf(
-        params: &SkinParams,
-        phase_g: f64,
-        walk_below_mm: Option<f32>,
-    ) -> Result<Self, MultipoleError> {
-        let mut transport_mfp_mm = 0.0f64;
-        for i in 0..=40 {
-            let lambda = Wavelength::new(FROM_NM + 10.0 * f64::from(i))?;
-            let medium = LayeredMedium::skin(params, lambda, phase_g)?;
-            if let Some(d) = medium.layers().last() {
-                transport_mfp_mm = transport_mfp_mm.max(1.0 / (d.sigma_a() + d.sigma_s_prime()));
-            }
-        }
-        Ok(Self::Bssrdf {
-            transport_mfp_mm,
+    /// The BSSRDF with the dermis' largest transport mean free path of the material's layers
+    /// `media`, and the walk below `walk_below_mm`.
+    #[must_use]
+    pub fn bssrdf(media: &SkinMedia, walk_below_mm: Option<f32>) -> Self {
+        Self::Bssrdf {
+            transport_mfp_mm: media.largest_transport_mfp_mm,
             walk_below_mm,
-        })
+        }
     }
 }
 
@@ -70,22 +58,22 @@ pub struct DiffusionFailures {
     pub layers: Vec<&'static str>,
 }
 
-/// Where multipole diffusion misses the exact (adding-doubling) total of `params` by 2% or more,
-/// every 10 nm over 380–780 nm, and which layers' own totals are off there
-/// (`multipole::skin::layer_scales`); `None` where it is accurate everywhere.
+/// Where multipole diffusion misses the exact (adding-doubling) total of the skin `params`, whose
+/// layers at the material's g are `media`, by 2% or more, every 10 nm over 380–780 nm, and which
+/// layers' own totals are off there (`multipole::skin::layer_scales`); `None` where it is accurate
+/// everywhere.
 #[must_use]
-pub fn diffusion_failures(params: &SkinParams) -> Option<DiffusionFailures> {
+pub fn diffusion_failures(params: &SkinParams, media: &SkinMedia) -> Option<DiffusionFailures> {
     let mut out = DiffusionFailures {
         wavelengths_nm: Vec::new(),
         worst: 0.0,
         layers: Vec::new(),
     };
-    for i in 0..=40 {
-        let nm = FROM_NM + 10.0 * f64::from(i);
+    for (nm, medium) in media.every_10nm() {
         let Ok(l) = Wavelength::new(nm) else { continue };
         let (Ok(m), Ok(e)) = (
-            multipole::skin::total_reflectance(params, l, Method::Multipole),
-            multipole::skin::total_reflectance(params, l, Method::Exact),
+            multipole::skin::medium_total_reflectance(medium, Method::Multipole),
+            multipole::skin::medium_total_reflectance(medium, Method::Exact),
         ) else {
             continue;
         };
@@ -316,7 +304,9 @@ mod tests {
     /// BENCHMARKS.md): it is flagged with its blue wavelengths; ranges print compactly.
     #[test]
     fn diffusion_failures_name_wavelengths_and_layers() {
-        let f = diffusion_failures(&SkinParams::preset(Preset::Dark)).expect("dark fails");
+        let dark = SkinParams::preset(Preset::Dark);
+        let media = SkinMedia::new(&dark, multipole::DEFAULT_G).unwrap();
+        let f = diffusion_failures(&dark, &media).expect("dark fails");
         assert!(f.wavelengths_nm.contains(&400.0), "{f:?}");
         assert!(f.worst > 0.5 && !f.layers.is_empty(), "{f:?}");
         assert_eq!(ranges_nm(&[380.0, 390.0, 400.0, 600.0]), "380–400, 600 nm");

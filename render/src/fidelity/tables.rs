@@ -7,6 +7,7 @@ use super::photons::{self, PhotonChoice};
 use super::wavelengths::{self, WavelengthChoice};
 use super::{FidelityKnobs, Lod, PhotonPolicy, Resolved, StepChoice};
 use crate::bssrdf::{ProfileTable, TableOptions};
+use crate::media::SkinMedia;
 use multipole::skin::{ExactShape, ShapeTableOptions};
 use multipole::{Method, MultipoleError};
 use serde::{Deserialize, Serialize};
@@ -52,16 +53,18 @@ fn table_options(resolved: &Resolved, shapes: Shapes, phase_g: f64, step_nm: f64
     opts
 }
 
-/// Build (or read from the cache) the profile table of `params` with `method`, the shape knob
-/// the layers' Henyey–Greenstein `phase_g` and the fidelity `knobs`, and record the choices.
+/// Build (or read from the cache) the profile table of `params` (whose layers at their
+/// Henyey–Greenstein g are `media`) with `method`, the shape knob and the fidelity `knobs`, and
+/// record the choices.
 pub fn skin_table(
     params: &SkinParams,
+    media: &SkinMedia,
     method: Method,
     shape_escapes: Option<u64>,
-    phase_g: f64,
     knobs: &FidelityKnobs,
 ) -> Result<(ProfileTable, SkinChoices), MultipoleError> {
     let t0 = Instant::now();
+    let phase_g = media.phase_g;
     let resolved = knobs.resolve().map_err(|e| MultipoleError::InvalidOption {
         name: e.name,
         value: e.value,
@@ -146,14 +149,13 @@ pub fn skin_table(
             band,
         }),
         transport: TransportChoice::bssrdf(
-            params,
-            phase_g,
+            media,
             resolved.thin_walk_r99.map(|k| k as f32 * r99_mm),
-        )?,
+        ),
         cache: outcome,
         build_ms: 1e3 * t0.elapsed().as_secs_f64(),
         diffusion_failures: (method == Method::Multipole)
-            .then(|| diffusion_failures(params))
+            .then(|| diffusion_failures(params, media))
             .flatten(),
     };
     Ok((table, choices))
@@ -203,9 +205,9 @@ mod tests {
         let build = || {
             let (t, c) = skin_table(
                 params,
+                &SkinMedia::new(params, multipole::DEFAULT_G).unwrap(),
                 Method::Exact,
                 None,
-                multipole::DEFAULT_G,
                 &FidelityKnobs {
                     cache: false,
                     ..knobs

@@ -325,11 +325,14 @@ mod tests {
     use rand_xoshiro::Xoshiro256PlusPlus;
 
     fn skin(rd: f32) -> Material {
+        let params = skin_optics::SkinParams::preset(skin_optics::Preset::Light);
+        let media = crate::media::SkinMedia::new(&params, multipole::DEFAULT_G).unwrap();
         Material::Skin(SkinMaterial::new(
-            skin_optics::SkinParams::preset(skin_optics::Preset::Light),
+            params,
             TorranceSparrow::new(0.3, 0.25, 1.4).unwrap(),
             SpectrumTable::constant(rd),
             None,
+            std::sync::Arc::new(media),
         ))
     }
 

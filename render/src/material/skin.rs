@@ -10,14 +10,15 @@
 
 use crate::bssrdf::{Directional, EnergySplit, Subsurface};
 use crate::fidelity::SKIN_TABLE_STEP_NM;
-use crate::fidelity::wavelengths::{FROM_NM, TO_NM};
+use crate::fidelity::wavelengths::FROM_NM;
 use crate::material::{SurfaceKind, TextureRef};
+use crate::media::{MediaError, SkinMedia};
 use crate::spectrum::{LAMBDA_MIN_NM, SpectrumTable};
 use crate::texture::Texture;
 use brdf::TorranceSparrow;
 use glam::Vec2;
 use rayon::prelude::*;
-use skin_optics::{SkinParams, Wavelength};
+use skin_optics::SkinParams;
 use std::sync::Arc;
 use thiserror::Error;
 
@@ -61,9 +62,9 @@ pub enum SkinBuildError {
         /// What the model reported.
         source: multipole::MultipoleError,
     },
-    /// A wavelength of the table is outside the model's range.
+    /// The skin's layers could not be built at a wavelength.
     #[error("{0}")]
-    Wavelength(String),
+    Media(#[from] MediaError),
     /// A total came out outside [0, 1] (a model failure, never silently clamped).
     #[error("skin reflectance {0} outside [0, 1]")]
     OutOfRange(f64),
@@ -89,8 +90,9 @@ pub struct SkinMaterial {
     pub choices: Option<Box<crate::fidelity::SkinChoices>>,
     /// The surface model: the oily lobe `surface`, or a smooth dielectric of index `surface.eta()`.
     pub surface_kind: SurfaceKind,
-    /// Henyey–Greenstein g of both layers (what the totals, the shapes and the volumetric walk use).
-    pub phase_g: f64,
+    /// Both layers' coefficients at the skin's Henyey–Greenstein g, built once: what the totals,
+    /// the shapes and the volumetric walks use.
+    pub media: Arc<SkinMedia>,
 }
 
 impl SkinMaterial {
@@ -106,16 +108,17 @@ impl SkinMaterial {
         let surface =
             TorranceSparrow::new(roughness_m, params.oiliness() as f32, params.eta() as f32)?;
         let g = knobs.phase_g.unwrap_or(multipole::DEFAULT_G);
+        let media = Arc::new(SkinMedia::new(&params, g)?);
         if knobs.no_subsurface {
-            let totals = total_table(&params, knobs.method, g)?;
-            return Ok(Self::new(params, surface, totals, albedo_texture)
-                .with_surface_kind(knobs.surface, g));
+            let totals = total_table(&media, knobs.method)?;
+            return Ok(Self::new(params, surface, totals, albedo_texture, media)
+                .with_surface_kind(knobs.surface));
         }
         let (table, choices) = crate::fidelity::tables::skin_table(
             &params,
+            &media,
             knobs.method,
             knobs.shape_escapes,
-            g,
             &knobs.fidelity,
         )
         .map_err(SkinBuildError::Profiles)?;
@@ -133,20 +136,21 @@ impl SkinMaterial {
         };
         let directional = Directional::new(surface.clone(), split);
         let subsurface = Subsurface::new(Arc::new(table), directional);
-        let mut skin = Self::new(params, surface, totals, albedo_texture)
-            .with_surface_kind(knobs.surface, g)
+        let mut skin = Self::new(params, surface, totals, albedo_texture, media)
+            .with_surface_kind(knobs.surface)
             .with_subsurface(subsurface);
         skin.choices = Some(Box::new(choices));
         Ok(skin)
     }
 
-    /// Skin from its parameters, surface lobe and R_d(λ) table (no BSSRDF).
+    /// Skin from its parameters, surface lobe, R_d(λ) table and layers (no BSSRDF).
     #[must_use]
     pub fn new(
         params: SkinParams,
         surface: TorranceSparrow,
         total_reflectance: SpectrumTable,
         albedo_texture: Option<TextureRef>,
+        media: Arc<SkinMedia>,
     ) -> Self {
         // Midpoint rule in μ = cosθ; T is smooth, 256 nodes are far below f32 noise.
         let n = 256;
@@ -165,16 +169,15 @@ impl SkinMaterial {
             subsurface: None,
             choices: None,
             surface_kind: SurfaceKind::Oily,
-            phase_g: multipole::DEFAULT_G,
+            media,
         }
     }
 
-    /// The same skin with surface model `kind` and layer anisotropy `phase_g` (T̄ recomputed for
-    /// the smooth surface's Fresnel split, T = 1 − F(θ)).
+    /// The same skin with surface model `kind` (T̄ recomputed for the smooth surface's Fresnel
+    /// split, T = 1 − F(θ)).
     #[must_use]
-    pub fn with_surface_kind(mut self, kind: SurfaceKind, phase_g: f64) -> Self {
+    pub fn with_surface_kind(mut self, kind: SurfaceKind) -> Self {
         self.surface_kind = kind;
-        self.phase_g = phase_g;
         if kind == SurfaceKind::Smooth {
             let eta = self.surface.eta();
             let n = 256;
@@ -210,21 +213,18 @@ impl SkinMaterial {
     }
 }
 
-/// R_tot(λ) of `params` with `method` and HG anisotropy `g` at [`SKIN_TABLE_STEP_NM`] steps over 380–780 nm, computed in
-/// parallel and interpolated linearly.
+/// R_tot(λ) of the skin layers `media` with `method` every 10 nm ([`SKIN_TABLE_STEP_NM`]) over
+/// 380–780 nm, computed in parallel and interpolated linearly.
 fn total_table(
-    params: &SkinParams,
+    media: &SkinMedia,
     method: multipole::Method,
-    g: f64,
 ) -> Result<SpectrumTable, SkinBuildError> {
-    let n = ((TO_NM - FROM_NM) / SKIN_TABLE_STEP_NM) as usize + 1;
-    let rd = (0..n)
+    let rows: Vec<(f64, &multipole::LayeredMedium)> = media.every_10nm().collect();
+    let n = rows.len();
+    let rd = rows
         .into_par_iter()
-        .map(|i| {
-            let nm = FROM_NM + SKIN_TABLE_STEP_NM * i as f64;
-            let lambda =
-                Wavelength::new(nm).map_err(|e| SkinBuildError::Wavelength(e.to_string()))?;
-            multipole::skin::total_reflectance_at_g(params, lambda, method, g)
+        .map(|(nm, medium)| {
+            multipole::skin::medium_total_reflectance(medium, method)
                 .map_err(|source| SkinBuildError::Reflectance { nm, source })
         })
         .collect::<Result<Vec<f64>, _>>()?;

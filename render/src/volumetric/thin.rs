@@ -22,7 +22,7 @@
 //! paths. There the hit keeps the BSSRDF and no probe ray is traced, as the level of detail
 //! (`crate::fidelity::lod`) keeps no profile the footprint cannot resolve.
 
-use super::{LayerTables, SkinVolume, VolumetricError, layer_tables};
+use super::{LayerTables, SkinVolume, VolumetricError};
 use crate::geometry::{Geometry, SurfaceHit, offset_origin};
 use crate::material::Material;
 use crate::scene::Scene;
@@ -58,7 +58,7 @@ impl ThinParts {
     /// when none does.
     pub fn build(scene: &Scene) -> Result<Option<Self>, VolumetricError> {
         let mut parts = Vec::with_capacity(scene.materials.len());
-        for (index, m) in scene.materials.iter().enumerate() {
+        for m in &scene.materials {
             let below = match m {
                 Material::Skin(s) if s.subsurface.is_some() => {
                     s.choices.as_ref().and_then(|c| c.transport.walk_below_mm())
@@ -69,19 +69,11 @@ impl ThinParts {
                 parts.push(None);
                 continue;
             };
-            let (epidermis, dermis) =
-                layer_tables(&skin.params, skin.phase_g).map_err(|(nm, source)| {
-                    VolumetricError::Layers {
-                        material: scene.material_names[index].clone(),
-                        nm,
-                        source,
-                    }
-                })?;
             parts.push(Some(ThinPart {
                 walk_below_mm,
-                epidermis,
-                dermis,
-                phase_g: skin.phase_g,
+                epidermis: skin.media.epidermis.clone(),
+                dermis: skin.media.dermis.clone(),
+                phase_g: skin.media.phase_g,
                 eta: skin.params.eta() as f32,
                 d_epi_mm: skin.params.epidermis_thickness_mm() as f32,
                 volume: OnceLock::new(),
