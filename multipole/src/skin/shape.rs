@@ -131,8 +131,10 @@ pub fn exact_profile(
             return shape_profile(&monte_carlo_shape(skin, lambda, g, escapes, total)?, total);
         }
         ExactShape::Table(table_opts) => {
-            let total = total_reflectance_at_g(skin, lambda, Method::Exact, g)?;
-            if let Some(p) = table_profile(skin, lambda, g, &table_opts, total)? {
+            // One medium for the total and the shape: the coefficients are built once.
+            let medium = LayeredMedium::skin(skin, lambda, g)?;
+            let total = super::medium_total_reflectance(&medium, Method::Exact)?;
+            if let Some(p) = medium_table_profile(&medium, &table_opts, total)? {
                 return Ok(p);
             }
             let escapes = DEFAULT_SHAPE_ESCAPES;
