@@ -13,7 +13,8 @@ use std::path::PathBuf;
 /// Arguments of `skin export`.
 #[derive(Args, Debug, Clone)]
 pub struct ExportArgs {
-    /// Format: openpbr, standard-surface, unreal, hdrp, gaussians, burley, pbrt, mitsuba, mcml, mcx.
+    /// Format: openpbr, standard-surface, unreal, hdrp, gaussians, burley, pbrt, mitsuba, mcml, mcx,
+    /// blender (a bpy script), blender-json (its values).
     #[arg(value_name = "FORMAT")]
     pub format: String,
     /// The skin (preset and/or fractions).
@@ -56,13 +57,13 @@ pub struct ExportArgs {
         default_value = "lin_rec709"
     )]
     pub colour_space: String,
-    /// Length of one scene unit in mm (OpenPBR, Standard Surface, pbrt, Mitsuba), [1e-6, 1e6].
+    /// Length of one scene unit in mm (OpenPBR, Standard Surface, pbrt, Mitsuba, Blender), [1e-6, 1e6].
     #[arg(long = "unit-mm", value_name = "MM", default_value_t = 1.0)]
     pub unit_mm: f64,
     /// Photons per run written into MCML / MCX inputs, [1, 2e9].
     #[arg(long, value_name = "N", default_value_t = ExportOptions::default().photons)]
     pub photons: u64,
-    /// Monte Carlo histories per channel for the OpenPBR / Standard Surface medium and pbrt's shape check.
+    /// Monte Carlo histories per channel for the OpenPBR / Standard Surface medium, Cycles' walk medium and pbrt's shape check.
     #[arg(long = "volume-photons", value_name = "N", default_value_t = ExportOptions::default().volume_photons)]
     pub volume_photons: u64,
     /// Gaussians written by `gaussians`, [1, 8] (4, 5 and 6 are always reported).
@@ -77,7 +78,7 @@ pub struct ExportArgs {
     /// Write a complete scene (camera and uniform sky) that renders as is (mitsuba).
     #[arg(long)]
     pub scene: bool,
-    /// Finite dermis thickness for MCML, MCX and Mitsuba, mm, [1, 1000].
+    /// Finite dermis thickness for MCML, MCX, Mitsuba and Blender's volume, mm, [1, 1000].
     #[arg(long = "dermis-mm", value_name = "MM", default_value_t = ExportOptions::default().dermis_thickness_mm)]
     pub dermis_mm: f64,
 }

@@ -369,6 +369,8 @@ fn what_a_format_cannot_carry_is_refused() {
         Format::Mcx,
         Format::Mcml,
         Format::Mitsuba,
+        Format::Blender,
+        Format::BlenderJson,
     ] {
         let err = skin_export::export(&s, format, &aces).unwrap_err();
         assert!(
@@ -384,6 +386,62 @@ fn what_a_format_cannot_carry_is_refused() {
     };
     let err = skin_export::export(&s, Format::Mitsuba, &mono).unwrap_err();
     assert!(err.to_string().contains("[360, 830] nm"), "{err}");
+    // The Cycles table was measured at η = 1.4 only.
+    let other_eta = s.with_eta(1.33).unwrap();
+    let err = skin_export::export(&other_eta, Format::BlenderJson, &opts()).unwrap_err();
+    assert!(err.to_string().contains("1.4"), "{err}");
+    let err = "blender-yaml".parse::<Format>().unwrap_err();
+    assert!(err.to_string().contains("blender-json"), "{err}");
+}
+
+#[test]
+fn blender_values_return_our_diffuse_reflectance_through_the_cycles_table() {
+    use skin_export::blender::{Calibration, CyclesMethod, cycles_albedo, cycles_radius_mm};
+    let s = skin();
+    let values = json(&skin_export::export(&s, Format::BlenderJson, &opts()).unwrap().text);
+    let script = skin_export::export(&s, Format::Blender, &opts()).unwrap().text;
+    // The script carries the same values (its VALUES block) and builds the material by name.
+    let block = script.split("r\"\"\"").nth(1).unwrap().split("\"\"\"").next().unwrap();
+    let mut from_script = json(block);
+    let mut plain = values.clone();
+    from_script.as_object_mut().unwrap().remove("notes");
+    plain.as_object_mut().unwrap().remove("notes");
+    assert_eq!(from_script, plain);
+    assert!(script.contains("def subsurface_material(") && script.contains("def volume_slab("));
+    // Target: our diffuse reflectance per incident photon = total per entering × (1 − F(0)).
+    let f0 = skin_export::Surface::of(&s).f0();
+    let target: Vec<f64> = rgb().totals().iter().map(|t| t * (1.0 - f0)).collect();
+    for (c, t) in target.iter().enumerate() {
+        assert!(close(values["target_diffuse_reflectance"][c].as_f64().unwrap(), *t, 1e-12));
+    }
+    for method in CyclesMethod::ALL {
+        let v = &values["principled"][method.identifier()];
+        let cal = Calibration::committed(method).unwrap();
+        let scale = v["subsurface_scale"].as_f64().unwrap();
+        for c in 0..3 {
+            let base = v["base_color"][c].as_f64().unwrap();
+            // The measured curve at the written Base Color is the target (bisection to 1e-12).
+            assert!(close(cal.reflectance(base), target[c], 1e-9), "{method} {c}");
+            // Radius × Scale is Cycles' conversion of a reduced mean free path d > 0 whose walk
+            // albedo is Cycles' remap of that Base Color.
+            let radius = v["subsurface_radius"][c].as_f64().unwrap() * scale;
+            let d = radius / cycles_radius_mm(method, 1.0, base, 1.4);
+            assert!(d > 0.0 && d < 10.0, "{method} {c}: d = {d} mm");
+            assert!(
+                (v["walk_single_scattering_albedo"][c].as_f64().unwrap() - cycles_albedo(base, 0.0))
+                    .abs()
+                    < 1e-12
+            );
+        }
+    }
+    // The volume's layers return our per-entering totals (adding-doubling, bisection).
+    for c in 0..3 {
+        let total = values["volume"]["per_entering_totals"][c].as_f64().unwrap();
+        assert!(close(total, rgb().totals()[c], 1e-6), "{c}: {total}");
+        let e = &values["volume"]["epidermis"];
+        let a = e["color"][c].as_f64().unwrap();
+        assert!(a > 0.9 && a < 1.0 && e["density"].as_f64().unwrap() > 1.0);
+    }
 }
 
 #[test]
@@ -710,4 +768,57 @@ fn bad_input_ends_in_one_line_naming_the_problem() {
         "{stderr}"
     );
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The Python that has the engines: $SKIN_ENGINES_PYTHON, else python3.
+fn engines_python() -> String {
+    std::env::var("SKIN_ENGINES_PYTHON").unwrap_or_else(|_| "python3".into())
+}
+
+#[test]
+fn materialx_documents_pass_materialx_own_checks_where_it_is_installed() {
+    let python = engines_python();
+    let importable = std::process::Command::new(&python)
+        .args(["-c", "import MaterialX"])
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if !importable {
+        eprintln!(
+            "skipped: {python} cannot import MaterialX (pip install materialx, or set SKIN_ENGINES_PYTHON)"
+        );
+        return;
+    }
+    let script = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../validation/engines/materialx_check.py"
+    );
+    let dir = std::env::temp_dir().join(format!("skin-mtlx-check-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for format in [Format::OpenPbr, Format::StandardSurface] {
+        for space in [ColourSpace::LinRec709, ColourSpace::AcesCg] {
+            let o = ExportOptions {
+                colour_space: space,
+                ..opts()
+            };
+            let path = dir.join(format!("{format}_{space}.mtlx"));
+            std::fs::write(&path, skin_export::export(&skin(), format, &o).unwrap().text).unwrap();
+            let out = std::process::Command::new(&python)
+                .arg(script)
+                .arg(&path)
+                .output()
+                .unwrap();
+            assert!(
+                out.status.success(),
+                "{format} {space}: {}",
+                String::from_utf8_lossy(&out.stderr)
+            );
+            let stdout = String::from_utf8_lossy(&out.stdout);
+            let v = json(stdout.lines().last().unwrap());
+            // MaterialX's validate() and every input known to the node's nodedef with its type.
+            assert_eq!(v["valid"], Value::Bool(true), "{format} {space}: {}", v["message"]);
+            assert_eq!(v["unknown_inputs"], serde_json::json!([]), "{format} {space}");
+            assert_eq!(v["colorspace"], space.materialx_name());
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
 }

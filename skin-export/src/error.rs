@@ -10,7 +10,7 @@ use thiserror::Error;
 pub enum ExportError {
     /// The format name is not one of [`crate::Format::ALL`].
     #[error(
-        "unknown export format '{0}' (valid: openpbr, standard-surface, unreal, hdrp, gaussians, burley, pbrt, mitsuba, mcml, mcx)"
+        "unknown export format '{0}' (valid: openpbr, standard-surface, unreal, hdrp, gaussians, burley, pbrt, mitsuba, mcml, mcx, blender, blender-json)"
     )]
     UnknownFormat(String),
     /// A numeric option outside its range.
@@ -45,6 +45,14 @@ pub enum ExportError {
         /// 1-based line number in the input.
         line: usize,
         /// What was expected there.
+        message: String,
+    },
+    /// A Cycles calibration table that does not parse or fit.
+    #[error("Cycles calibration table line {line}: {message}")]
+    Calibration {
+        /// 1-based line number (0: the table as a whole).
+        line: usize,
+        /// What was wrong.
         message: String,
     },
     /// A fit that found no admissible value.

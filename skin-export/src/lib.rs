@@ -1,5 +1,6 @@
 #![doc = include_str!("../README.md")]
 
+pub mod blender;
 pub mod burley;
 pub mod colour;
 pub mod engines;
@@ -49,11 +50,16 @@ pub enum Format {
     Mcml,
     /// MCX / pmcx JSON input at one wavelength.
     Mcx,
+    /// Blender Cycles: a Python script that builds the calibrated Principled BSDF and the
+    /// volumetric slab.
+    Blender,
+    /// Blender Cycles: the same values as JSON.
+    BlenderJson,
 }
 
 impl Format {
     /// Every format, in the order of the documentation.
-    pub const ALL: [Format; 10] = [
+    pub const ALL: [Format; 12] = [
         Format::OpenPbr,
         Format::StandardSurface,
         Format::Unreal,
@@ -64,6 +70,8 @@ impl Format {
         Format::Mitsuba,
         Format::Mcml,
         Format::Mcx,
+        Format::Blender,
+        Format::BlenderJson,
     ];
 
     /// The command-line name.
@@ -80,6 +88,8 @@ impl Format {
             Format::Mitsuba => "mitsuba",
             Format::Mcml => "mcml",
             Format::Mcx => "mcx",
+            Format::Blender => "blender",
+            Format::BlenderJson => "blender-json",
         }
     }
 
@@ -121,7 +131,7 @@ pub struct ExportOptions {
     pub shape_step_nm: f64,
     /// Colour space of exported colours.
     pub colour_space: ColourSpace,
-    /// Length of one scene unit, mm (OpenPBR, Standard Surface, pbrt, Mitsuba).
+    /// Length of one scene unit, mm (OpenPBR, Standard Surface, pbrt, Mitsuba, Blender).
     pub scene_unit_mm: f64,
     /// Photons per run written into MCML / MCX inputs.
     pub photons: u64,
@@ -135,7 +145,7 @@ pub struct ExportOptions {
     pub mitsuba_variant: mitsuba::Variant,
     /// Write a complete scene (camera, sky) where the format has one (Mitsuba).
     pub scene: bool,
-    /// Thickness given to the dermis where the program needs a finite layer (MCML, MCX, Mitsuba), mm.
+    /// Thickness given to the dermis where the program needs a finite layer (MCML, MCX, Mitsuba, Blender), mm.
     pub dermis_thickness_mm: f64,
 }
 
@@ -220,13 +230,15 @@ impl ExportOptions {
         let carries_acescg = match format {
             Format::OpenPbr | Format::StandardSurface | Format::Gaussians | Format::Burley => true,
             Format::Unreal | Format::Hdrp | Format::Pbrt | Format::Mcml | Format::Mcx => false,
-            Format::Mitsuba => false,
+            Format::Mitsuba | Format::Blender | Format::BlenderJson => false,
         };
         if self.colour_space != ColourSpace::LinRec709 && !carries_acescg {
             return Err(ExportError::ColourSpace {
                 format: format.name(),
                 space: self.colour_space.materialx_name(),
-                valid: if format.is_rgb() {
+                valid: if matches!(format, Format::Blender | Format::BlenderJson) {
+                    "lin_rec709 (Blender's default scene-linear working space, where the values are fitted)"
+                } else if format.is_rgb() {
                     "lin_rec709 (the engine's working space; the file has no colour-space tag)"
                 } else {
                     "lin_rec709 (the format is spectral: it holds no colours)"
@@ -339,7 +351,16 @@ pub fn export(
             _ => *opts,
         };
         let rgb = rgb_profile(skin, &rgb_opts)?;
-        export_rgb(format, &rgb, surface, opts)?
+        if matches!(format, Format::Blender | Format::BlenderJson) {
+            let (text, notes) = blender::write(format, skin, &rgb, surface, opts)?;
+            Export {
+                format,
+                text,
+                notes,
+            }
+        } else {
+            export_rgb(format, &rgb, surface, opts)?
+        }
     } else if format == Format::Mcx
         || (format == Format::Mitsuba && opts.mitsuba_variant == mitsuba::Variant::Mono)
     {
@@ -410,7 +431,11 @@ pub fn export_rgb(
                 .collect::<Result<Vec<_>, _>>()?;
             engines::write_gaussians(&fits, opts)
         }
-        _ => unreachable!("spectral formats go through export_spectral"),
+        _ => {
+            return Err(ExportError::Fit(format!(
+                "{format}: not an RGB profile format (use `export`)"
+            )));
+        }
     };
     Ok(Export {
         format,
@@ -452,7 +477,7 @@ fn materialise_notes(format: Format, notes: &[String], text: &str) -> String {
                 .collect();
             format!("{decl}\n{comments}{rest}")
         }
-        Format::Pbrt => {
+        Format::Pbrt | Format::Blender => {
             let comments: String = notes.iter().map(|n| format!("# {n}\n")).collect();
             format!("{comments}{text}")
         }
@@ -465,7 +490,12 @@ fn materialise_notes(format: Format, notes: &[String], text: &str) -> String {
                 .collect();
             format!("{comments}{}", mcml::ascii(text))
         }
-        Format::Unreal | Format::Hdrp | Format::Gaussians | Format::Burley | Format::Mcx => {
+        Format::Unreal
+        | Format::Hdrp
+        | Format::Gaussians
+        | Format::Burley
+        | Format::Mcx
+        | Format::BlenderJson => {
             let mut value: serde_json::Value =
                 serde_json::from_str(text).expect("the JSON writers produce valid JSON");
             value["notes"] = serde_json::json!(notes);

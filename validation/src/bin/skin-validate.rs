@@ -53,7 +53,7 @@ enum Command {
     /// The BSSRDF against the volumetric reference in image space: per-pixel error maps, region
     /// means by shape and skin tone, error against render time (PNG, CSV, render.md) into --out.
     Render(RenderStudyArgs),
-    /// Each installed engine (MaterialX, Mitsuba 3) on the exported files against our exact
+    /// Each installed engine (MaterialX, Mitsuba 3, MCX, Blender Cycles) on the exported files against our exact
     /// numbers: CSV and PNG into --out; an engine that is not installed is skipped with a note.
     Engines(EnginesArgs),
 }
@@ -69,6 +69,16 @@ struct EnginesArgs {
     /// Samples per pixel of the Mitsuba renders (16 × 16 pixels), [1, 65536].
     #[arg(long, value_name = "N", default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=65_536))]
     spp: u32,
+    /// Samples per pixel of the Cycles renders, [1, 65536].
+    #[arg(long = "cycles-spp", value_name = "N", default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=65_536))]
+    cycles_spp: u32,
+    /// Photons of each MCX run, [1000, 1e9].
+    #[arg(long = "mcx-photons", value_name = "N", default_value_t = 100_000, value_parser = clap::value_parser!(u64).range(1_000..=1_000_000_000))]
+    mcx_photons: u64,
+    /// Library to preload into the MCX driver (e.g. /usr/lib/x86_64-linux-gnu/libstdc++.so.6 when
+    /// pocl's kernel build cannot find 'stdint.h').
+    #[arg(long = "mcx-ld-preload", value_name = "PATH")]
+    mcx_ld_preload: Option<PathBuf>,
     /// Output folder.
     #[arg(long, value_name = "DIR", default_value = "out/engines")]
     out: PathBuf,
@@ -85,6 +95,9 @@ fn run_engines(args: &EnginesArgs) -> anyhow::Result<()> {
         scripts: args.scripts.clone(),
         out: args.out.clone(),
         spp: args.spp,
+        cycles_spp: args.cycles_spp,
+        mcx_photons: args.mcx_photons,
+        mcx_preload: args.mcx_ld_preload.clone(),
     };
     let (rows, notes) = validation::engines::run_engines(&opts)?;
     for r in &rows {

@@ -7,7 +7,14 @@
 //!   to lin_rec709 against the lin_rec709 file's;
 //! - **Mitsuba 3**: the flat slab under a uniform sky of radiance 1 at normal view (`--scene`), in
 //!   the rgb variant (per channel: F(0) + the RGB of `skin spectrum`'s diffuse reflectance) and the
-//!   mono variant at 550 nm (F(0) + the diffuse reflectance there).
+//!   mono variant at 550 nm (F(0) + the diffuse reflectance there);
+//! - **MCX** (pmcxcl, MCX on OpenCL): the exported input at 550 nm, its detected weights per photon
+//!   entering against our adding-doubling total per photon entering (the file's normalisation);
+//! - **Blender Cycles** (bpy): the `blender` script's Principled BSDF (Random Walk and Random Walk
+//!   (Skin)) on the flat slab at normal view and over a sphere, both under a uniform white sky, its
+//!   subsurface part (the render minus the same render with Base Color 0) against the RGB of
+//!   `skin spectrum`'s diffuse reflectance; and its volumetric slab (`volume_slab()`) against F(0)
+//!   + that reflectance.
 
 use anyhow::{Context, bail};
 use skin_export::mitsuba::Variant;
@@ -32,6 +39,13 @@ pub struct EngineOptions {
     pub out: PathBuf,
     /// Samples per pixel of the Mitsuba renders (16 × 16 pixels each).
     pub spp: u32,
+    /// Samples per pixel of the Cycles renders.
+    pub cycles_spp: u32,
+    /// Photons of each MCX run.
+    pub mcx_photons: u64,
+    /// A library preloaded into the MCX driver (pocl's kernel compiler on some systems needs the
+    /// system libstdc++ ahead of the one Python loads).
+    pub mcx_preload: Option<PathBuf>,
 }
 
 /// One comparison: an engine's number against ours.
@@ -63,9 +77,22 @@ impl Row {
 
 /// Run a driver script; its stdout's last line parsed as JSON.
 fn driver(opts: &EngineOptions, script: &str, args: &[&str]) -> anyhow::Result<serde_json::Value> {
-    let out = Command::new(&opts.python)
-        .arg(opts.scripts.join(script))
-        .args(args)
+    driver_with(opts, script, args, None)
+}
+
+/// [`driver`] with `LD_PRELOAD` set to `preload` when given.
+fn driver_with(
+    opts: &EngineOptions,
+    script: &str,
+    args: &[&str],
+    preload: Option<&Path>,
+) -> anyhow::Result<serde_json::Value> {
+    let mut cmd = Command::new(&opts.python);
+    cmd.arg(opts.scripts.join(script)).args(args);
+    if let Some(p) = preload {
+        cmd.env("LD_PRELOAD", p);
+    }
+    let out = cmd
         .output()
         .with_context(|| format!("running {} {script}", opts.python.display()))?;
     if !out.status.success() {
@@ -176,20 +203,25 @@ fn materialx(opts: &EngineOptions, rows: &mut Vec<Row>) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// `skin spectrum`'s diffuse reflectance (per incident photon, exact) as a D65 colour in linear Rec.709.
+fn diffuse_rgb(skin: &SkinParams) -> anyhow::Result<[f64; 3]> {
+    let grid = WavelengthGrid::visible();
+    let spectrum = skin_cli::spectrum::rows(skin, &grid, multipole::Method::Exact)?;
+    Ok(reflectance_to_xyz(&GridSpectrum::new(
+        grid,
+        spectrum.iter().map(|r| r.diffuse_reflectance).collect(),
+    )?)
+    .to_linear_srgb()
+    .0)
+}
+
 fn mitsuba(opts: &EngineOptions, rows: &mut Vec<Row>) -> anyhow::Result<()> {
     let llvm = std::env::var_os("DRJIT_LIBLLVM_PATH").is_some();
     let spp = opts.spp.to_string();
     for (name, preset) in PRESETS {
         let skin = SkinParams::preset(preset);
         let f0 = skin_export::Surface::of(&skin).f0();
-        let grid = WavelengthGrid::visible();
-        let spectrum = skin_cli::spectrum::rows(&skin, &grid, multipole::Method::Exact)?;
-        let rgb = reflectance_to_xyz(&GridSpectrum::new(
-            grid,
-            spectrum.iter().map(|r| r.diffuse_reflectance).collect(),
-        )?)
-        .to_linear_srgb()
-        .0;
+        let rgb = diffuse_rgb(&skin)?;
         let mut cases = vec![(
             Variant::Rgb,
             if llvm { "llvm_ad_rgb" } else { "scalar_rgb" },
@@ -250,6 +282,92 @@ fn mitsuba(opts: &EngineOptions, rows: &mut Vec<Row>) -> anyhow::Result<()> {
     Ok(())
 }
 
+fn mcx(opts: &EngineOptions, rows: &mut Vec<Row>) -> anyhow::Result<()> {
+    let photons = opts.mcx_photons.to_string();
+    for (name, preset) in PRESETS {
+        let skin = SkinParams::preset(preset);
+        let eo = ExportOptions {
+            photons: opts.mcx_photons,
+            ..export_options()
+        };
+        let path = opts.out.join(format!("{name}_mcx.json"));
+        write_export(&skin, Format::Mcx, &eo, &path)?;
+        let v = driver_with(
+            opts,
+            "mcx_run.py",
+            &[path.to_str().context("path")?, &photons],
+            opts.mcx_preload.as_deref(),
+        )?;
+        let ours = multipole::exact::adding_doubling::skin_total_reflectance(
+            &skin,
+            skin_optics::Wavelength::new(eo.lambda_nm)?,
+            &multipole::exact::adding_doubling::AddingDoublingOptions::default(),
+        )?;
+        rows.push(Row {
+            engine: format!("MCX ({})", v["version"].as_str().unwrap_or("?")),
+            preset: name,
+            quantity: format!(
+                "reflectance per entering photon, {} photons, 20 mm dermis",
+                opts.mcx_photons
+            ),
+            channel: format!("{} nm", eo.lambda_nm),
+            ours,
+            engine_value: v["reflectance"].as_f64().context("reflectance")?,
+            engine_stderr: v["stderr"].as_f64().context("stderr")?,
+        });
+    }
+    Ok(())
+}
+
+fn cycles(opts: &EngineOptions, rows: &mut Vec<Row>) -> anyhow::Result<()> {
+    let spp = opts.cycles_spp.to_string();
+    for (name, preset) in PRESETS {
+        let skin = SkinParams::preset(preset);
+        let f0 = skin_export::Surface::of(&skin).f0();
+        let rgb = diffuse_rgb(&skin)?;
+        let path = opts.out.join(format!("{name}_blender.py"));
+        write_export(&skin, Format::Blender, &export_options(), &path)?;
+        let file = path.to_str().context("path")?;
+        let mut cases: Vec<(&str, &str)> = Vec::new();
+        for method in skin_export::blender::CyclesMethod::ALL {
+            cases.push(("slab", method.identifier()));
+            cases.push(("sphere", method.identifier()));
+        }
+        cases.push(("volume", "-"));
+        for (scene, method) in cases {
+            let v = driver(opts, "cycles_render.py", &[file, scene, method, &spp])?;
+            let engine = format!("Cycles {}", v["version"].as_str().unwrap_or("?"));
+            let (mean, se) = (numbers(&v["mean"]), numbers(&v["stderr"]));
+            let (quantity, offset) = match scene {
+                "volume" => (
+                    format!("volume_slab() under uniform sky, normal view ({spp} spp): F(0) + diffuse"),
+                    f0,
+                ),
+                "slab" => (
+                    format!("Principled {method}, slab, normal view ({spp} spp): subsurface part"),
+                    0.0,
+                ),
+                _ => (
+                    format!("Principled {method}, sphere under white sky ({spp} spp): subsurface part"),
+                    0.0,
+                ),
+            };
+            for c in 0..3 {
+                rows.push(Row {
+                    engine: engine.clone(),
+                    preset: name,
+                    quantity: quantity.clone(),
+                    channel: ["R", "G", "B"][c].into(),
+                    ours: offset + rgb[c],
+                    engine_value: mean[c],
+                    engine_stderr: se[c],
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Run every installed engine; write `engines.csv` and `engines.png` into `opts.out`. Returns the
 /// rows and one note per engine skipped.
 pub fn run_engines(opts: &EngineOptions) -> anyhow::Result<(Vec<Row>, Vec<String>)> {
@@ -257,9 +375,11 @@ pub fn run_engines(opts: &EngineOptions) -> anyhow::Result<(Vec<Row>, Vec<String
     let mut rows = Vec::new();
     let mut notes = Vec::new();
     type Driver = fn(&EngineOptions, &mut Vec<Row>) -> anyhow::Result<()>;
-    let engines: [(&str, &str, Driver); 2] = [
+    let engines: [(&str, &str, Driver); 4] = [
         ("MaterialX", "MaterialX", materialx),
         ("Mitsuba 3", "mitsuba", mitsuba),
+        ("MCX (pmcxcl)", "pmcxcl", mcx),
+        ("Blender Cycles", "bpy", cycles),
     ];
     for (label, module, run) in engines {
         if !importable(opts, module) {
@@ -272,7 +392,6 @@ pub fn run_engines(opts: &EngineOptions) -> anyhow::Result<(Vec<Row>, Vec<String
         log::info!("{label}: running");
         run(opts, &mut rows)?;
     }
-    notes.push("MCX (pmcxcl), Blender Cycles: not driven by this command yet".into());
     notes.push(
         "Unreal, HDRP: cannot run here; their model-side error is what `skin export` prints".into(),
     );
