@@ -398,10 +398,22 @@ fn what_a_format_cannot_carry_is_refused() {
 fn blender_values_return_our_diffuse_reflectance_through_the_cycles_table() {
     use skin_export::blender::{Calibration, CyclesMethod, cycles_albedo, cycles_radius_mm};
     let s = skin();
-    let values = json(&skin_export::export(&s, Format::BlenderJson, &opts()).unwrap().text);
-    let script = skin_export::export(&s, Format::Blender, &opts()).unwrap().text;
+    let values = json(
+        &skin_export::export(&s, Format::BlenderJson, &opts())
+            .unwrap()
+            .text,
+    );
+    let script = skin_export::export(&s, Format::Blender, &opts())
+        .unwrap()
+        .text;
     // The script carries the same values (its VALUES block) and builds the material by name.
-    let block = script.split("r\"\"\"").nth(1).unwrap().split("\"\"\"").next().unwrap();
+    let block = script
+        .split("r\"\"\"")
+        .nth(1)
+        .unwrap()
+        .split("\"\"\"")
+        .next()
+        .unwrap();
     let mut from_script = json(block);
     let mut plain = values.clone();
     from_script.as_object_mut().unwrap().remove("notes");
@@ -412,7 +424,11 @@ fn blender_values_return_our_diffuse_reflectance_through_the_cycles_table() {
     let f0 = skin_export::Surface::of(&s).f0();
     let target: Vec<f64> = rgb().totals().iter().map(|t| t * (1.0 - f0)).collect();
     for (c, t) in target.iter().enumerate() {
-        assert!(close(values["target_diffuse_reflectance"][c].as_f64().unwrap(), *t, 1e-12));
+        assert!(close(
+            values["target_diffuse_reflectance"][c].as_f64().unwrap(),
+            *t,
+            1e-12
+        ));
     }
     for method in CyclesMethod::ALL {
         let v = &values["principled"][method.identifier()];
@@ -421,15 +437,19 @@ fn blender_values_return_our_diffuse_reflectance_through_the_cycles_table() {
         for c in 0..3 {
             let base = v["base_color"][c].as_f64().unwrap();
             // The measured curve at the written Base Color is the target (bisection to 1e-12).
-            assert!(close(cal.reflectance(base), target[c], 1e-9), "{method} {c}");
+            assert!(
+                close(cal.reflectance(base), target[c], 1e-9),
+                "{method} {c}"
+            );
             // Radius × Scale is Cycles' conversion of a reduced mean free path d > 0 whose walk
             // albedo is Cycles' remap of that Base Color.
             let radius = v["subsurface_radius"][c].as_f64().unwrap() * scale;
             let d = radius / cycles_radius_mm(method, 1.0, base, 1.4);
             assert!(d > 0.0 && d < 10.0, "{method} {c}: d = {d} mm");
             assert!(
-                (v["walk_single_scattering_albedo"][c].as_f64().unwrap() - cycles_albedo(base, 0.0))
-                    .abs()
+                (v["walk_single_scattering_albedo"][c].as_f64().unwrap()
+                    - cycles_albedo(base, 0.0))
+                .abs()
                     < 1e-12
             );
         }
@@ -801,7 +821,11 @@ fn materialx_documents_pass_materialx_own_checks_where_it_is_installed() {
                 ..opts()
             };
             let path = dir.join(format!("{format}_{space}.mtlx"));
-            std::fs::write(&path, skin_export::export(&skin(), format, &o).unwrap().text).unwrap();
+            std::fs::write(
+                &path,
+                skin_export::export(&skin(), format, &o).unwrap().text,
+            )
+            .unwrap();
             let out = std::process::Command::new(&python)
                 .arg(script)
                 .arg(&path)
@@ -815,8 +839,17 @@ fn materialx_documents_pass_materialx_own_checks_where_it_is_installed() {
             let stdout = String::from_utf8_lossy(&out.stdout);
             let v = json(stdout.lines().last().unwrap());
             // MaterialX's validate() and every input known to the node's nodedef with its type.
-            assert_eq!(v["valid"], Value::Bool(true), "{format} {space}: {}", v["message"]);
-            assert_eq!(v["unknown_inputs"], serde_json::json!([]), "{format} {space}");
+            assert_eq!(
+                v["valid"],
+                Value::Bool(true),
+                "{format} {space}: {}",
+                v["message"]
+            );
+            assert_eq!(
+                v["unknown_inputs"],
+                serde_json::json!([]),
+                "{format} {space}"
+            );
             assert_eq!(v["colorspace"], space.materialx_name());
         }
     }

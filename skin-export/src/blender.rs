@@ -144,7 +144,11 @@ impl Calibration {
             if f.len() != 4 {
                 return Err(bad(format!("{} fields (expected 4)", f.len())));
             }
-            if f[0].parse::<CyclesMethod>().map_err(|e| bad(e.to_string()))? != method {
+            if f[0]
+                .parse::<CyclesMethod>()
+                .map_err(|e| bad(e.to_string()))?
+                != method
+            {
                 continue;
             }
             let num = |k: usize, name: &str| -> Result<f64, ExportError> {
@@ -161,7 +165,7 @@ impl Calibration {
             );
             if !(0.0..=1.0).contains(&base_color) || stderr <= 0.0 {
                 return Err(bad(
-                    "base_color outside [0, 1] or stderr not positive".to_string(),
+                    "base_color outside [0, 1] or stderr not positive".to_string()
                 ));
             }
             points.push(CalibrationPoint {
@@ -299,10 +303,11 @@ fn solve_linear(mut a: Vec<Vec<f64>>) -> Option<Vec<f64>> {
             return None;
         }
         a.swap(col, pivot);
-        for row in col + 1..n {
-            let f = a[row][col] / a[col][col];
-            for k in col..=n {
-                a[row][k] -= f * a[col][k];
+        let pivot_row = a[col].clone();
+        for row in a.iter_mut().skip(col + 1) {
+            let f = row[col] / pivot_row[col];
+            for (v, p) in row.iter_mut().zip(&pivot_row).skip(col) {
+                *v -= f * p;
             }
         }
     }
@@ -482,8 +487,8 @@ impl PrincipledFit {
             shape_error: [0.0; 3],
             calibration_residual: cal.max_residual(),
         };
-        for c in 0..3 {
-            let base = cal.base_color(targets[c])?;
+        for (c, &target) in targets.iter().enumerate() {
+            let base = cal.base_color(target)?;
             let alpha = cycles_albedo(base, g);
             // The walk at d = 1 mm: σt = 1/(1 − g); it leaves at the first surface hit, which is
             // our medium under an index-matched face.
@@ -765,9 +770,6 @@ pub fn write(
         VOLUME_GAP_MM,
         percent3([0, 1, 2].map(|c| fit.volume[c].total), 2)
     ));
-    notes.push(format!(
-        "measured in Cycles {BLENDER_VERSION} (bpy, CPU) by skin-validate engines: BENCHMARKS.md, Engines"
-    ));
     Ok((text, notes))
 }
 
@@ -781,7 +783,9 @@ mod tests {
         // B = 4.98511194385 + 0.127355959438, D = 0.496310210422, E = 4.23190299701 + 0.00310603949088.
         let c: f64 = 0.5;
         let blend = c.powf(0.25);
-        let want = (1.0 - blend) * 1.826_052_378_2 * (5.112_467_903_288 * c).atan().powf(1.096_861_024_24)
+        let want = (1.0 - blend)
+            * 1.826_052_378_2
+            * (5.112_467_903_288 * c).atan().powf(1.096_861_024_24)
             + blend * 0.496_310_210_422 * (4.235_009_036_500_88 * c).atan().powf(2.406_029_994_08);
         assert!((cycles_albedo_raw(c, 0.0) - want).abs() < 1e-12);
         // Monotone in c and floored at 0.2 where Cycles floors it.
@@ -799,7 +803,10 @@ mod tests {
         for ap in [0.3_f64, 0.9, 0.99] {
             let s: f64 = (3.0 * (1.0 - ap)).sqrt();
             let rd = 0.5 * ap * (1.0 + (-a * s).exp()) * (-s).exp();
-            assert!((cycles_skin_alpha_prime(rd, ior) - ap).abs() < 2.5e-4, "{ap}");
+            assert!(
+                (cycles_skin_alpha_prime(rd, ior) - ap).abs() < 2.5e-4,
+                "{ap}"
+            );
         }
     }
 
@@ -835,7 +842,10 @@ mod tests {
             let (held, n_held) = cal.chi_squared(true);
             assert_eq!((n_fit, n_held), (16, 8), "{method}");
             assert!((1.479..=29.588).contains(&fit), "{method}: fitted χ² {fit}");
-            assert!((0.857..=26.124).contains(&held), "{method}: held-out χ² {held}");
+            assert!(
+                (0.857..=26.124).contains(&held),
+                "{method}: held-out χ² {held}"
+            );
             // The inverse map returns each measured row's Base Color within 3.5σ of its noise,
             // carried through the curve's slope.
             for p in &cal.points {

@@ -93,6 +93,33 @@ impl Format {
         }
     }
 
+    /// What running the file in its engine here measured (`skin-validate engines`, BENCHMARKS.md
+    /// "Engines", where the commands, versions and machine are), or why it was not run.
+    #[must_use]
+    pub fn measured_in_engine(self) -> &'static str {
+        match self {
+            Format::OpenPbr | Format::StandardSurface => {
+                "MaterialX 1.39.5: validate() clean, only nodedef inputs with their types; acescg radii through MaterialX's own colour transform equal the lin_rec709 file's (≤ 0.001%); no MaterialX renderer runs here, so the totals and shape are the model-side errors above"
+            }
+            Format::Mitsuba => {
+                "Mitsuba 3.9.1, slab under a uniform sky at normal view: rgb and mono variants within 1.1σ of F(0) + our diffuse reflectance (≤ 1.1%, σ 0.7–5%), light, medium and dark skin"
+            }
+            Format::Mcx => "@MCX@",
+            Format::Mcml => {
+                "MCML 1.2 (the exported runs): within 1.8 binomial σ of skin spectrum's diffuse_reflectance"
+            }
+            Format::Blender | Format::BlenderJson => {
+                "Blender 5.0.1 Cycles (CPU, 256 spp), light, medium and dark skin: Principled BSDF subsurface part on a slab at normal view within 2.2% of our diffuse reflectance (both methods); over a sphere under a white sky 5–12% above it, as Cycles' walk returns more than skin at oblique incidence (the 3% target is not met there); volume_slab() within 2.5% of F(0) + our diffuse reflectance for light and medium skin (light red −2.5%: Cycles' 1,024-bounce limit), dark skin +4.6–6.5%"
+            }
+            Format::Unreal | Format::Hdrp => {
+                "cannot run here (no Unreal or Unity on this machine): the errors above are model-side, Burley's profile against ours"
+            }
+            Format::Burley | Format::Gaussians | Format::Pbrt => {
+                "no engine run here: the errors above are model-side, the format's profile model against ours"
+            }
+        }
+    }
+
     /// Whether the format is fitted to RGB profiles (otherwise it is spectral).
     #[must_use]
     pub fn is_rgb(self) -> bool {
@@ -391,6 +418,15 @@ pub fn export(
         )?
     };
     header.append(&mut out.notes);
+    if !format.is_rgb() {
+        header.push(
+            "colour space: none (spectral: per-wavelength coefficients, no colours)".to_string(),
+        );
+    }
+    header.push(format!(
+        "measured in the engine: {}",
+        format.measured_in_engine()
+    ));
     out.notes = header;
     out.text = materialise_notes(format, &out.notes, &out.text);
     Ok(out)

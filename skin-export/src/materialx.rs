@@ -92,7 +92,7 @@ pub fn write(
             fit.mean_free_path_mm[2]
         ),
         format!(
-            "engine model: {}'s subsurface (MaterialX 1.39 nodedef {}); normalisation: subsurface_color is a fraction of the flux entering through the specular face (per entering photon); measured in MaterialX 1.39.5: loads and validate()s cleanly, radii round-trip through its colour management (BENCHMARKS.md, Engines)",
+            "engine model: {}'s subsurface (MaterialX 1.39 nodedef {}); normalisation: subsurface_color is a fraction of the flux entering through the specular face (per entering photon)",
             if format == Format::OpenPbr {
                 "OpenPBR Surface 1.1"
             } else {

@@ -92,7 +92,7 @@ pub fn write(
             row.diffuse_reflectance,
             1.0 - f0
         ),
-        "engine model: MCX voxel Monte Carlo (measured with pmcxcl 0.7.5 on CPU OpenCL: BENCHMARKS.md, Engines); accuracy: our layers, so nothing lost by construction; lateral and depth truncation of the volume are MCX's only departures from the model".to_string(),
+        "engine model: MCX voxel Monte Carlo; accuracy: our layers, so nothing lost by construction; lateral and depth truncation of the volume are MCX's only departures from the model".to_string(),
     ];
     Ok((
         serde_json::to_string_pretty(&value).expect("a JSON value serialises"),

@@ -378,7 +378,7 @@ pub fn write(
         "normalisation: our totals are per photon entering; per incident photon multiply by 1 − F(0); add a sensor and emitter to render (or export with --scene)".to_string()
     });
     notes.push(
-        "accuracy: the layers are ours, so volpath solves our transport (only the finite dermis and block differ from the semi-infinite model); measured in Mitsuba 3.9.1: BENCHMARKS.md, Engines".to_string(),
+        "accuracy: the layers are ours, so volpath solves our transport (only the finite dermis and block differ from the semi-infinite model)".to_string(),
     );
     Ok((x, notes))
 }

@@ -2,7 +2,11 @@
 
 Usage: python cycles_render.py SKIN.py SCENE METHOD SPP
 SCENE is `slab` or `sphere` (the scenes of `cycles_common`) with the script's
-subsurface_material(METHOD), or `volume` (the script's volume_slab(); METHOD is ignored).
+subsurface_material(METHOD), `volume` (the script's volume_slab() seen straight down; METHOD is
+ignored) or `volume_white` (what the `sphere` scene averages, on that slab: the camera at the four
+Gauss–Legendre nodes of t = μ² on [t₀, 1], t₀ = 1 − 0.95² the sphere mask's edge, each pixel minus
+the exact Fresnel reflectance F(μ) of the smooth face; the mean over the projected disc of a large
+sphere under a white sky is the mean of R(μ) over t, since a disc's area is uniform in μ²).
 
 For the Principled scenes the same scene is rendered again with Base Color 0 (the specular face
 alone) and the subsurface part is the difference. Prints one JSON object: {"engine", "version",
@@ -38,17 +42,48 @@ def principled(skin, scene_name, method, spp, base_zero, seed):
     return cc.mean_and_stderr(pixels), int(pixels.size // 3)
 
 
+def fresnel(mu, eta):
+    """Unpolarised Fresnel reflectance from air onto index `eta` at incidence cosine `mu`."""
+    sin_t2 = (1.0 - mu * mu) / (eta * eta)
+    mu_t = np.sqrt(1.0 - sin_t2)
+    rs = (mu - eta * mu_t) / (mu + eta * mu_t)
+    rp = (eta * mu - mu_t) / (eta * mu + mu_t)
+    return 0.5 * (rs * rs + rp * rp)
+
+
+def volume_view(path, spp, mu, seed):
+    """Mean pixel and standard error of the volumetric slab seen at incidence cosine `mu`."""
+    scene = cc.reset(spp, 16, seed=seed)
+    skin = runpy.run_path(path, run_name="skin_export")
+    skin["volume_slab"](scene)
+    cam = cc.camera(scene, 10.0, 1.0)
+    sin = np.sqrt(1.0 - mu * mu)
+    cam.location = (0.0, -10.0 * sin, 10.0 * mu)
+    cam.rotation_euler = (float(np.arccos(mu)), 0.0, 0.0)
+    return cc.mean_and_stderr(cc.render(scene)), skin["VALUES"]["volume"]["glass_ior"]
+
+
 def main():
     path, scene_name, method, spp = sys.argv[1], sys.argv[2], sys.argv[3], int(sys.argv[4])
     # Loading the script defines its functions without running its __main__ block; every scene
     # below starts from an empty file, so the functions are looked up again after each reset.
     if scene_name == "volume":
-        scene = cc.reset(spp, 16, seed=3)
-        skin = runpy.run_path(path, run_name="skin_export")
-        skin["volume_slab"](scene)
-        cc.camera(scene, 10.0, 1.0)
-        (mean, se), n = cc.mean_and_stderr(cc.render(scene)), 256
+        ((mean, se), _), n = volume_view(path, spp, 1.0, 3), 256
         spec = np.zeros(3)
+    elif scene_name == "volume_white":
+        # Mean of R(√t) over t = μ² ∈ [t₀, 1]: 4-point Gauss–Legendre.
+        nodes, weights = np.polynomial.legendre.leggauss(4)
+        t0 = 1.0 - cc.SPHERE_MASK ** 2
+        mean, var, spec, n = np.zeros(3), np.zeros(3), np.zeros(3), 0
+        for k, (x, w) in enumerate(zip(nodes, weights)):
+            mu = float(np.sqrt(t0 + (1.0 - t0) * 0.5 * (x + 1.0)))
+            (m, e), eta = volume_view(path, spp, mu, 10 + k)
+            f = fresnel(mu, eta)
+            mean += 0.5 * w * (m - f)
+            var += (0.5 * w * e) ** 2
+            spec += 0.5 * w * f
+            n += 256
+        se = np.sqrt(var)
     else:
         skin = runpy.run_path(path, run_name="skin_export")
         (full, se_full), n = principled(skin, scene_name, method, spp, False, 5)

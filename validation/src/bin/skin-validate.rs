@@ -79,6 +79,9 @@ struct EnginesArgs {
     /// pocl's kernel build cannot find 'stdint.h').
     #[arg(long = "mcx-ld-preload", value_name = "PATH")]
     mcx_ld_preload: Option<PathBuf>,
+    /// Run only this engine (its Python module: MaterialX, mitsuba, pmcxcl, bpy); repeatable.
+    #[arg(long = "engine", value_name = "MODULE", value_parser = ["MaterialX", "mitsuba", "pmcxcl", "bpy"])]
+    engine: Vec<String>,
     /// Output folder.
     #[arg(long, value_name = "DIR", default_value = "out/engines")]
     out: PathBuf,
@@ -98,6 +101,7 @@ fn run_engines(args: &EnginesArgs) -> anyhow::Result<()> {
         cycles_spp: args.cycles_spp,
         mcx_photons: args.mcx_photons,
         mcx_preload: args.mcx_ld_preload.clone(),
+        only: args.engine.clone(),
     };
     let (rows, notes) = validation::engines::run_engines(&opts)?;
     for r in &rows {

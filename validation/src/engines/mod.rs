@@ -43,6 +43,8 @@ pub struct EngineOptions {
     pub cycles_spp: u32,
     /// Photons of each MCX run.
     pub mcx_photons: u64,
+    /// Run only the engines whose Python module is listed (empty: every engine).
+    pub only: Vec<String>,
     /// A library preloaded into the MCX driver (pocl's kernel compiler on some systems needs the
     /// system libstdc++ ahead of the one Python loads).
     pub mcx_preload: Option<PathBuf>,
@@ -334,13 +336,19 @@ fn cycles(opts: &EngineOptions, rows: &mut Vec<Row>) -> anyhow::Result<()> {
             cases.push(("sphere", method.identifier()));
         }
         cases.push(("volume", "-"));
+        // Our layers' mean subsurface reflectance over what the sphere's mask sees, rendered
+        // exactly by the volumetric slab at four view angles.
+        let white = driver(opts, "cycles_render.py", &[file, "volume_white", "-", &spp])?;
+        let (white_mean, white_se) = (numbers(&white["mean"]), numbers(&white["stderr"]));
         for (scene, method) in cases {
             let v = driver(opts, "cycles_render.py", &[file, scene, method, &spp])?;
             let engine = format!("Cycles {}", v["version"].as_str().unwrap_or("?"));
             let (mean, se) = (numbers(&v["mean"]), numbers(&v["stderr"]));
             let (quantity, offset) = match scene {
                 "volume" => (
-                    format!("volume_slab() under uniform sky, normal view ({spp} spp): F(0) + diffuse"),
+                    format!(
+                        "volume_slab() under uniform sky, normal view ({spp} spp): F(0) + diffuse"
+                    ),
                     f0,
                 ),
                 "slab" => (
@@ -348,7 +356,9 @@ fn cycles(opts: &EngineOptions, rows: &mut Vec<Row>) -> anyhow::Result<()> {
                     0.0,
                 ),
                 _ => (
-                    format!("Principled {method}, sphere under white sky ({spp} spp): subsurface part"),
+                    format!(
+                        "Principled {method}, sphere under white sky ({spp} spp): subsurface part"
+                    ),
                     0.0,
                 ),
             };
@@ -362,6 +372,21 @@ fn cycles(opts: &EngineOptions, rows: &mut Vec<Row>) -> anyhow::Result<()> {
                     engine_value: mean[c],
                     engine_stderr: se[c],
                 });
+            }
+            if scene == "sphere" {
+                for c in 0..3 {
+                    rows.push(Row {
+                        engine: engine.clone(),
+                        preset: name,
+                        quantity: format!(
+                            "Principled {method}, sphere under white sky ({spp} spp): subsurface part against our layers over the same view angles (volume_slab() at 4 angles; its stderr added)"
+                        ),
+                        channel: ["R", "G", "B"][c].into(),
+                        ours: white_mean[c],
+                        engine_value: mean[c],
+                        engine_stderr: se[c].hypot(white_se[c]),
+                    });
+                }
             }
         }
     }
@@ -382,6 +407,9 @@ pub fn run_engines(opts: &EngineOptions) -> anyhow::Result<(Vec<Row>, Vec<String
         ("Blender Cycles", "bpy", cycles),
     ];
     for (label, module, run) in engines {
+        if !opts.only.is_empty() && !opts.only.iter().any(|m| m == module) {
+            continue;
+        }
         if !importable(opts, module) {
             notes.push(format!(
                 "{label}: skipped ({} cannot import {module})",
