@@ -20,6 +20,35 @@ fn main() -> anyhow::Result<()> {
                   [materials.skin]\ntype = \"skin\"\npreset = \"light\"\nsurface = \"smooth\"\n\
                   [[meshes]]\nshape = \"sphere\"\nmaterial = \"skin\"\nunits_mm = 10\n";
     let scene = Scene::from_toml(sphere, "sphere.toml", None, &SkinKnobs::default())?;
+    // The Mitsuba comparison's skin (mitsuba_side_by_side): two layers, isotropic phase.
+    let skin_sphere = sphere
+        .replace(
+            "preset = \"light\"",
+            "melanin = 0.05\neumelanin = 0.7\nhemoglobin = 0.02\nphase_g = 0",
+        )
+        .replace("fov_deg = 20", "fov_deg = 24");
+    let skin_scene = Scene::from_toml(&skin_sphere, "skin.toml", None, &SkinKnobs::default())?;
+    {
+        let body = BodyIntegrator::build(&skin_scene, IntegratorKind::Volumetric)?;
+        let opts = RenderOptions {
+            width: 64,
+            height: 64,
+            spp: 8,
+            seed: 1,
+            wavelength_nm: Some(550.0),
+            ..Default::default()
+        };
+        let t0 = cpu_time::ProcessTime::now();
+        let (_, stats) = render_with(&skin_scene, &body, &opts.validate()?, None)?;
+        let cpu = t0.elapsed().as_secs_f64();
+        let paths = (64 * 64 * 8) as f64;
+        println!(
+            "skin sphere (C_m 0.05, β_m 0.7, C_h 0.02, g 0), 550 nm: {:.0} camera paths per CPU-s, {:.2} µs each ({:.1} rays per path; {cpu:.2} CPU s)",
+            paths / cpu,
+            cpu / paths * 1e6,
+            stats.rays as f64 / paths
+        );
+    }
     let two_layer = Volumetric::build(&scene)?;
     // Homogeneous: both layers the dermis.
     let mut homogeneous = two_layer.clone();
@@ -83,7 +112,7 @@ fn distance_cost() -> anyhow::Result<()> {
     let t0 = cpu_time::ProcessTime::now();
     let inside = points
         .iter()
-        .filter(|&&p| skin.epidermis_region.within(p))
+        .filter(|&&p| skin.epidermis_region.within(p.as_dvec3()))
         .count();
     let dt = t0.elapsed().as_secs_f64();
     let t1 = cpu_time::ProcessTime::now();

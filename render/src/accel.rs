@@ -28,6 +28,11 @@ pub const BVH_BUILD: BvhBuildParams = BvhBuildParams {
     ..BvhBuildParams::very_slow_build()
 };
 
+/// Distance below which obvhs 0.4's CWBVH traversal passes over hits, mm: its node test clamps the
+/// ray's entry distance to 10⁻⁴ scene units (`cwbvh::node::EPSILON`), so a node the ray leaves
+/// sooner is skipped. A ray that must see a surface closer than this starts further back.
+pub const BVH_MIN_T_MM: f32 = 1e-4;
+
 /// A ray–triangle hit: distance, triangle id (index in the scene's triangle list) and barycentrics.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TriHit {
@@ -95,15 +100,26 @@ impl Accel {
     /// Nearest hit in [tmin, tmax], if any.
     #[must_use]
     pub fn closest(&self, ray: &Ray) -> Option<TriHit> {
+        self.closest_where(ray, |_| true)
+    }
+
+    /// Nearest hit in [tmin, tmax] among the triangles `keep` accepts (by their index in the list
+    /// the accelerator was built from), if any.
+    #[must_use]
+    pub fn closest_where(&self, ray: &Ray, keep: impl Fn(u32) -> bool) -> Option<TriHit> {
         if self.leaf_tris.is_empty() {
             return None;
         }
         let mut hit = RayHit::none();
         let tris = &self.leaf_tris;
-        if self
-            .bvh
-            .ray_traverse(*ray, &mut hit, |r, i| tris[i].intersect(r))
-        {
+        let ids = &self.bvh.primitive_indices;
+        if self.bvh.ray_traverse(*ray, &mut hit, |r, i| {
+            if keep(ids[i]) {
+                tris[i].intersect(r)
+            } else {
+                f32::INFINITY
+            }
+        }) {
             let leaf = hit.primitive_id as usize;
             Some(TriHit {
                 t: hit.t,

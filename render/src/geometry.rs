@@ -125,6 +125,31 @@ impl Geometry {
             .map(|h| self.surface(&h))
     }
 
+    /// Nearest surface of material `material` along (`o`, unit `d`) within (`tmin`, `tmax`), mm
+    /// (other materials' triangles are passed through).
+    #[must_use]
+    pub fn intersect_material(
+        &self,
+        o: Vec3,
+        d: Vec3,
+        tmin: f32,
+        tmax: f32,
+        material: u32,
+    ) -> Option<SurfaceHit> {
+        let materials = &self.materials;
+        self.accel
+            .closest_where(&ray(o, d, tmin, tmax), |t| {
+                materials[t as usize] == material
+            })
+            .map(|h| self.surface(&h))
+    }
+
+    /// The vertices of triangle `triangle`, world mm.
+    #[must_use]
+    pub fn triangle(&self, triangle: u32) -> [Vec3; 3] {
+        self.triangles[triangle as usize].map(|i| self.positions[i as usize])
+    }
+
     /// True when something blocks the segment from `o` along unit `d` up to `tmax`.
     #[must_use]
     pub fn occluded(&self, o: Vec3, d: Vec3, tmax: f32) -> bool {

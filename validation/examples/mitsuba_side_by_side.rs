@@ -1,9 +1,15 @@
 //! Our volumetric reference (`render::volumetric`) beside Mitsuba 3's volumetric path tracer
-//! (`volpath`) on one matched scene (BENCHMARKS.md, "Volumetric reference"): a homogeneous sphere
-//! of radius 10 mm (`TriangleMesh::sphere(4)`, the same OBJ for both), σa 0.3 mm⁻¹, σs 60 mm⁻¹
-//! (light skin's dermis at 550 nm, σs' 6 mm⁻¹), Henyey–Greenstein g 0.9, a smooth dielectric of
-//! index 1.4, under a constant sky of radiance 1, seen from 60 mm through a 24° field of view at
-//! one wavelength; box pixel filter, no depth limit in Mitsuba.
+//! (`volpath`) on one matched scene (BENCHMARKS.md, "Volumetric reference"): a sphere of radius
+//! 10 mm (`TriangleMesh::sphere(4)`, the same OBJ for both) with a smooth dielectric surface of
+//! index 1.4 under a constant sky of radiance 1, seen from 60 mm through a 24° field of view at
+//! 550 nm; box pixel filter, no depth limit in Mitsuba. Two bodies (`SCENE`):
+//!
+//! - `skin` (default): two-layer skin C_m 0.05, β_m 0.7, C_h 0.02 with an isotropic phase
+//!   (`phase_g = 0`), its layers from `multipole::LayeredMedium::skin` at 550 nm; Mitsuba's
+//!   dermis is an index-matched (`null`) inner sphere, the same mesh scaled to R − d_epi, whose
+//!   faces lie d_epi · 0.998 under the outer ones (our epidermis: within d_epi of the mesh);
+//! - `homogeneous`: σa 0.3 mm⁻¹, σs 60 mm⁻¹ (light skin's dermis at 550 nm, σs' 6 mm⁻¹),
+//!   Henyey–Greenstein g 0.9.
 //!
 //! For each round the two renderers alternate, each rendering the image twice (two seeds) on one
 //! thread. Over the pixels whose centre lies within 0.9 of the sphere's projected radius it
@@ -14,19 +20,23 @@
 //!
 //! Mitsuba runs in a Python outside this tree (`validation/examples/mitsuba_sphere.py`):
 //! `cargo run --release -p validation --features studies --example mitsuba_side_by_side -- PYTHON [VARIANT]
-//! [RR_DEPTH] [ROUNDS] [SPP] [SIDE]` (defaults llvm_ad_mono, Mitsuba's own rr_depth 5, 3 rounds,
-//! 32 spp, 48 px), PYTHON a python with `mitsuba` and `numpy` installed (the LLVM variants need
-//! libLLVM ≥ 16, e.g. `DRJIT_LIBLLVM_PATH=/usr/lib/x86_64-linux-gnu/libLLVM-19.so`). CPU time: ours from the process clock around `render` (a
-//! rayon pool of one thread), Mitsuba's from `time.process_time()` around `mi.render` after a
-//! warm-up render (the LLVM kernels compiled once, not counted).
+//! [RR_DEPTH] [ROUNDS] [SPP] [SIDE] [SCENE]` (defaults llvm_ad_mono, Mitsuba's own rr_depth 5, 3
+//! rounds, 32 spp, 48 px, skin), PYTHON a python with `mitsuba` and `numpy` installed (the LLVM
+//! variants need libLLVM ≥ 16, e.g. `DRJIT_LIBLLVM_PATH=/usr/lib/x86_64-linux-gnu/libLLVM-19.so`).
+//! CPU time: ours from the process clock around `render` (a rayon pool of one thread), Mitsuba's
+//! from `time.process_time()` around `mi.render` after a warm-up render (the LLVM kernels compiled
+//! once, not counted).
 
 use anyhow::Context;
-use render::integrator::BodyIntegrator;
+use multipole::LayeredMedium;
+use render::integrator::{BodyIntegrator, IntegratorKind};
+use render::material::Material;
 use render::material::SkinKnobs;
 use render::mesh::TriangleMesh;
 use render::renderer::{RenderOptions, render_with};
 use render::scene::Scene;
 use render::volumetric::{LayerTables, SkinVolume, Volumetric};
+use skin_optics::Wavelength;
 use std::fmt::Write as _;
 use std::path::Path;
 use std::process::Command;
@@ -39,13 +49,34 @@ const SIGMA_S: f32 = 60.0;
 const G: f64 = 0.9;
 const ETA: f32 = 1.4;
 const NM: f32 = 550.0;
+/// The two-layer skin's melanin C_m, eumelanin blend β_m and hemoglobin C_h.
+const SKIN: [f64; 3] = [0.05, 0.7, 0.02];
 
-/// The sphere as OBJ in mm, with its vertex normals.
-fn sphere_obj() -> String {
+/// The matched body.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Body {
+    /// Two-layer skin ([`SKIN`]), isotropic phase.
+    Skin,
+    /// σa [`SIGMA_A`], σs [`SIGMA_S`], g [`G`].
+    Homogeneous,
+}
+
+/// What Mitsuba is given: (σa, σs) of the outer medium (mm⁻¹), and for two layers the dermis'
+/// with d_epi (mm); g and η.
+#[derive(Debug, Clone, Copy)]
+struct Media {
+    outer: (f64, f64),
+    dermis: Option<((f64, f64), f64)>,
+    g: f64,
+    eta: f64,
+}
+
+/// The sphere of radius `radius_mm` as OBJ in mm, with its vertex normals.
+fn sphere_obj(radius_mm: f32) -> String {
     let mesh = TriangleMesh::sphere(4);
-    let mut obj = String::from("# icosphere, 4 subdivisions, radius 10 mm\n");
+    let mut obj = format!("# icosphere, 4 subdivisions, radius {radius_mm} mm\n");
     for (p, n) in mesh.positions.iter().zip(&mesh.normals) {
-        let p = *p * RADIUS_MM;
+        let p = *p * radius_mm;
         let _ = writeln!(obj, "v {} {} {}\nvn {} {} {}", p.x, p.y, p.z, n.x, n.y, n.z);
     }
     for t in &mesh.indices {
@@ -55,16 +86,42 @@ fn sphere_obj() -> String {
     obj
 }
 
-/// Our scene: the OBJ under the constant sky, its body the homogeneous medium (both layers).
-fn our_scene(dir: &Path) -> anyhow::Result<(Scene, BodyIntegrator)> {
+/// Our scene: the OBJ under the constant sky with the body, and what Mitsuba is to be given.
+fn our_scene(dir: &Path, body: Body) -> anyhow::Result<((Scene, BodyIntegrator), Media)> {
+    let keys = match body {
+        Body::Skin => format!(
+            "melanin = {}\neumelanin = {}\nhemoglobin = {}\nphase_g = 0",
+            SKIN[0], SKIN[1], SKIN[2]
+        ),
+        Body::Homogeneous => format!("phase_g = {G}"),
+    };
     let text = format!(
         "[camera]\nposition_mm = [0, 0, {DISTANCE_MM}]\nlook_at_mm = [0, 0, 0]\nfov_deg = {FOV_DEG}\n\
          [environment]\nspectral_radiance = 1\n\
-         [materials.skin]\ntype = \"skin\"\nsurface = \"smooth\"\nphase_g = {G}\n\
+         [materials.skin]\ntype = \"skin\"\nsurface = \"smooth\"\n{keys}\n\
          [[meshes]]\nfile = \"sphere.obj\"\nmaterial = \"skin\"\n"
     );
     let scene = Scene::from_toml(&text, "sphere.toml", Some(dir), &SkinKnobs::default())?;
-    let body = SkinVolume::new(
+    if body == Body::Skin {
+        let Material::Skin(skin) = &scene.materials[0] else {
+            anyhow::bail!("the sphere is not skin");
+        };
+        let medium = LayeredMedium::skin(&skin.params, Wavelength::new(f64::from(NM))?, 0.0)?;
+        let layers = medium.layers();
+        let (e, d) = (layers[0], layers[layers.len() - 1]);
+        let media = Media {
+            outer: (e.sigma_a(), e.sigma_s()),
+            dermis: Some((
+                (d.sigma_a(), d.sigma_s()),
+                skin.params.epidermis_thickness_mm(),
+            )),
+            g: 0.0,
+            eta: skin.params.eta(),
+        };
+        let integrator = BodyIntegrator::build(&scene, IntegratorKind::Volumetric)?;
+        return Ok(((scene, integrator), media));
+    }
+    let volume = SkinVolume::new(
         LayerTables::constant(SIGMA_A, SIGMA_S),
         LayerTables::constant(SIGMA_A, SIGMA_S),
         G,
@@ -72,10 +129,16 @@ fn our_scene(dir: &Path) -> anyhow::Result<(Scene, BodyIntegrator)> {
         0.1,
         scene.geometry.triangles_of(0),
     );
-    let body = BodyIntegrator::Volumetric(Volumetric {
-        media: vec![Some(body)],
+    let integrator = BodyIntegrator::Volumetric(Volumetric {
+        media: vec![Some(volume)],
     });
-    Ok((scene, body))
+    let media = Media {
+        outer: (f64::from(SIGMA_A), f64::from(SIGMA_S)),
+        dermis: None,
+        g: G,
+        eta: f64::from(ETA),
+    };
+    Ok(((scene, integrator), media))
 }
 
 /// Pixels whose centre lies within 0.9 of the sphere's projected radius (row-major).
@@ -128,10 +191,12 @@ fn ours(
 }
 
 /// Mitsuba's two renders (seeds `seeds`): images and CPU seconds each.
+#[allow(clippy::too_many_arguments)] // the renderer, its scene and its film
 fn mitsuba(
     python: &str,
     variant: &str,
     rr_depth: u32,
+    media: &Media,
     dir: &Path,
     side: usize,
     spp: u32,
@@ -148,12 +213,20 @@ fn mitsuba(
             spp.to_string(),
             DISTANCE_MM.to_string(),
             FOV_DEG.to_string(),
-            SIGMA_A.to_string(),
-            SIGMA_S.to_string(),
-            G.to_string(),
-            ETA.to_string(),
+            media.outer.0.to_string(),
+            media.outer.1.to_string(),
+            media.g.to_string(),
+            media.eta.to_string(),
         ])
         .arg(&prefix)
+        .args(media.dermis.iter().flat_map(|((sa, ss), _)| {
+            [
+                "--dermis".to_string(),
+                dir.join("dermis.obj").display().to_string(),
+                sa.to_string(),
+                ss.to_string(),
+            ]
+        }))
         .args(seeds.map(|s| s.to_string()))
         .output()
         .with_context(|| format!("running {python}"))?;
@@ -193,16 +266,28 @@ fn mitsuba(
 
 fn main() -> anyhow::Result<()> {
     let args: Vec<String> = std::env::args().collect();
-    let python = args
-        .get(1)
-        .context("usage: mitsuba_side_by_side PYTHON [VARIANT] [RR_DEPTH] [ROUNDS] [SPP] [SIDE]")?;
+    let python = args.get(1).context(
+        "usage: mitsuba_side_by_side PYTHON [VARIANT] [RR_DEPTH] [ROUNDS] [SPP] [SIDE] [SCENE]",
+    )?;
     let variant = args.get(2).map_or("llvm_ad_mono", String::as_str);
     let num = |k: usize, d: u32| args.get(k).map_or(Ok(d), |s| s.parse::<u32>());
     let (rr_depth, rounds) = (num(3, 5)?, num(4, 3)?);
     let (spp, side) = (num(5, 32)?, num(6, 48)? as usize);
+    let body = match args.get(7).map_or("skin", String::as_str) {
+        "skin" => Body::Skin,
+        "homogeneous" => Body::Homogeneous,
+        other => anyhow::bail!("SCENE {other:?}: skin or homogeneous"),
+    };
     let dir = tempfile::tempdir()?;
-    std::fs::write(dir.path().join("sphere.obj"), sphere_obj())?;
-    let scene = our_scene(dir.path())?;
+    std::fs::write(dir.path().join("sphere.obj"), sphere_obj(RADIUS_MM))?;
+    let (scene, media) = our_scene(dir.path(), body)?;
+    if let Some((_, d_epi)) = media.dermis {
+        std::fs::write(
+            dir.path().join("dermis.obj"),
+            sphere_obj(RADIUS_MM - d_epi as f32),
+        )?;
+    }
+    println!("{body:?} sphere; Mitsuba's media {media:?}");
     let pixels = region(side);
     let paths = (side * side) as f64 * f64::from(spp);
     println!(
@@ -217,7 +302,16 @@ fn main() -> anyhow::Result<()> {
         let seeds = [2 * round + 1, 2 * round + 2];
         let (a, ta) = ours(&scene, side, spp, seeds[0])?;
         let (b, tb) = ours(&scene, side, spp, seeds[1])?;
-        let m = mitsuba(python, variant, rr_depth, dir.path(), side, spp, seeds)?;
+        let m = mitsuba(
+            python,
+            variant,
+            rr_depth,
+            &media,
+            dir.path(),
+            side,
+            spp,
+            seeds,
+        )?;
         let mut row = Vec::new();
         for (k, (x, y, t)) in [
             (a, b, ta + tb),

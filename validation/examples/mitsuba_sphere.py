@@ -9,7 +9,10 @@ and for each seed a line `seed S cpu_s T` gives the process CPU seconds of `mi.r
 one warm-up render, so that the LLVM variant's kernel compilation is not counted).
 
 python mitsuba_sphere.py VARIANT THREADS RR_DEPTH OBJ SIDE SPP DISTANCE FOV_DEG SIGMA_A SIGMA_S G
-       ETA OUT_PREFIX SEED...
+       ETA OUT_PREFIX [--dermis INNER_OBJ SIGMA_A SIGMA_S] SEED...
+
+With `--dermis`, the sphere is two-layer: SIGMA_A and SIGMA_S are the epidermis', and INNER_OBJ,
+an index-matched (`null`) shape inside, holds the dermis medium (its own sigma_a and sigma_s).
 
 RR_DEPTH is volpath's `rr_depth`, the bounce from which Russian roulette may end a path (its
 default 5; a huge value turns roulette off).
@@ -27,13 +30,33 @@ def main(argv):
     variant, threads, rr_depth = argv[1], int(argv[2]), int(argv[3])
     obj, side, spp = argv[4], int(argv[5]), int(argv[6])
     distance, fov, sigma_a, sigma_s, g, eta = map(float, argv[7:13])
-    out_prefix, seeds = argv[13], [int(s) for s in argv[14:]]
+    out_prefix, rest = argv[13], argv[14:]
+    inner = None
+    if rest and rest[0] == "--dermis":
+        inner = (rest[1], float(rest[2]), float(rest[3]))
+        rest = rest[4:]
+    seeds = [int(s) for s in rest]
     mi.set_variant(variant)
     mi.set_log_level(mi.LogLevel.Error)
     dr.set_thread_count(threads)
-    sigma_t = sigma_a + sigma_s
+    def medium(sa, ss):
+        return {
+            "type": "homogeneous",
+            "sigma_t": sa + ss,
+            "albedo": ss / (sa + ss),
+            "phase": {"type": "hg", "g": g},
+        }
 
     def scene(seed, samples):
+        shapes = {}
+        if inner is not None:
+            shapes["dermis"] = {
+                "type": "obj",
+                "filename": inner[0],
+                "bsdf": {"type": "null"},
+                "interior": medium(inner[1], inner[2]),
+                "exterior": medium(sigma_a, sigma_s),
+            }
         return mi.load_dict({
             "type": "scene",
             "integrator": {"type": "volpath", "max_depth": -1, "rr_depth": rr_depth},
@@ -52,13 +75,9 @@ def main(argv):
                 "type": "obj",
                 "filename": obj,
                 "bsdf": {"type": "dielectric", "int_ior": eta, "ext_ior": 1.0},
-                "interior": {
-                    "type": "homogeneous",
-                    "sigma_t": sigma_t,
-                    "albedo": sigma_s / sigma_t,
-                    "phase": {"type": "hg", "g": g},
-                },
+                "interior": medium(sigma_a, sigma_s),
             },
+            **shapes,
         })
 
     warm = scene(0, 1)

@@ -8,10 +8,28 @@
 //! leaves with probability T(θ_out) (the same energy split as the BSSRDF's, `Directional`:
 //! 1 − F for the smooth surface, 1 − ρ_dr for the oily lobe), refracted by Snell's law, or is
 //! reflected back in.
+//!
+//! Where it may go without asking the mesh (§15.5): the walk keeps an anchor point with bounds
+//! lo ≤ D ≤ hi on its distance D to the surface ([`super::distance`]). Within |x − anchor| = δ,
+//! D(x) ≥ lo − δ and D(x) ≤ hi + δ (D is 1-Lipschitz), which settles the layer of most tentative
+//! collisions (dermis when lo − δ > d_epi, epidermis when hi + δ ≤ d_epi), and a flight of length
+//! s with s < lo − δ cannot reach the surface, so no ray is cast for it. Otherwise the bounds are
+//! taken afresh at x, and a ray is cast only when the flight may still reach the surface. Every
+//! decision is the one the exact distance and ray would give: the walk is unchanged in law, only
+//! cheaper.
+//!
+//! Precision: the walk's position and direction are f64 in world mm. A ray is cast in the f32 BVH
+//! from a point pulled back along the direction beyond the f32 rounding of the position, and each
+//! hit is refined in f64 against its triangle's plane; hits behind the position (or on the face
+//! the walk is leaving) are passed over. So the walk neither skips medium near the surface nor
+//! loses light through it, whatever the mesh's distance from the origin (§15.5). At the surface the
+//! walk uses the triangle's geometric normal: the volume it tracks is the mesh's polyhedron, and a
+//! smooth normal there would refract into directions the flat face does not allow.
 
 use super::SkinVolume;
+use crate::accel::BVH_MIN_T_MM;
 use crate::bssrdf::Directional;
-use crate::geometry::Geometry;
+use crate::geometry::{Geometry, SurfaceHit};
 use glam::{DVec3, Vec3};
 use multipole::exact::montecarlo::{ROULETTE_SURVIVAL, ROULETTE_THRESHOLD, scatter_direction};
 use rand::{Rng, RngCore};
@@ -19,6 +37,10 @@ use rand::{Rng, RngCore};
 /// Most real collisions per walk (a bound on the cost; a walk reaching it is dropped, a bias
 /// below 1e-6 of the energy for skin — BENCHMARKS.md).
 pub const MAX_COLLISIONS: u32 = 1_000_000;
+
+/// Most BVH hits one surface query passes over (behind the walk, or its own face) before the
+/// light is counted lost.
+const MAX_PASSED_HITS: usize = 16;
 
 /// Where and how a walk left the skin.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -57,15 +79,15 @@ pub fn refract(d: Vec3, n: Vec3, eta: f32) -> Option<Vec3> {
     Some((d * eta + n * (eta * cos_i - cos_t)).normalize())
 }
 
-/// Walk light that has just entered the skin volume `vol` (material `material`) at `p` along the
-/// refracted direction `dir` (pointing in), at wavelength `nm`; `rays` counts the rays cast.
+/// Walk light that has just entered the skin volume `vol` through the surface point `entry` (of
+/// the volume's material) along the refracted direction `dir` (pointing in), at wavelength `nm`;
+/// `rays` counts the rays cast.
 #[allow(clippy::too_many_arguments)] // the walk's medium, start and random state
 pub fn walk<R: RngCore>(
     geometry: &Geometry,
     vol: &SkinVolume,
     directional: &Directional,
-    p: Vec3,
-    ng_out: Vec3,
+    entry: &SurfaceHit,
     dir: Vec3,
     nm: f32,
     rng: &mut R,
@@ -76,135 +98,197 @@ pub fn walk<R: RngCore>(
         vol.epidermis.sigma_s.at_nm(nm),
     );
     let dermis = (vol.dermis.sigma_a.at_nm(nm), vol.dermis.sigma_s.at_nm(nm));
-    let media = Media {
-        epidermis,
-        dermis,
-        majorant: (epidermis.0 + epidermis.1).max(dermis.0 + dermis.1),
-    };
+    let majorant = (epidermis.0 + epidermis.1).max(dermis.0 + dermis.1);
     let mut out = Walk {
         exit: None,
         collisions: 0,
         tentative: 0,
     };
     debug_assert!(
-        dir.dot(ng_out) <= 1e-4,
+        dir.dot(entry.ng) <= 1e-4,
         "the walk starts with light going in"
     );
-    // The walk starts on the surface itself: an origin offset into the skin would skip medium,
-    // and the offset that clears a triangle grows with the coordinates (2·10⁻⁵ of them: 0.02 mm,
-    // two mean free paths in the blue, on a 1 m mesh). Leaving the surface, the ray ignores hits
-    // closer than that instead. The position is kept in f64: f32 steps of 0.01 mm would round by
-    // 10% at 10 m from the origin.
-    let mut x = p.as_dvec3();
-    let mut t_min = surface_clearance(p);
-    let mut d = dir;
+    let region = &vol.epidermis_region;
+    let d_epi = region.radius_mm();
+    let one_layer = epidermis == dermis;
+    let material = entry.material;
+    // The walk starts on the entry face itself (its f32 hit point put back on the face's plane):
+    // an origin offset into the skin would skip medium.
+    let mut x = onto_face(geometry, entry.triangle, entry.p.as_dvec3());
+    let mut d = dir.as_dvec3();
+    let mut on_face = Some(entry.triangle);
+    let mut anchor = Anchor::surface(x);
+    let mut ahead: Option<Boundary> = None;
     let mut w = 1.0f64;
     while out.collisions < MAX_COLLISIONS {
-        *rays += 1;
-        let Some(hit) = geometry.intersect(x.as_vec3(), d, t_min, f32::INFINITY) else {
-            // Not a closed mesh around x: the light is lost.
-            return out;
+        // A clear medium (σ̄ = 0) flies straight to the surface.
+        let s = if majorant > 0.0 {
+            -(1.0 - rng.random::<f64>()).ln() / f64::from(majorant)
+        } else {
+            f64::INFINITY
         };
-        t_min = 0.0;
-        match fly(&mut x, &mut d, &mut w, hit.t, vol, &media, &mut out, rng) {
-            Flight::Absorbed => return out,
-            Flight::Scattered => continue,
-            Flight::Surface => {}
-        }
-        // At the surface, from inside.
-        let n_out = if hit.ng.dot(d) > 0.0 { hit.ng } else { -hit.ng };
-        let leaving = refract(d, -n_out, vol.eta);
-        if let Some(t) = leaving {
-            let cos_out = t.dot(n_out);
-            if rng.random::<f32>() < directional.transmittance(cos_out) {
-                out.exit = Some(Exit {
-                    p: hit.p,
-                    ng: n_out,
-                    dir: t,
-                    weight: w as f32,
-                });
-                return out;
+        if ahead.is_none() && s >= anchor.lo - anchor.x0.distance(x) {
+            anchor = Anchor::at(region, x);
+            if s >= anchor.lo {
+                *rays += 1;
+                let Some(b) = surface_ahead(geometry, material, x, d, on_face) else {
+                    // Not a closed mesh around x: the light is lost.
+                    return out;
+                };
+                ahead = Some(b);
             }
         }
-        d -= n_out * (2.0 * d.dot(n_out));
-        x = hit.p.as_dvec3();
-        t_min = surface_clearance(hit.p);
+        if let Some(b) = ahead.filter(|b| s >= b.t) {
+            // At the surface, from inside.
+            let dir32 = d.as_vec3();
+            let n_out = if b.hit.ng.dot(dir32) > 0.0 {
+                b.hit.ng
+            } else {
+                -b.hit.ng
+            };
+            if let Some(t) = refract(dir32, -n_out, vol.eta) {
+                if rng.random::<f32>() < directional.transmittance(t.dot(n_out)) {
+                    out.exit = Some(Exit {
+                        p: b.p.as_vec3(),
+                        ng: n_out,
+                        dir: t,
+                        weight: w as f32,
+                    });
+                    return out;
+                }
+            }
+            let n = n_out.as_dvec3();
+            d = (d - n * (2.0 * d.dot(n))).normalize();
+            x = b.p;
+            on_face = Some(b.hit.triangle);
+            anchor = Anchor::surface(x);
+            ahead = None;
+            continue;
+        }
+        x += d * s;
+        on_face = None;
+        if let Some(b) = &mut ahead {
+            b.t -= s;
+        }
+        out.tentative += 1;
+        let (sa, ss) = if one_layer {
+            dermis
+        } else {
+            let delta = anchor.x0.distance(x);
+            let in_epidermis = if anchor.lo - delta > d_epi {
+                false
+            } else if anchor.hi + delta <= d_epi {
+                true
+            } else {
+                anchor = Anchor::at(region, x);
+                anchor.hi <= d_epi
+            };
+            if in_epidermis { epidermis } else { dermis }
+        };
+        if rng.random::<f32>() * majorant >= sa + ss {
+            continue; // null collision
+        }
+        out.collisions += 1;
+        w *= f64::from(ss / (sa + ss));
+        if w == 0.0 {
+            return out;
+        }
+        if w < ROULETTE_THRESHOLD {
+            if rng.random::<f64>() >= ROULETTE_SURVIVAL {
+                return out;
+            }
+            w /= ROULETTE_SURVIVAL;
+        }
+        d = DVec3::from_array(scatter_direction(d.to_array(), &vol.hg, rng)).normalize();
+        ahead = None;
     }
     out
 }
 
-/// The walk's two media at its wavelength, (σa, σs) in mm⁻¹, and the majorant σ̄ of σt.
-struct Media {
-    epidermis: (f32, f32),
-    dermis: (f32, f32),
-    majorant: f32,
+/// A point and bounds lo ≤ D ≤ hi on its distance D to the surface, mm.
+#[derive(Debug, Clone, Copy)]
+struct Anchor {
+    x0: DVec3,
+    lo: f64,
+    hi: f64,
 }
 
-/// How a flight towards the surface ended.
-enum Flight {
-    /// It reached the surface `left` mm ahead.
-    Surface,
-    /// It scattered at a real collision (`x`, `d` and `w` updated).
-    Scattered,
-    /// The light was absorbed (weight 0, or lost at roulette).
-    Absorbed,
-}
+impl Anchor {
+    /// A point on the surface.
+    fn surface(x0: DVec3) -> Self {
+        Self {
+            x0,
+            lo: 0.0,
+            hi: 0.0,
+        }
+    }
 
-/// Delta-track from `x` along `d` towards the surface `left` mm ahead: null collisions pass, the
-/// first real one scatters (implicit capture in `w`, roulette below its threshold).
-#[allow(clippy::too_many_arguments)] // the walk's state, its media and its random state
-fn fly<R: RngCore>(
-    x: &mut DVec3,
-    d: &mut Vec3,
-    w: &mut f64,
-    mut left: f32,
-    vol: &SkinVolume,
-    media: &Media,
-    out: &mut Walk,
-    rng: &mut R,
-) -> Flight {
-    loop {
-        // A clear medium (σ̄ = 0) flies straight to the surface.
-        let step = if media.majorant > 0.0 {
-            -(1.0 - rng.random::<f32>()).ln() / media.majorant
-        } else {
-            f32::INFINITY
-        };
-        if step >= left {
-            return Flight::Surface;
-        }
-        left -= step;
-        *x += d.as_dvec3() * f64::from(step);
-        out.tentative += 1;
-        let (sa, ss) = if vol.epidermis_region.within(x.as_vec3()) {
-            media.epidermis
-        } else {
-            media.dermis
-        };
-        if rng.random::<f32>() * media.majorant >= sa + ss {
-            continue; // null collision
-        }
-        out.collisions += 1;
-        *w *= f64::from(ss / (sa + ss));
-        if *w == 0.0 {
-            return Flight::Absorbed;
-        }
-        if *w < ROULETTE_THRESHOLD {
-            if rng.random::<f64>() >= ROULETTE_SURVIVAL {
-                return Flight::Absorbed;
-            }
-            *w /= ROULETTE_SURVIVAL;
-        }
-        let u = scatter_direction(d.as_dvec3().to_array(), &vol.hg, rng);
-        *d = DVec3::from_array(u).normalize().as_vec3();
-        return Flight::Scattered;
+    /// The bounds at `x0`.
+    fn at(region: &super::distance::SurfaceDistance, x0: DVec3) -> Self {
+        let (lo, hi) = region.bounds(x0);
+        Self { x0, lo, hi }
     }
 }
 
-/// Distance along a ray leaving the surface at `p` within which hits are its own triangle's:
-/// a few hundred f32 ulps of the coordinates (the scale of `geometry::offset_origin`).
-fn surface_clearance(p: Vec3) -> f32 {
-    2e-5 * (1.0 + p.abs().max_element())
+/// The surface ahead of the walk: distance along its direction, point (f64, on the face's plane)
+/// and the BVH hit.
+#[derive(Debug, Clone, Copy)]
+struct Boundary {
+    t: f64,
+    p: DVec3,
+    hit: SurfaceHit,
+}
+
+/// `p` moved onto the plane of triangle `triangle`.
+fn onto_face(geometry: &Geometry, triangle: u32, p: DVec3) -> DVec3 {
+    let [a, b, c] = geometry.triangle(triangle).map(Vec3::as_dvec3);
+    let n = (b - a).cross(c - a).normalize_or_zero();
+    p - n * n.dot(p - a)
+}
+
+/// The first surface of `material` along `d` from `x`, refined in f64 against its face, passing
+/// over faces behind `x` and the face `on_face` that `x` lies on.
+fn surface_ahead(
+    geometry: &Geometry,
+    material: u32,
+    x: DVec3,
+    d: DVec3,
+    on_face: Option<u32>,
+) -> Option<Boundary> {
+    let scale = 1.0 + x.abs().max_element();
+    // Beyond the f32 rounding of x (half an ulp of the coordinates) with a wide margin, and far
+    // enough that the BVH sees surfaces just ahead of x.
+    let back = (16.0 * f64::from(f32::EPSILON) * scale).max(2.0 * f64::from(BVH_MIN_T_MM));
+    // What f64 plane intersections can still confuse with "on the face".
+    let ahead_min = 64.0 * f64::EPSILON * scale;
+    let (o, d32) = ((x - d * back).as_vec3(), d.as_vec3());
+    let mut t_min = 0.0f32;
+    for _ in 0..MAX_PASSED_HITS {
+        let hit = geometry.intersect_material(o, d32, t_min, f32::INFINITY, material)?;
+        let [a, b, c] = geometry.triangle(hit.triangle).map(Vec3::as_dvec3);
+        let n = (b - a).cross(c - a);
+        let nd = n.dot(d);
+        let t = if nd.abs() > 1e-9 * n.length() {
+            n.dot(a - x) / nd
+        } else {
+            f64::from(hit.t) - back
+        };
+        if t > ahead_min && Some(hit.triangle) != on_face {
+            return Some(Boundary {
+                t,
+                p: x + d * t,
+                hit,
+            });
+        }
+        // Past this hit (its t may be −0 when the origin rounds onto its plane).
+        let passed = hit.t.max(t_min);
+        t_min = if passed > 0.0 {
+            f32::from_bits(passed.to_bits() + 1)
+        } else {
+            f32::MIN_POSITIVE
+        };
+    }
+    None
 }
 
 #[cfg(test)]
