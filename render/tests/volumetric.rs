@@ -19,7 +19,7 @@ use render::material::{Material, SkinMaterial, SurfaceKind};
 use render::renderer::{RenderOptions, render_with};
 use render::scene::Scene;
 use render::spectrum::SpectrumTable;
-use render::volumetric::shapes::box_obj;
+use render::volumetric::shapes::{box_obj, sphere_obj};
 use render::volumetric::{LayerTables, SkinVolume, Volumetric};
 use skin_optics::{Preset, SkinParams, Wavelength};
 use std::path::Path;
@@ -278,4 +278,49 @@ fn the_walk_is_independent_of_the_mesh_scale() {
             "half-side {half_mm} mm: walk {l} ± {sigma} vs adding-doubling {want}"
         );
     }
+}
+
+/// The reference does not depend on the tessellation of what it renders: a sphere of radius
+/// 10 mm as 320 and as 20,480 triangles (icospheres of 2 and 5 subdivisions, exact sphere normals
+/// at the vertices), light skin at 550 nm with an isotropic phase, smooth surface, uniform sky,
+/// seen from 60 mm over its central 4 mm: the two mean radiances agree within 3σ of both renders'
+/// noise (1.8% here). The walk refracts at the facets' geometric normals, the entry's Fresnel
+/// split takes the smooth normal; under a uniform sky the coarse facets' tilt (up to 9°, 6.4°
+/// inside) changes the albedo at second order, by about 1 − cos 6.4° = 0.6% at the steepest facet
+/// and less over the disc: below the tolerance, while light lost or skipped at the facets' edges
+/// would show.
+#[test]
+fn the_walk_is_independent_of_the_tessellation() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut results = Vec::new();
+    for subdivisions in [2u32, 5] {
+        std::fs::write(
+            dir.path().join("sphere.obj"),
+            sphere_obj(subdivisions, 10.0),
+        )
+        .unwrap();
+        let text = "[camera]\nposition_mm = [0, 0, 60]\nlook_at_mm = [0, 0, 0]\nfov_deg = 4\n\
+             [environment]\nspectral_radiance = 1\n\
+             [materials.skin]\ntype = \"skin\"\npreset = \"light\"\nsurface = \"smooth\"\nphase_g = 0\n\
+             [[meshes]]\nfile = \"sphere.obj\"\nmaterial = \"skin\"\n";
+        let scene =
+            Scene::from_toml(text, "sphere.toml", Some(dir.path()), &SkinKnobs::default()).unwrap();
+        assert_eq!(
+            scene.geometry.triangle_count(),
+            20 * 4usize.pow(subdivisions)
+        );
+        let body = BodyIntegrator::build(&scene, IntegratorKind::Volumetric).unwrap();
+        let film = render_mono(&scene, &body, 4, 2000, 3);
+        let (l, sigma) = mean_and_sigma(&film);
+        eprintln!(
+            "{} triangles: {l:.5} ± {sigma:.5}",
+            scene.geometry.triangle_count()
+        );
+        results.push((l, sigma));
+    }
+    let [(a, sa), (b, sb)] = [results[0], results[1]];
+    assert!(
+        (a - b).abs() <= 3.0 * sa.hypot(sb),
+        "320 triangles {a} ± {sa} vs 20,480 triangles {b} ± {sb}"
+    );
 }

@@ -32,12 +32,11 @@ use multipole::LayeredMedium;
 use render::integrator::{BodyIntegrator, IntegratorKind};
 use render::material::Material;
 use render::material::SkinKnobs;
-use render::mesh::TriangleMesh;
 use render::renderer::{RenderOptions, render_with};
 use render::scene::Scene;
+use render::volumetric::shapes::sphere_obj;
 use render::volumetric::{LayerTables, SkinVolume, Volumetric};
 use skin_optics::Wavelength;
-use std::fmt::Write as _;
 use std::path::Path;
 use std::process::Command;
 
@@ -69,21 +68,6 @@ struct Media {
     dermis: Option<((f64, f64), f64)>,
     g: f64,
     eta: f64,
-}
-
-/// The sphere of radius `radius_mm` as OBJ in mm, with its vertex normals.
-fn sphere_obj(radius_mm: f32) -> String {
-    let mesh = TriangleMesh::sphere(4);
-    let mut obj = format!("# icosphere, 4 subdivisions, radius {radius_mm} mm\n");
-    for (p, n) in mesh.positions.iter().zip(&mesh.normals) {
-        let p = *p * radius_mm;
-        let _ = writeln!(obj, "v {} {} {}\nvn {} {} {}", p.x, p.y, p.z, n.x, n.y, n.z);
-    }
-    for t in &mesh.indices {
-        let [a, b, c] = t.map(|i| i + 1);
-        let _ = writeln!(obj, "f {a}//{a} {b}//{b} {c}//{c}");
-    }
-    obj
 }
 
 /// Our scene: the OBJ under the constant sky with the body, and what Mitsuba is to be given.
@@ -279,12 +263,12 @@ fn main() -> anyhow::Result<()> {
         other => anyhow::bail!("SCENE {other:?}: skin or homogeneous"),
     };
     let dir = tempfile::tempdir()?;
-    std::fs::write(dir.path().join("sphere.obj"), sphere_obj(RADIUS_MM))?;
+    std::fs::write(dir.path().join("sphere.obj"), sphere_obj(4, RADIUS_MM))?;
     let (scene, media) = our_scene(dir.path(), body)?;
     if let Some((_, d_epi)) = media.dermis {
         std::fs::write(
             dir.path().join("dermis.obj"),
-            sphere_obj(RADIUS_MM - d_epi as f32),
+            sphere_obj(4, RADIUS_MM - d_epi as f32),
         )?;
     }
     println!("{body:?} sphere; Mitsuba's media {media:?}");

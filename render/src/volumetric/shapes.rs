@@ -1,7 +1,29 @@
 //! Closed test shapes for the volumetric reference, as Wavefront OBJ text (the scene loader reads
-//! them like any mesh): boxes for slabs of a given thickness.
+//! them like any mesh): boxes for slabs of a given thickness, and icospheres of a given
+//! tessellation.
 
+use crate::mesh::TriangleMesh;
 use std::fmt::Write as _;
+
+/// An icosphere of radius `radius_mm` centred on the origin (`TriangleMesh::sphere`:
+/// 20 · 4^`subdivisions` triangles), with its exact sphere normals at the vertices, as OBJ.
+#[must_use]
+pub fn sphere_obj(subdivisions: u32, radius_mm: f32) -> String {
+    let mesh = TriangleMesh::sphere(subdivisions);
+    let mut obj = format!(
+        "# icosphere, {subdivisions} subdivisions, {} triangles, radius {radius_mm} mm\n",
+        mesh.indices.len()
+    );
+    for (p, n) in mesh.positions.iter().zip(&mesh.normals) {
+        let p = *p * radius_mm;
+        let _ = writeln!(obj, "v {} {} {}\nvn {} {} {}", p.x, p.y, p.z, n.x, n.y, n.z);
+    }
+    for t in &mesh.indices {
+        let [a, b, c] = t.map(|i| i + 1);
+        let _ = writeln!(obj, "f {a}//{a} {b}//{b} {c}//{c}");
+    }
+    obj
+}
 
 /// A closed box of `size_mm` = [x, y, z] centred on the origin, 12 outward-facing triangles, as OBJ.
 #[must_use]
