@@ -3,7 +3,9 @@
 //! the dermis' coefficients) under a uniform sky, at one wavelength and over the spectrum; and the
 //! cost of the epidermis test (distance to the head mesh) against a BVH ray cast.
 //!
-//! `cargo run --release -p render --example volumetric_speed`
+//! `cargo run --release -p render --features studies --example volumetric_speed [SKIN_SPP]`: with
+//! SKIN_SPP, only the two-layer skin sphere of the Mitsuba comparison, at that many samples per pixel
+//! on one thread (for profiles).
 
 use glam::Vec3;
 use rand::{Rng, SeedableRng};
@@ -30,24 +32,30 @@ fn main() -> anyhow::Result<()> {
     let skin_scene = Scene::from_toml(&skin_sphere, "skin.toml", None, &SkinKnobs::default())?;
     {
         let body = BodyIntegrator::build(&skin_scene, IntegratorKind::Volumetric)?;
+        let only: Option<u32> = std::env::args().nth(1).map(|s| s.parse()).transpose()?;
         let opts = RenderOptions {
             width: 64,
             height: 64,
-            spp: 8,
+            spp: only.unwrap_or(8),
             seed: 1,
             wavelength_nm: Some(550.0),
+            threads: only.map(|_| 1),
             ..Default::default()
         };
+        let settings = opts.validate()?;
         let t0 = cpu_time::ProcessTime::now();
-        let (_, stats) = render_with(&skin_scene, &body, &opts.validate()?, None)?;
+        let (_, stats) = render_with(&skin_scene, &body, &settings, None)?;
         let cpu = t0.elapsed().as_secs_f64();
-        let paths = (64 * 64 * 8) as f64;
+        let paths = f64::from(64 * 64 * settings.spp);
         println!(
             "skin sphere (C_m 0.05, β_m 0.7, C_h 0.02, g 0), 550 nm: {:.0} camera paths per CPU-s, {:.2} µs each ({:.1} rays per path; {cpu:.2} CPU s)",
             paths / cpu,
             cpu / paths * 1e6,
             stats.rays as f64 / paths
         );
+        if only.is_some() {
+            return Ok(());
+        }
     }
     let two_layer = Volumetric::build(&scene)?;
     // Homogeneous: both layers the dermis.

@@ -5,7 +5,8 @@
 //!
 //! Two grids answer, both in world mm with the queries in f64:
 //!
-//! - a sparse **fine grid** (cell h = max(2d, extent / 256)) lists per cell the triangles whose
+//! - a sparse **fine grid** (cell h = max(d, extent / 256), larger when the mesh's area would
+//!   need more than [`MAX_FINE_CELLS`]) lists per cell the triangles whose
 //!   distance to the cell's centre c is at most R = d + h√3/2. For a point p of the cell every
 //!   triangle not listed is farther than R − |p − c| ≥ d (triangle inequality), so with m the least
 //!   distance over the list, lo = min(m, R − |p − c|) and hi = m bound the distance D:
@@ -24,6 +25,9 @@ use std::collections::VecDeque;
 
 /// Most fine cells one side of the grid spans over the mesh's extent.
 const MAX_CELLS_PER_SIDE: f64 = 256.0;
+
+/// About the most fine cells the grid holds (memory: a few tens of bytes each).
+const MAX_FINE_CELLS: f64 = 1.0e6;
 
 /// Most coarse cells per side.
 const MAX_COARSE_PER_SIDE: f64 = 64.0;
@@ -130,6 +134,15 @@ impl Coarse {
         }
     }
 
+    /// Whether `p` lies on the grid (the mesh's bounding box and a cell around it).
+    fn encloses(&self, p: DVec3) -> bool {
+        let q = (p - self.lo) / self.cell_mm;
+        q.min_element() >= 0.0
+            && q.x < self.dims[0] as f64
+            && q.y < self.dims[1] as f64
+            && q.z < self.dims[2] as f64
+    }
+
     /// A lower bound on the distance from `p` to the surface, mm (0 off the grid).
     #[inline]
     fn lower(&self, p: DVec3) -> f64 {
@@ -174,7 +187,19 @@ impl SurfaceDistance {
             (DVec3::ZERO, DVec3::ZERO)
         };
         let extent = (hi - lo).max_element().max(radius_mm);
-        let cell_mm = (2.0 * radius_mm).max(extent / MAX_CELLS_PER_SIDE);
+        // Small cells list few triangles (a query tests each); the cells within R of an area A
+        // number about 2A·R / h³, kept under a budget.
+        let area: f64 = triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(Vec3::as_dvec3);
+                0.5 * (b - a).cross(c - a).length()
+            })
+            .sum();
+        let mut cell_mm = radius_mm.max(extent / MAX_CELLS_PER_SIDE);
+        while 2.0 * area * (radius_mm + cell_mm) / cell_mm.powi(3) > MAX_FINE_CELLS {
+            cell_mm *= 1.25;
+        }
         let reach_mm = radius_mm + cell_mm * 0.5 * 3f64.sqrt();
         let reach2 = reach_mm * reach_mm;
         let tris: Vec<Tri> = triangles.iter().map(Tri::new).collect();
@@ -235,6 +260,13 @@ impl SurfaceDistance {
             .fold(f64::INFINITY, f64::min);
         let m = m2.sqrt();
         (m.min(unlisted.max(coarse)), m)
+    }
+
+    /// Whether `p` lies within the mesh's bounding box (and a margin): a point outside it is outside
+    /// the closed mesh.
+    #[must_use]
+    pub fn encloses(&self, p: DVec3) -> bool {
+        self.coarse.encloses(p)
     }
 
     /// True when some triangle lies within the radius of `p`.

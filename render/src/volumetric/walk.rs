@@ -31,12 +31,18 @@ use crate::accel::BVH_MIN_T_MM;
 use crate::bssrdf::Directional;
 use crate::geometry::{Geometry, SurfaceHit};
 use glam::{DVec3, Vec3};
-use multipole::exact::montecarlo::{ROULETTE_SURVIVAL, ROULETTE_THRESHOLD, scatter_direction};
+use multipole::exact::montecarlo::scatter_direction;
 use rand::{Rng, RngCore};
 
 /// Most real collisions per walk (a bound on the cost; a walk reaching it is dropped, a bias
 /// below 1e-6 of the energy for skin — BENCHMARKS.md).
 pub const MAX_COLLISIONS: u32 = 1_000_000;
+
+/// Weight below which a walk plays Russian roulette: it goes on with probability w / this, at
+/// weight this, else ends (unbiased [AK90]); light skin's walks fall below it after about twenty
+/// collisions, and ending most of their tails costs less than the variance it adds
+/// (BENCHMARKS.md, "Volumetric reference").
+pub const ROULETTE_BELOW: f64 = 0.1;
 
 /// Most BVH hits one surface query passes over (behind the walk, or its own face) before the
 /// light is counted lost.
@@ -127,15 +133,24 @@ pub fn walk<R: RngCore>(
         } else {
             f64::INFINITY
         };
-        if ahead.is_none() && s >= anchor.lo - anchor.x0.distance(x) {
-            anchor = Anchor::at(region, x);
-            if s >= anchor.lo {
+        let delta = anchor.x0.distance(x);
+        if ahead.is_none() && s >= anchor.lo - delta {
+            // D(x) ≤ hi + δ: when the flight is longer, fresh bounds could not clear it.
+            let lo = if s < anchor.hi + delta {
+                anchor = Anchor::at(region, x);
+                anchor.lo
+            } else {
+                anchor.lo - delta
+            };
+            if s >= lo {
+                // Only as far as the flight goes: a short ray visits few BVH nodes.
                 *rays += 1;
-                let Some(b) = surface_ahead(geometry, material, x, d, on_face) else {
+                match surface_ahead(geometry, material, x, d, s, on_face) {
+                    Ahead::Surface(b) => ahead = Some(b),
+                    Ahead::Clear if region.encloses(x + d * s) => {}
                     // Not a closed mesh around x: the light is lost.
-                    return out;
-                };
-                ahead = Some(b);
+                    Ahead::Clear | Ahead::Lost => return out,
+                }
             }
         }
         if let Some(b) = ahead.filter(|b| s >= b.t) {
@@ -193,11 +208,11 @@ pub fn walk<R: RngCore>(
         if w == 0.0 {
             return out;
         }
-        if w < ROULETTE_THRESHOLD {
-            if rng.random::<f64>() >= ROULETTE_SURVIVAL {
+        if w < ROULETTE_BELOW {
+            if rng.random::<f64>() * ROULETTE_BELOW >= w {
                 return out;
             }
-            w /= ROULETTE_SURVIVAL;
+            w = ROULETTE_BELOW;
         }
         d = DVec3::from_array(scatter_direction(d.to_array(), &vol.hg, rng)).normalize();
         ahead = None;
@@ -239,6 +254,17 @@ struct Boundary {
     hit: SurfaceHit,
 }
 
+/// What lies along a flight.
+#[derive(Debug, Clone, Copy)]
+enum Ahead {
+    /// The surface, within the flight.
+    Surface(Boundary),
+    /// No surface within the flight.
+    Clear,
+    /// The query passed over too many hits (the walk is no longer inside a closed mesh).
+    Lost,
+}
+
 /// `p` moved onto the plane of triangle `triangle`.
 fn onto_face(geometry: &Geometry, triangle: u32, p: DVec3) -> DVec3 {
     let [a, b, c] = geometry.triangle(triangle).map(Vec3::as_dvec3);
@@ -246,15 +272,16 @@ fn onto_face(geometry: &Geometry, triangle: u32, p: DVec3) -> DVec3 {
     p - n * n.dot(p - a)
 }
 
-/// The first surface of `material` along `d` from `x`, refined in f64 against its face, passing
-/// over faces behind `x` and the face `on_face` that `x` lies on.
+/// The first surface of `material` along `d` from `x` within `reach_mm`, refined in f64 against its
+/// face, passing over faces behind `x` and the face `on_face` that `x` lies on.
 fn surface_ahead(
     geometry: &Geometry,
     material: u32,
     x: DVec3,
     d: DVec3,
+    reach_mm: f64,
     on_face: Option<u32>,
-) -> Option<Boundary> {
+) -> Ahead {
     let scale = 1.0 + x.abs().max_element();
     // Beyond the f32 rounding of x (half an ulp of the coordinates) with a wide margin, and far
     // enough that the BVH sees surfaces just ahead of x.
@@ -262,9 +289,13 @@ fn surface_ahead(
     // What f64 plane intersections can still confuse with "on the face".
     let ahead_min = 64.0 * f64::EPSILON * scale;
     let (o, d32) = ((x - d * back).as_vec3(), d.as_vec3());
+    // Past the reach by the f32 rounding of the origin and of t.
+    let t_max = (back + reach_mm + back) as f32;
     let mut t_min = 0.0f32;
     for _ in 0..MAX_PASSED_HITS {
-        let hit = geometry.intersect_material(o, d32, t_min, f32::INFINITY, material)?;
+        let Some(hit) = geometry.intersect_material(o, d32, t_min, t_max, material) else {
+            return Ahead::Clear;
+        };
         let [a, b, c] = geometry.triangle(hit.triangle).map(Vec3::as_dvec3);
         let n = (b - a).cross(c - a);
         let nd = n.dot(d);
@@ -273,8 +304,11 @@ fn surface_ahead(
         } else {
             f64::from(hit.t) - back
         };
+        if t > reach_mm {
+            return Ahead::Clear;
+        }
         if t > ahead_min && Some(hit.triangle) != on_face {
-            return Some(Boundary {
+            return Ahead::Surface(Boundary {
                 t,
                 p: x + d * t,
                 hit,
@@ -288,7 +322,7 @@ fn surface_ahead(
             f32::MIN_POSITIVE
         };
     }
-    None
+    Ahead::Lost
 }
 
 #[cfg(test)]
