@@ -168,7 +168,8 @@ pub struct SurfaceDistance {
     triangles: Vec<Tri>,
     /// Per occupied fine cell, its range in `lists`.
     cells: FxHashMap<[i32; 3], (u32, u32)>,
-    lists: Vec<u32>,
+    /// (distance of the triangle from the cell's centre in mm, triangle), nearest first.
+    lists: Vec<(f32, u32)>,
     coarse: Coarse,
 }
 
@@ -203,7 +204,8 @@ impl SurfaceDistance {
         let reach_mm = radius_mm + cell_mm * 0.5 * 3f64.sqrt();
         let reach2 = reach_mm * reach_mm;
         let tris: Vec<Tri> = triangles.iter().map(Tri::new).collect();
-        let mut per_cell: FxHashMap<[i32; 3], Vec<u32>> = FxHashMap::default();
+        // Per cell, (distance from its centre, triangle).
+        let mut per_cell: FxHashMap<[i32; 3], Vec<(f32, u32)>> = FxHashMap::default();
         for (index, (t, tri)) in triangles.iter().zip(&tris).enumerate() {
             let tlo = t[0].min(t[1]).min(t[2]).as_dvec3() - DVec3::splat(reach_mm);
             let thi = t[0].max(t[1]).max(t[2]).as_dvec3() + DVec3::splat(reach_mm);
@@ -213,7 +215,10 @@ impl SurfaceDistance {
                     for k in a[2]..=b[2] {
                         let centre = centre_of([i, j, k], cell_mm);
                         if tri.distance_squared(centre) <= reach2 {
-                            per_cell.entry([i, j, k]).or_default().push(index as u32);
+                            per_cell
+                                .entry([i, j, k])
+                                .or_default()
+                                .push((below(tri.distance_squared(centre).sqrt()), index as u32));
                         }
                     }
                 }
@@ -221,7 +226,9 @@ impl SurfaceDistance {
         }
         let mut cells = FxHashMap::default();
         let mut lists = Vec::with_capacity(per_cell.values().map(Vec::len).sum());
-        for (cell, list) in per_cell {
+        for (cell, mut list) in per_cell {
+            // Nearest the centre first: a query stops at the first triangle that cannot be nearer.
+            list.sort_by(|a, b| a.0.total_cmp(&b.0));
             cells.insert(cell, (lists.len() as u32, list.len() as u32));
             lists.extend(list);
         }
@@ -249,17 +256,27 @@ impl SurfaceDistance {
     #[inline]
     pub fn bounds(&self, p: DVec3) -> (f64, f64) {
         let cell = cell_of(p, self.cell_mm);
-        let unlisted = self.reach_mm - (p - centre_of(cell, self.cell_mm)).length();
-        let coarse = self.coarse.lower(p);
+        let off_centre = (p - centre_of(cell, self.cell_mm)).length();
+        let unlisted = self.reach_mm - off_centre;
         let Some(&(start, len)) = self.cells.get(&cell) else {
-            return (unlisted.max(coarse), f64::INFINITY);
+            return (unlisted.max(self.coarse.lower(p)), f64::INFINITY);
         };
-        let m2 = self.lists[start as usize..(start + len) as usize]
-            .iter()
-            .map(|&t| self.triangles[t as usize].distance_squared(p))
-            .fold(f64::INFINITY, f64::min);
+        let mut m2 = f64::INFINITY;
+        for &(from_centre, t) in &self.lists[start as usize..(start + len) as usize] {
+            // |p − q| ≥ |c − q| − |p − c| for every point q of this and later triangles.
+            let bound = f64::from(from_centre) - off_centre;
+            if bound > 0.0 && bound * bound >= m2 {
+                break;
+            }
+            m2 = m2.min(self.triangles[t as usize].distance_squared(p));
+        }
         let m = m2.sqrt();
-        (m.min(unlisted.max(coarse)), m)
+        let lo = if m <= unlisted {
+            m
+        } else {
+            m.min(unlisted.max(self.coarse.lower(p)))
+        };
+        (lo, m)
     }
 
     /// Whether `p` lies within the mesh's bounding box (and a margin): a point outside it is outside
@@ -279,6 +296,16 @@ impl SurfaceDistance {
     #[must_use]
     pub fn size(&self) -> (usize, usize) {
         (self.cells.len(), self.lists.len())
+    }
+}
+
+/// `x` ≥ 0 as an f32 no larger than it (a lower bound stays one).
+fn below(x: f64) -> f32 {
+    let f = x as f32;
+    if f64::from(f) > x && f > 0.0 {
+        f32::from_bits(f.to_bits() - 1)
+    } else {
+        f
     }
 }
 
@@ -421,5 +448,42 @@ mod tests {
             }
         }
         assert!(deep > 100);
+    }
+
+    /// The same on a curved mesh (a 1,280-triangle sphere of radius 10 mm, many triangles per
+    /// cell), at points within 1 mm of its surface: the bounds enclose the brute-force distance
+    /// and equal it within the radius.
+    #[test]
+    fn bounds_enclose_the_distance_to_a_sphere() {
+        let mesh = crate::mesh::TriangleMesh::sphere(3);
+        let tris: Vec<[Vec3; 3]> = mesh
+            .indices
+            .iter()
+            .map(|t| t.map(|i| mesh.positions[i as usize] * 10.0))
+            .collect();
+        let grid = SurfaceDistance::new(tris.clone(), 0.25);
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(9);
+        let mut within = 0;
+        for _ in 0..5_000 {
+            let u = DVec3::new(
+                rng.random_range(-1.0..1.0),
+                rng.random_range(-1.0..1.0),
+                rng.random_range(-1.0..1.0),
+            )
+            .normalize();
+            let p = u * rng.random_range(9.0..10.5);
+            let exact = tris
+                .iter()
+                .map(|t| distance_squared(p, t))
+                .fold(f64::INFINITY, f64::min)
+                .sqrt();
+            let (lo, hi) = grid.bounds(p);
+            assert!(lo <= exact && exact <= hi, "{p}: {lo} {exact} {hi}");
+            if exact <= 0.25 {
+                within += 1;
+                assert!(hi == exact && lo == exact, "{p}: {lo} {exact} {hi}");
+            }
+        }
+        assert!(within > 500);
     }
 }
