@@ -3,7 +3,7 @@
 //! (a distance from the surface, not a plane) is crossed exactly without ever being intersected;
 //! at a real collision the weight keeps σs/σt (implicit capture) and the direction turns by
 //! Henyey–Greenstein — both from `multipole::exact::montecarlo`, the photon physics of the layered Monte
-//! Carlo; below its roulette threshold the walk plays its Russian roulette. At the surface the
+//! Carlo; below weight [`ROULETTE_BELOW`] the walk plays Russian roulette. At the surface the
 //! walk meets the skin's boundary: total internal reflection beyond the critical angle, else it
 //! leaves with probability T(θ_out) (the same energy split as the BSSRDF's, `Directional`:
 //! 1 − F for the smooth surface, 1 − ρ_dr for the oily lobe), refracted by Snell's law, or is
