@@ -161,16 +161,16 @@ pub fn walk<R: RngCore>(
             } else {
                 -b.hit.ng
             };
-            if let Some(t) = refract(dir32, -n_out, vol.eta) {
-                if rng.random::<f32>() < directional.transmittance(t.dot(n_out)) {
-                    out.exit = Some(Exit {
-                        p: b.p.as_vec3(),
-                        ng: n_out,
-                        dir: t,
-                        weight: w as f32,
-                    });
-                    return out;
-                }
+            if let Some(t) = refract(dir32, -n_out, vol.eta)
+                && rng.random::<f32>() < directional.transmittance(t.dot(n_out))
+            {
+                out.exit = Some(Exit {
+                    p: b.p.as_vec3(),
+                    ng: n_out,
+                    dir: t,
+                    weight: w as f32,
+                });
+                return out;
             }
             let n = n_out.as_dvec3();
             d = (d - n * (2.0 * d.dot(n))).normalize();
