@@ -25,12 +25,14 @@
 //! then clamped to [0, `MAX_TEXEL`]), fitted like any other and flagged out of gamut. Texels
 //! outside the mask are not fitted: they get the median of the fitted maps, ΔE 0 and the flag 0.
 
+mod delta_e;
 mod edit;
 mod invert;
 mod table;
 #[cfg(test)]
 mod tests;
 
+pub use delta_e::delta_e_2000_fast;
 pub use edit::{EDIT_SYNTAX, Edit, apply as apply_edits};
 pub use invert::{Inverted, Inverter, LOOKUP_NODES, PRIOR_WEIGHT_DE};
 pub use table::{
@@ -43,7 +45,7 @@ use rayon::prelude::*;
 use skin_io::cache::CacheOutcome;
 use skin_optics::SkinParams;
 use skin_optics::color::LinearSrgb;
-use skin_optics::lab::{Lab, delta_e_2000};
+use skin_optics::lab::Lab;
 use std::path::PathBuf;
 
 /// A texel is in gamut when the fitted skin reproduces it within this ΔE2000.
@@ -264,9 +266,11 @@ fn memo_slot(bits: [u32; 3]) -> usize {
     (h >> (64 - MEMO_SLOTS.trailing_zeros())) as usize
 }
 
-/// CIELAB of a linear Rec.709 texel, and whether it had to be replaced (module doc).
+/// CIELAB (L*, a*, b*) of a linear Rec.709 texel, and whether it had to be replaced (module
+/// doc): CIE 015 eqs 8.1–8.4 as [`Lab::from_xyz`], with the cube root by Halley's iteration.
 #[inline]
-fn texel_lab(t: [f32; 3]) -> ([f64; 3], bool) {
+#[must_use]
+pub fn texel_lab(t: [f32; 3]) -> ([f64; 3], bool) {
     let bad = t
         .iter()
         .any(|c| !(c.is_finite() && (0.0..=MAX_TEXEL).contains(c)));
@@ -277,8 +281,33 @@ fn texel_lab(t: [f32; 3]) -> ([f64; 3], bool) {
             f64::from(c.clamp(0.0, MAX_TEXEL))
         }
     });
-    let lab = Lab::from_xyz(LinearSrgb(rgb).to_xyz());
-    ([lab.l, lab.a, lab.b], bad)
+    let xyz = LinearSrgb(rgb).to_xyz().0;
+    let w = skin_optics::lab::d65_white().0;
+    const DELTA3: f64 = (6.0 / 29.0) * (6.0 / 29.0) * (6.0 / 29.0);
+    let f = |x: f64| {
+        if x > DELTA3 {
+            cbrt(x)
+        } else {
+            x / (3.0 * (6.0 / 29.0) * (6.0 / 29.0)) + 4.0 / 29.0
+        }
+    };
+    let [fx, fy, fz] = [f(xyz[0] / w[0]), f(xyz[1] / w[1]), f(xyz[2] / w[2])];
+    (
+        [116.0 * fy - 16.0, 500.0 * (fx - fy), 200.0 * (fy - fz)],
+        bad,
+    )
+}
+
+/// Cube root of a positive normal `x`: a first guess from the exponent bits (within 3.3 %), then
+/// two Halley steps y ← y (y³ + 2x)/(2y³ + x), each cubing the relative error (to below 1e-13).
+#[inline]
+fn cbrt(x: f64) -> f64 {
+    let mut y = f64::from_bits(x.to_bits() / 3 + 0x2A9F_7893_782D_A1CE);
+    for _ in 0..2 {
+        let y3 = y * y * y;
+        y *= (y3 + 2.0 * x) / (2.0 * y3 + x);
+    }
+    y
 }
 
 #[inline]
@@ -394,7 +423,7 @@ impl MapsModel {
                             let out = (
                                 melanin_of_u(r.u) as f32,
                                 hemoglobin_of_v(r.v) as f32,
-                                delta_e_2000(lab_of(lab), lab_of(r.lab)) as f32,
+                                delta_e_2000_fast(&lab, &r.lab) as f32,
                                 bad,
                             );
                             memo[slot] = Some((bits, out));
@@ -497,9 +526,7 @@ impl MapsModel {
                 .iter()
                 .map(|lab| {
                     let r = inv.invert(lab);
-                    delta_e_2000(lab_of(*lab), lab_of(r.lab))
-                        .min(BETA_CAP_DE)
-                        .powi(2)
+                    delta_e_2000_fast(lab, &r.lab).min(BETA_CAP_DE).powi(2)
                 })
                 .sum();
             (sum / sample.len() as f64).sqrt()

@@ -4,6 +4,7 @@
 use super::*;
 use crate::ColourModel;
 use multipole::Method;
+use skin_optics::lab::delta_e_2000;
 use std::sync::OnceLock;
 
 /// The default table, built once for all tests here (about 4 CPU-s in release).
@@ -35,8 +36,9 @@ fn exact_texel(m: &ColourModel, p: [f64; 3]) -> [f32; 3] {
         .map(|c| c as f32)
 }
 
+/// CIELAB of a texel by the textbook formulas (not the maps' own path).
 fn texel_to_lab(t: [f32; 3]) -> Lab {
-    lab(texel_lab(t).0)
+    Lab::from_xyz(LinearSrgb(t.map(f64::from)).to_xyz())
 }
 
 /// A smooth synthetic texture: C_m 0.005–0.4 along x, C_h 0.005–0.08 along y (both geometric,
@@ -414,4 +416,55 @@ fn axes_map_to_the_ranges_and_back() {
     for c in [0.001, 0.005, 0.08] {
         assert!((hemoglobin_of_v(v_of_hemoglobin(c)) - c).abs() < 1e-15);
     }
+}
+
+/// The maps' CIEDE2000 without hue angles equals the textbook one ([`delta_e_2000`], eqs 1–22
+/// with atan2 and cosines) within 1e-9 over colour pairs of every kind: skin against skin,
+/// random pairs over the whole CIELAB box, greys (zero chroma), opposite hues, and mean hues on
+/// both sides of the 100° where the rotation term is dropped and around 275° where it peaks.
+#[test]
+fn fast_delta_e_2000_is_the_textbook_one() {
+    use rand::{Rng, SeedableRng};
+    let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(7);
+    let mut pairs: Vec<([f64; 3], [f64; 3])> = Vec::new();
+    for _ in 0..20_000 {
+        let mut draw = |lo: [f64; 3], hi: [f64; 3]| -> [f64; 3] {
+            std::array::from_fn(|c| rng.random_range(lo[c]..hi[c]))
+        };
+        let skin = draw([20.0, 0.0, 5.0], [80.0, 30.0, 35.0]);
+        pairs.push((skin, [skin[0] + 1.5, skin[1] - 0.7, skin[2] + 2.0]));
+        let a = draw([0.0, -128.0, -128.0], [100.0, 128.0, 128.0]);
+        let b = draw([0.0, -128.0, -128.0], [100.0, 128.0, 128.0]);
+        pairs.push((a, b));
+    }
+    for h in (0..3600).map(|k| f64::from(k) * 0.1) {
+        let (c, s) = (h.to_radians().cos(), h.to_radians().sin());
+        pairs.push(([50.0, 20.0 * c, 20.0 * s], [52.0, 21.0 * c, 19.0 * s]));
+        pairs.push(([50.0, 20.0 * c, 20.0 * s], [50.0, -20.0 * c, -20.0 * s]));
+    }
+    pairs.push(([50.0, 0.0, 0.0], [60.0, 0.0, 0.0]));
+    pairs.push(([50.0, 0.0, 0.0], [60.0, 3.0, -4.0]));
+    pairs.push(([0.0, 0.0, 0.0], [100.0, 0.0, 0.0]));
+    for (x, y) in &pairs {
+        let want = delta_e_2000(lab(*x), lab(*y));
+        let got = delta_e_2000_fast(x, y);
+        assert!((got - want).abs() <= 1e-9, "{x:?} {y:?}: {got} vs {want}");
+    }
+}
+
+/// A texel's CIELAB (Halley cube root) is [`Lab::from_xyz`]'s within 1e-11 over texels from near
+/// black (the linear branch of f) to [`MAX_TEXEL`].
+#[test]
+fn texel_lab_is_the_cie_formula() {
+    let mut worst: f64 = 0.0;
+    for k in 0..20_000u32 {
+        let x = |s: u32| (f64::from((k * s) % 9973) / 9972.0).powi(3) * f64::from(MAX_TEXEL);
+        let t = [x(7), x(13), x(31)].map(|v| v as f32);
+        let want = Lab::from_xyz(LinearSrgb(t.map(f64::from)).to_xyz());
+        let got = texel_lab(t).0;
+        for (g, w) in got.iter().zip([want.l, want.a, want.b]) {
+            worst = worst.max((g - w).abs());
+        }
+    }
+    assert!(worst <= 1e-11, "worst {worst}");
 }
