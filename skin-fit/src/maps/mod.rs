@@ -27,6 +27,7 @@
 
 mod delta_e;
 mod edit;
+mod extended;
 mod invert;
 mod table;
 #[cfg(test)]
@@ -34,6 +35,7 @@ mod tests;
 
 pub use delta_e::delta_e_2000_fast;
 pub use edit::{EDIT_SYNTAX, Edit, apply as apply_edits};
+pub use extended::{EXTENDED_STEPS, ExtendedFit, ExtendedValue};
 pub use invert::{Inverted, Inverter, LOOKUP_NODES, PRIOR_WEIGHT_DE};
 pub use table::{
     ForwardTable, MELANIN_KNEE, STEP_NM, Slice, TableSize, cache_key, hemoglobin_of_v,
@@ -100,6 +102,25 @@ pub enum Eumelanin {
     Fit,
 }
 
+/// How the texture's exposure is chosen: a gain on each linear channel (R, G, B) of every texel
+/// before the fit, for a photograph whose light level or white balance is not that of the D65
+/// white the texels are relative to (module doc).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Exposure {
+    /// These gains on R, G and B, each in [`EXPOSURE_RANGE`] (1: the texels as given).
+    Fixed([f64; 3]),
+    /// One gain on all three channels, fitted with β_m over the texels: the gain whose maps
+    /// pass closest to a sample of them.
+    Auto,
+    /// A gain per channel (exposure and white balance), fitted as [`Exposure::Auto`].
+    WhiteBalance,
+}
+
+/// Gains the exposure fit explores: 1/8 to 2 (three stops down, one up).
+pub const EXPOSURE_RANGE: [f64; 2] = [0.125, 2.0];
+/// Gain candidates of the exposure fit, evenly in log₂ g over [`EXPOSURE_RANGE`] (eighth stops).
+const EXPOSURE_STEPS: usize = 33;
+
 /// Whether texels are inverted through the inverse lookup grid ([`Inverter::invert_fast`]) or
 /// each by the full inversion ([`Inverter::invert`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -135,6 +156,8 @@ pub struct MapsOptions {
     pub beta_tolerance_de: f64,
     /// The inverse lookup grid or the full inversion per texel (default [`Lookup::Auto`]).
     pub lookup: Lookup,
+    /// The gain on every texel, given or fitted (default 1: the texels as given).
+    pub exposure: Exposure,
 }
 
 impl Default for MapsOptions {
@@ -149,6 +172,7 @@ impl Default for MapsOptions {
             beta_steps: 21,
             beta_tolerance_de: 0.25,
             lookup: Lookup::Auto,
+            exposure: Exposure::Fixed([1.0; 3]),
         }
     }
 }
@@ -165,6 +189,12 @@ impl MapsOptions {
         };
         if let Eumelanin::Fixed(b) = self.eumelanin {
             check("eumelanin", b, (0.0..=1.0).contains(&b), "[0, 1]")?;
+        }
+        if let Exposure::Fixed(gains) = self.exposure {
+            let [lo, hi] = EXPOSURE_RANGE;
+            for g in gains {
+                check("exposure", g, (lo..=hi).contains(&g), "[0.125, 2]")?;
+            }
         }
         for (name, n) in [
             ("table.melanin", self.table.melanin),
@@ -194,19 +224,22 @@ impl MapsOptions {
     }
 }
 
-/// The β_m range the texels allow: the connected candidates around the fit whose RMS capped
-/// ΔE2000 stays within `tolerance_de` of the best.
+/// The range of a per-texture value (β_m, the exposure) that the texels allow: the connected
+/// candidates around the fit whose RMS capped ΔE2000 stays within `tolerance_de` of the best.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct EumelaninSpread {
-    /// Lowest allowed β_m.
+pub struct FittedRange {
+    /// Lowest allowed value.
     pub min: f64,
-    /// Highest allowed β_m.
+    /// Highest allowed value.
     pub max: f64,
     /// The tolerance, ΔE2000.
     pub tolerance_de: f64,
-    /// RMS capped ΔE2000 of the sample at the fitted β_m.
+    /// RMS capped ΔE2000 of the sample at the fitted value.
     pub best_rms_de: f64,
 }
+
+/// The β_m range the texels allow.
+pub type EumelaninSpread = FittedRange;
 
 /// What a fit did, for the summary line.
 #[derive(Debug, Clone, PartialEq)]
@@ -225,6 +258,10 @@ pub struct MapsSummary {
     pub max_de: f64,
     /// The β_m range the data allow (`None` when β_m was given or nothing was fitted).
     pub eumelanin_spread: Option<EumelaninSpread>,
+    /// The gains on R, G and B applied to every texel before the fit.
+    pub exposure: [f64; 3],
+    /// The common gains the data allow (`None` unless [`Exposure::Auto`] fitted them).
+    pub exposure_spread: Option<FittedRange>,
 }
 
 /// The maps of a texture, one value per texel (row-major, as the texels given).
@@ -281,6 +318,13 @@ pub fn texel_lab(t: [f32; 3]) -> ([f64; 3], bool) {
             f64::from(c.clamp(0.0, MAX_TEXEL))
         }
     });
+    (lab_of_linear(rgb), bad)
+}
+
+/// CIELAB of linear Rec.709 `rgb` (non-negative): CIE 015 eqs 8.1–8.4 as [`Lab::from_xyz`], with
+/// the cube root by Halley's iteration.
+#[inline]
+fn lab_of_linear(rgb: [f64; 3]) -> [f64; 3] {
     let xyz = LinearSrgb(rgb).to_xyz().0;
     let w = skin_optics::lab::d65_white().0;
     const DELTA3: f64 = (6.0 / 29.0) * (6.0 / 29.0) * (6.0 / 29.0);
@@ -292,10 +336,15 @@ pub fn texel_lab(t: [f32; 3]) -> ([f64; 3], bool) {
         }
     };
     let [fx, fy, fz] = [f(xyz[0] / w[0]), f(xyz[1] / w[1]), f(xyz[2] / w[2])];
-    (
-        [116.0 * fy - 16.0, 500.0 * (fx - fy), 200.0 * (fy - fz)],
-        bad,
-    )
+    [116.0 * fy - 16.0, 500.0 * (fx - fy), 200.0 * (fy - fz)]
+}
+
+/// CIELAB of a fitted colour `lab` (found for texels scaled by `gain`) seen at the texture's own
+/// exposure: its linear Rec.709 divided by the gains.
+#[inline]
+fn unscaled(lab: &[f64; 3], gain: [f64; 3]) -> [f64; 3] {
+    let rgb = lab_of(*lab).to_xyz().to_linear_srgb().0;
+    lab_of_linear(std::array::from_fn(|c| (rgb[c] / gain[c]).max(0.0)))
 }
 
 /// Cube root of a positive normal `x`: a first guess from the exponent bits (within 3.3 %), then
@@ -382,10 +431,10 @@ impl MapsModel {
             });
         }
         let fitted: Vec<bool> = mask.map_or_else(|| vec![true; texels.len()], <[bool]>::to_vec);
-        let (beta, spread) = match opts.eumelanin {
-            Eumelanin::Fixed(b) => (b, None),
-            Eumelanin::Fit => self.fit_eumelanin(texels, &fitted, opts),
-        };
+        let shared = self.fit_shared(texels, &fitted, opts);
+        let (beta, gain) = (shared.beta, shared.gain);
+        let gain32 = gain.map(|g| g as f32);
+        let unit_gain = gain == [1.0; 3];
         let count = fitted.iter().filter(|f| **f).count();
         let slice = self.table.slice(beta);
         let inverter = match opts.lookup {
@@ -418,12 +467,18 @@ impl MapsModel {
                     let (mk, hk, dk, bad) = match memo[slot] {
                         Some((b, out)) if b == bits => out,
                         _ => {
-                            let (lab, bad) = texel_lab(t[k]);
+                            let (lab, bad) = texel_lab(scaled(t[k], gain32));
                             let r = inverter.invert_fast(&lab);
+                            // The residual at the texture's own exposure (module doc).
+                            let (seen, fit) = if unit_gain {
+                                (lab, r.lab)
+                            } else {
+                                (texel_lab(t[k]).0, unscaled(&r.lab, gain))
+                            };
                             let out = (
                                 melanin_of_u(r.u) as f32,
                                 hemoglobin_of_v(r.v) as f32,
-                                delta_e_2000_fast(&lab, &r.lab) as f32,
+                                delta_e_2000_fast(&seen, &fit) as f32,
                                 bad,
                             );
                             memo[slot] = Some((bits, out));
@@ -483,7 +538,9 @@ impl MapsModel {
             median_de: quantile(&mut residuals, 0.5),
             p95_de: quantile(&mut residuals, 0.95),
             max_de: residuals.iter().copied().fold(0.0f32, f32::max).into(),
-            eumelanin_spread: spread,
+            eumelanin_spread: shared.beta_spread,
+            exposure: gain,
+            exposure_spread: shared.gain_spread,
         };
         Ok(Maps {
             melanin,
@@ -496,76 +553,82 @@ impl MapsModel {
         })
     }
 
-    /// β_m fitted over a sample of the fitted texels, and its spread (module doc); β_m 0.6 (the
-    /// medium preset's, the prior of `skin fit`) when nothing is fitted.
-    fn fit_eumelanin(
-        &self,
-        texels: &[[f32; 3]],
-        fitted: &[bool],
-        opts: &MapsOptions,
-    ) -> (f64, Option<EumelaninSpread>) {
-        let chosen: Vec<usize> = (0..texels.len()).filter(|&k| fitted[k]).collect();
-        if chosen.is_empty() {
-            return (0.6, None);
+    /// β_m and the exposure, each given or fitted over a sample of the fitted texels, with the
+    /// ranges the sample allows (module doc). Both fitted: alternately, the gain at β_m 0.6 (the
+    /// medium preset's, the prior of `skin fit`), β_m at that gain, the gain again, β_m again.
+    /// β_m 0.6 and gain 1 when nothing is fitted.
+    fn fit_shared(&self, texels: &[[f32; 3]], fitted: &[bool], opts: &MapsOptions) -> Shared {
+        let mut out = Shared {
+            beta: match opts.eumelanin {
+                Eumelanin::Fixed(b) => b,
+                Eumelanin::Fit => 0.6,
+            },
+            gain: match opts.exposure {
+                Exposure::Fixed(g) => g,
+                Exposure::Auto | Exposure::WhiteBalance => [1.0; 3],
+            },
+            beta_spread: None,
+            gain_spread: None,
+        };
+        let fit_beta = opts.eumelanin == Eumelanin::Fit;
+        let fit_gain = !matches!(opts.exposure, Exposure::Fixed(_));
+        if !(fit_beta || fit_gain) {
+            return out;
         }
-        // Golden-ratio (Weyl) positions spread the sample over the texture without lining up
-        // with its rows, as a plain stride of a multiple of the width would.
-        let count = opts.beta_samples.min(chosen.len());
-        let golden = 0.5 * (5f64.sqrt() - 1.0);
-        let sample: Vec<[f64; 3]> = (0..count)
-            .map(|i| {
-                let at = ((i as f64 * golden).fract() * chosen.len() as f64) as usize;
-                texel_lab(texels[chosen[at.min(chosen.len() - 1)]]).0
-            })
-            .collect();
+        let sample = extended::sample_texels(texels, fitted, opts.beta_samples);
+        if sample.is_empty() {
+            return out;
+        }
+        let rms_of = |inv: &Inverter, gain: [f64; 3]| sample_rms(inv, &sample, gain);
         let steps = opts.beta_steps;
         let betas: Vec<f64> = (0..steps).map(|i| i as f64 / (steps - 1) as f64).collect();
-        let objective = |beta: f64| -> f64 {
-            let inv = Inverter::new(self.table.slice(beta));
-            let sum: f64 = sample
-                .iter()
-                .map(|lab| {
-                    let r = inv.invert(lab);
-                    delta_e_2000_fast(lab, &r.lab).min(BETA_CAP_DE).powi(2)
-                })
-                .sum();
-            (sum / sample.len() as f64).sqrt()
-        };
-        let rms: Vec<f64> = betas.par_iter().map(|&b| objective(b)).collect();
-        let best = (0..steps)
-            .min_by(|&a, &b| rms[a].total_cmp(&rms[b]))
-            .unwrap_or(0);
-        // A parabola through the best candidate and its neighbours places β_m between candidates.
-        let beta = if best > 0 && best + 1 < steps {
-            let (a, b, c) = (rms[best - 1], rms[best], rms[best + 1]);
-            let curvature = a - 2.0 * b + c;
-            let shift = if curvature > 0.0 {
-                (0.5 * (a - c) / curvature).clamp(-0.5, 0.5)
-            } else {
-                0.0
-            };
-            betas[best] + shift * (betas[1] - betas[0])
-        } else {
-            betas[best]
-        };
-        let limit = rms[best] + opts.beta_tolerance_de;
-        let mut lo = best;
-        while lo > 0 && rms[lo - 1] <= limit {
-            lo -= 1;
+        let [lo, hi] = EXPOSURE_RANGE.map(f64::log2);
+        let stops: Vec<f64> = (0..EXPOSURE_STEPS)
+            .map(|i| lo + (hi - lo) * i as f64 / (EXPOSURE_STEPS - 1) as f64)
+            .collect();
+        let tolerance = opts.beta_tolerance_de;
+        let rounds = if fit_beta && fit_gain { 2 } else { 1 };
+        for _ in 0..rounds {
+            if fit_gain {
+                let inv = Inverter::new(self.table.slice(out.beta));
+                let rms: Vec<f64> = stops.iter().map(|s| rms_of(&inv, [s.exp2(); 3])).collect();
+                let (stop, range) = best_on_grid(&stops, &rms, tolerance);
+                out.gain = [stop.exp2(); 3];
+                out.gain_spread = Some(FittedRange {
+                    min: range.min.exp2(),
+                    max: range.max.exp2(),
+                    ..range
+                });
+                if opts.exposure == Exposure::WhiteBalance {
+                    // Per channel, from the common gain: Nelder–Mead in log₂ g over the range.
+                    let unit = |x: &[f64; 3]| x.map(|x| (lo + (hi - lo) * x).exp2());
+                    let start = [(stop - lo) / (hi - lo); 3];
+                    let budget = crate::nelder_mead::Budget {
+                        x_tol: 1e-3,
+                        f_tol: 1e-4,
+                        max_evals: 150,
+                    };
+                    let best = crate::nelder_mead::minimize(
+                        &mut |x: &[f64; 3]| rms_of(&inv, unit(x)),
+                        start,
+                        0.1,
+                        budget,
+                    );
+                    out.gain = unit(&best.x);
+                    out.gain_spread = None;
+                }
+            }
+            if fit_beta {
+                let rms: Vec<f64> = betas
+                    .par_iter()
+                    .map(|&b| rms_of(&Inverter::new(self.table.slice(b)), out.gain))
+                    .collect();
+                let (beta, range) = best_on_grid(&betas, &rms, tolerance);
+                out.beta = beta;
+                out.beta_spread = Some(range);
+            }
         }
-        let mut hi = best;
-        while hi + 1 < steps && rms[hi + 1] <= limit {
-            hi += 1;
-        }
-        (
-            beta,
-            Some(EumelaninSpread {
-                min: betas[lo].min(beta),
-                max: betas[hi].max(beta),
-                tolerance_de: opts.beta_tolerance_de,
-                best_rms_de: rms[best],
-            }),
-        )
+        out
     }
 
     /// The linear Rec.709 diffuse albedo of the skins C_m = `melanin`, C_h = `hemoglobin`
@@ -611,4 +674,79 @@ pub fn fit_maps(
     progress: &(dyn Fn(usize) + Sync),
 ) -> Result<Maps, MapsError> {
     MapsModel::load(opts)?.fit(texels, mask, opts, progress)
+}
+
+/// RMS over `sample` of the ΔE2000 (capped at [`BETA_CAP_DE`]) between each texel and its
+/// inversion by `inv` at the exposure `gain`, seen at the texture's own exposure.
+fn sample_rms(inv: &Inverter, sample: &[[f32; 3]], gain: [f64; 3]) -> f64 {
+    let g = gain.map(|g| g as f32);
+    let sum: f64 = sample
+        .par_iter()
+        .with_min_len(256)
+        .map(|t| {
+            let r = inv.invert(&texel_lab(scaled(*t, g)).0);
+            let seen = texel_lab(*t).0;
+            let fit = if gain == [1.0; 3] {
+                r.lab
+            } else {
+                unscaled(&r.lab, gain)
+            };
+            delta_e_2000_fast(&seen, &fit).min(BETA_CAP_DE).powi(2)
+        })
+        .sum();
+    (sum / sample.len().max(1) as f64).sqrt()
+}
+
+/// A texel with its channels scaled by `gain`.
+#[inline]
+fn scaled(t: [f32; 3], gain: [f32; 3]) -> [f32; 3] {
+    [t[0] * gain[0], t[1] * gain[1], t[2] * gain[2]]
+}
+
+/// β_m and the exposure of a texture, with the ranges the texels allow when fitted.
+struct Shared {
+    beta: f64,
+    gain: [f64; 3],
+    beta_spread: Option<FittedRange>,
+    gain_spread: Option<FittedRange>,
+}
+
+/// The best of candidates `xs` (evenly spaced) by their RMS capped ΔE2000 `rms`, placed between
+/// candidates by a parabola through the best and its neighbours, and the connected candidates
+/// within `tolerance_de` of the best.
+fn best_on_grid(xs: &[f64], rms: &[f64], tolerance_de: f64) -> (f64, FittedRange) {
+    let n = xs.len();
+    let best = (0..n)
+        .min_by(|&a, &b| rms[a].total_cmp(&rms[b]))
+        .unwrap_or(0);
+    let x = if best > 0 && best + 1 < n {
+        let (a, b, c) = (rms[best - 1], rms[best], rms[best + 1]);
+        let curvature = a - 2.0 * b + c;
+        let shift = if curvature > 0.0 {
+            (0.5 * (a - c) / curvature).clamp(-0.5, 0.5)
+        } else {
+            0.0
+        };
+        xs[best] + shift * (xs[1] - xs[0])
+    } else {
+        xs[best]
+    };
+    let limit = rms[best] + tolerance_de;
+    let mut lo = best;
+    while lo > 0 && rms[lo - 1] <= limit {
+        lo -= 1;
+    }
+    let mut hi = best;
+    while hi + 1 < n && rms[hi + 1] <= limit {
+        hi += 1;
+    }
+    (
+        x,
+        FittedRange {
+            min: xs[lo].min(x),
+            max: xs[hi].max(x),
+            tolerance_de,
+            best_rms_de: rms[best],
+        },
+    )
 }

@@ -139,6 +139,33 @@ impl ForwardTable {
         })
     }
 
+    /// The slice at one β_m straight from the exact model (`nu` × `nv` nodes on the table's u, v
+    /// axes, skins built on `base`): what [`ForwardTable::slice`] interpolates, without the β_m
+    /// axis, for a search over skins that differ in more than C_m, β_m, C_h.
+    pub fn exact_slice(
+        nu: usize,
+        nv: usize,
+        base: SkinParams,
+        beta: f64,
+    ) -> Result<Slice, FitError> {
+        let exact = Forward::Exact(AddingDoublingOptions::default().with_layer_cache(true));
+        let model = ColourModel::with_forward(STEP_NM, exact, base)?;
+        let nodes = (0..nu * nv)
+            .into_par_iter()
+            .map(|k| {
+                let (i, j) = (k % nu, k / nu);
+                let skin = model.skin(
+                    melanin_of_u(i as f64 / (nu - 1) as f64),
+                    beta,
+                    hemoglobin_of_v(j as f64 / (nv - 1) as f64),
+                )?;
+                let lab = model.lab(&skin)?;
+                Ok([lab.l, lab.a, lab.b])
+            })
+            .collect::<Result<Vec<_>, FitError>>()?;
+        Ok(Slice::new(nu, nv, &nodes, beta))
+    }
+
     /// The node counts.
     #[must_use]
     pub fn size(&self) -> TableSize {
