@@ -183,6 +183,7 @@ pub fn run(args: &MapsArgs) -> anyhow::Result<()> {
             mask.as_deref(),
             &opts,
             args.model,
+            &skin_fit::Parameter::CANDIDATES,
             &|name| spinner.set_message(format!("fitting {name} over the texture")),
         )?;
         spinner.finish_and_clear();

@@ -1,6 +1,6 @@
 //! CIEDE2000 ([SWD05] eqs 1–22) for the maps' per-texel residual, written without the two hue
 //! angles: the same number as [`skin_optics::lab::delta_e_2000`] (to rounding, about 1e-13
-//! ΔE00) at a fraction of its cost (docs/physics.md §18.4).
+//! ΔE00) at a fraction of its cost (docs/physics.md §18, "ΔE2000 per texel").
 //!
 //! The hue angles h'₁, h'₂ enter ΔE00 only through sin(Δh'/2) and the mean hue H̄'. With the
 //! unit hue vectors e₁ = (a'₁, b₁)/C'₁ and e₂ = (a'₂, b₂)/C'₂:

@@ -1,5 +1,5 @@
 //! The extended parameters of `skin fit --model` in the maps: one value per texture each, fitted
-//! over a sample of the texels (docs/physics.md §18.5).
+//! over a sample of the texels (docs/physics.md §18, "Extended parameters").
 //!
 //! Three colour numbers per texel already go to C_m and C_h, so a parameter beyond them can only
 //! be read from the texture as a whole, as β_m is. Each free parameter in turn is set to
@@ -55,7 +55,8 @@ impl ExtendedFit {
 }
 
 impl MapsModel {
-    /// The extended parameters of `model` (`seed`: none) fitted per texture over the sample of
+    /// The extended parameters of `model` (`seed`: none), tried in the order of `candidates`
+    /// ([`Parameter::CANDIDATES`] for `skin fit`'s set), fitted per texture over the sample of
     /// `texels` (inside `mask`) that β_m is fitted on (module doc), from this model's β_m and
     /// exposure. `progress` gets the parameter's name before each is tried.
     pub fn fit_extended(
@@ -64,6 +65,7 @@ impl MapsModel {
         mask: Option<&[bool]>,
         opts: &MapsOptions,
         model: ModelChoice,
+        candidates: &[Parameter],
         progress: &(dyn Fn(&str) + Sync),
     ) -> Result<ExtendedFit, MapsError> {
         opts.validate()?;
@@ -95,12 +97,8 @@ impl MapsModel {
         };
         let mut current = seed_rms;
         let mut values = Vec::new();
-        let candidates: &[Parameter] = match model {
-            ModelChoice::Seed => &[],
-            ModelChoice::Full | ModelChoice::Auto => &Parameter::CANDIDATES,
-        };
         for &p in candidates {
-            if sample.is_empty() {
+            if sample.is_empty() || model == ModelChoice::Seed {
                 break;
             }
             progress(p.name());

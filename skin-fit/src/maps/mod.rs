@@ -12,14 +12,20 @@
 //! β_m its slice is interpolated (cubic along β_m), and each texel is inverted on the slice's
 //! bicubic interpolant: a seed from a grid over CIELAB, then damped Gauss–Newton steps minimising
 //! the CIELAB distance (ΔE76) plus the tiny C_h prior of `skin fit` ([`PRIOR_WEIGHT_DE`]).
-//! The reported residual is ΔE2000 between the texel and the fitted skin on the interpolant;
-//! a texel is in gamut when it is at most [`IN_GAMUT_DE`].
+//! The reported residual is ΔE2000 ([`delta_e_2000_fast`]) between the texel and the fitted skin
+//! on the interpolant; a texel is in gamut when it is at most [`IN_GAMUT_DE`].
 //!
 //! **β_m.** Three colour numbers per texel cannot pin three parameters well, so β_m is one value
 //! per texture: given ([`Eumelanin::Fixed`]) or fitted ([`Eumelanin::Fit`]) as the β_m whose slice
 //! passes closest to a sample of the texels (RMS of ΔE2000 capped at [`BETA_CAP_DE`], so hair and
 //! other non-skin texels weigh no more than a poor skin fit). [`EumelaninSpread`] reports the β_m
 //! range the data allow.
+//!
+//! **Exposure.** Every texel may be multiplied by gains on R, G, B first ([`Exposure`]), given or
+//! fitted with β_m on the same sample; the residuals (reported and scored) compare the texel with
+//! the fitted skin seen at the texture's own exposure (docs/physics.md §18, "Exposure").
+//! The extended parameters of `skin fit --model` are one value per texture
+//! ([`MapsModel::fit_extended`]).
 //!
 //! **Bad texels.** A non-finite, negative or huge component ([`MAX_TEXEL`]) is replaced (NaN by 0,
 //! then clamped to [0, `MAX_TEXEL`]), fitted like any other and flagged out of gamut. Texels
@@ -224,8 +230,9 @@ impl MapsOptions {
     }
 }
 
-/// The range of a per-texture value (β_m, the exposure) that the texels allow: the connected
-/// candidates around the fit whose RMS capped ΔE2000 stays within `tolerance_de` of the best.
+/// The range of a per-texture value (β_m, the exposure, an extended parameter) that the texels
+/// allow: around the fit, where the sample's RMS capped ΔE2000 (linear between the candidates
+/// tried) stays within `tolerance_de` of the best candidate's.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FittedRange {
     /// Lowest allowed value.
@@ -712,8 +719,8 @@ struct Shared {
 }
 
 /// The best of candidates `xs` (evenly spaced) by their RMS capped ΔE2000 `rms`, placed between
-/// candidates by a parabola through the best and its neighbours, and the connected candidates
-/// within `tolerance_de` of the best.
+/// candidates by a parabola through the best and its neighbours, and the range around it where
+/// the RMS (linear between candidates) stays within `tolerance_de` of the best candidate's.
 fn best_on_grid(xs: &[f64], rms: &[f64], tolerance_de: f64) -> (f64, FittedRange) {
     let n = xs.len();
     let best = (0..n)
@@ -740,11 +747,27 @@ fn best_on_grid(xs: &[f64], rms: &[f64], tolerance_de: f64) -> (f64, FittedRange
     while hi + 1 < n && rms[hi + 1] <= limit {
         hi += 1;
     }
+    // Each end where the RMS, linear between candidates, crosses the limit.
+    let crossing = |inside: usize, outside: usize| -> f64 {
+        let (a, b) = (rms[inside], rms[outside]);
+        let t = if b > a {
+            ((limit - a) / (b - a)).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        xs[inside] + t * (xs[outside] - xs[inside])
+    };
+    let min = if lo > 0 { crossing(lo, lo - 1) } else { xs[lo] };
+    let max = if hi + 1 < n {
+        crossing(hi, hi + 1)
+    } else {
+        xs[hi]
+    };
     (
         x,
         FittedRange {
-            min: xs[lo].min(x),
-            max: xs[hi].max(x),
+            min: min.min(x),
+            max: max.max(x),
             tolerance_de,
             best_rms_de: rms[best],
         },
