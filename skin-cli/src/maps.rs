@@ -46,11 +46,13 @@ pub struct MapsArgs {
     /// Fit β_m over the texels (the default), and report the range the data allow.
     #[arg(long)]
     pub fit_eumelanin: bool,
-    /// Gain on every linear texel before the fit, in [0.125, 2], or `auto` (fitted with β_m: the
-    /// gain whose maps reproduce a sample of the texels best; its range is reported). For a
-    /// photograph whose light level is not the D65 white's (a lit or exposed texture); 1 takes
-    /// the texels as a measured diffuse albedo. albedo.png is the fitted skin at that gain.
-    #[arg(long, value_name = "G|auto", default_value = "1", allow_hyphen_values = true, value_parser = crate::args::Checked(parse_exposure))]
+    /// Gains on the linear texels before the fit, each in [0.125, 2]: G (all channels), R,G,B,
+    /// `auto` (one gain fitted with β_m: the one whose maps reproduce a sample of the texels best;
+    /// its range is reported) or `auto-rgb` (one per channel: exposure and white balance). For a
+    /// photograph whose light level or colour balance is not a measured albedo's; 1 takes the
+    /// texels as they are. Residuals are measured at the texture's own exposure; albedo.png is
+    /// the fitted skins' albedo, so the texture after the gains.
+    #[arg(long, value_name = "G|R,G,B|auto|auto-rgb", default_value = "1", allow_hyphen_values = true, value_parser = crate::args::Checked(parse_exposure))]
     pub exposure: Exposure,
     /// Parameters beyond C_m, β_m, C_h, as `skin fit --model`: `seed` (none), `full` (blood near
     /// the surface, epidermis thickness, γ, scattering scales, bilirubin) or `auto` (those that
