@@ -254,6 +254,42 @@ fn exposure_scales_a_brighter_photograph_back() {
     }
 }
 
+/// `--eumelanin-regions 4` on the 8 × 4 texture: two regions, the eumelanin channel constant
+/// within each and in [0, 1], the summary names the regions, and the skins stay in gamut.
+#[test]
+fn eumelanin_per_region_fills_the_channel() {
+    let (tmp, out) = out_dir("regions");
+    let png = tmp.path().join("albedo.png");
+    write_png16(&png, 8, 4, &texture());
+    let o = skin_maps(&[
+        "--albedo",
+        png.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--eumelanin-regions",
+        "4",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(
+        err.contains("per region of 4×4 texels (2 regions)"),
+        "{err}"
+    );
+    let maps = read_maps(&out);
+    let b = &maps["eumelanin"];
+    for k in 0..32 {
+        assert!((0.0..=1.0).contains(&b[k]), "texel {k}: {}", b[k]);
+        assert_eq!(b[k], b[if k % 8 < 4 { 0 } else { 4 }], "texel {k}");
+        if k % 8 < 4 {
+            assert_eq!(
+                maps["in_gamut"][k], 1.0,
+                "texel {k}: {}",
+                maps["delta_e"][k]
+            );
+        }
+    }
+}
+
 /// Bad `--exposure` and `--model` values are usage errors naming the valid ones.
 #[test]
 fn bad_exposure_and_model_are_usage_errors() {
@@ -262,6 +298,7 @@ fn bad_exposure_and_model_are_usage_errors() {
         ("--exposure", "0.5,0.6", "is not G, R,G,B, auto or auto-rgb"),
         ("--exposure", "bright", "[0.125, 2]"),
         ("--model", "tiny", "valid: seed, full, auto"),
+        ("--eumelanin-regions", "2", "4..=4096"),
     ] {
         let o = skin_maps(&["--albedo", "x.png", flag, value]);
         assert_eq!(o.status.code(), Some(2), "{flag} {value}: {}", stderr(&o));

@@ -35,6 +35,7 @@ mod delta_e;
 mod edit;
 mod extended;
 mod invert;
+mod regions;
 mod table;
 #[cfg(test)]
 mod tests;
@@ -43,6 +44,7 @@ pub use delta_e::delta_e_2000_fast;
 pub use edit::{EDIT_SYNTAX, Edit, apply as apply_edits};
 pub use extended::{EXTENDED_STEPS, ExtendedFit, ExtendedValue};
 pub use invert::{Inverted, Inverter, LOOKUP_NODES, PRIOR_WEIGHT_DE};
+pub use regions::{DEFAULT_SMOOTHNESS, REGION_SAMPLES, RegionSummary, Regions};
 pub use table::{
     ForwardTable, MELANIN_KNEE, STEP_NM, Slice, TableSize, cache_key, hemoglobin_of_v,
     melanin_of_u, u_of_melanin, v_of_hemoglobin,
@@ -106,6 +108,8 @@ pub enum Eumelanin {
     Fixed(f64),
     /// Fitted over the texels (module doc).
     Fit,
+    /// One value per region of the texture, with a smoothness prior ([`Regions`]).
+    PerRegion(Regions),
 }
 
 /// How the texture's exposure is chosen: a gain on each linear channel (R, G, B) of every texel
@@ -196,6 +200,26 @@ impl MapsOptions {
         if let Eumelanin::Fixed(b) = self.eumelanin {
             check("eumelanin", b, (0.0..=1.0).contains(&b), "[0, 1]")?;
         }
+        if let Eumelanin::PerRegion(r) = self.eumelanin {
+            check(
+                "eumelanin regions block",
+                r.block as f64,
+                (4..=4096).contains(&r.block),
+                "[4, 4096] texels",
+            )?;
+            check(
+                "eumelanin regions width",
+                r.width as f64,
+                r.width >= 1,
+                "[1, ∞) texels",
+            )?;
+            check(
+                "eumelanin smoothness",
+                r.smoothness,
+                r.smoothness >= 0.0,
+                "[0, ∞) ΔE² per unit β_m²",
+            )?;
+        }
         if let Exposure::Fixed(gains) = self.exposure {
             let [lo, hi] = EXPOSURE_RANGE;
             for g in gains {
@@ -269,6 +293,8 @@ pub struct MapsSummary {
     pub exposure: [f64; 3],
     /// The common gains the data allow (`None` unless [`Exposure::Auto`] fitted them).
     pub exposure_spread: Option<FittedRange>,
+    /// β_m over the regions (`None` unless [`Eumelanin::PerRegion`]).
+    pub regions: Option<RegionSummary>,
 }
 
 /// The maps of a texture, one value per texel (row-major, as the texels given).
@@ -278,8 +304,10 @@ pub struct Maps {
     pub melanin: Vec<f32>,
     /// Hemoglobin volume fraction C_h, [0.001, 0.1].
     pub hemoglobin: Vec<f32>,
-    /// Eumelanin blend β_m of the whole texture, [0, 1].
+    /// Eumelanin blend β_m of the whole texture, [0, 1] (with regions: their median).
     pub eumelanin: f64,
+    /// β_m of every texel when it varies by region ([`Eumelanin::PerRegion`]).
+    pub eumelanin_map: Option<Vec<f32>>,
     /// ΔE2000 between the texel and the fitted skin (0 outside the mask).
     pub delta_e: Vec<f32>,
     /// Whether the texel was fitted and reproduced within [`IN_GAMUT_DE`].
@@ -443,12 +471,58 @@ impl MapsModel {
         let gain32 = gain.map(|g| g as f32);
         let unit_gain = gain == [1.0; 3];
         let count = fitted.iter().filter(|f| **f).count();
-        let slice = self.table.slice(beta);
-        let inverter = match opts.lookup {
-            Lookup::Always => Inverter::with_lookup(slice),
-            Lookup::Auto if count > LOOKUP_NODES => Inverter::with_lookup(slice),
-            _ => Inverter::new(slice),
+        let with_lookup = |texels: usize| match opts.lookup {
+            Lookup::Always => true,
+            Lookup::Auto => texels > LOOKUP_NODES,
+            Lookup::Never => false,
         };
+        // One inverter per β_m in use: the texture's, or each region's candidate.
+        let (inverters, regions): (Vec<Inverter>, Option<regions::RegionFit>) = match opts.eumelanin
+        {
+            Eumelanin::PerRegion(r) => {
+                let steps = opts.beta_steps;
+                let betas: Vec<f64> = (0..steps).map(|i| i as f64 / (steps - 1) as f64).collect();
+                let plain: Vec<Inverter> = betas
+                    .par_iter()
+                    .map(|&b| Inverter::new(self.table.slice(b)))
+                    .collect();
+                let fit = regions::fit_regions(
+                    texels,
+                    &fitted,
+                    r,
+                    &betas,
+                    &plain,
+                    gain,
+                    opts.beta_tolerance_de,
+                )?;
+                let mut uses = vec![0usize; betas.len()];
+                for (l, f) in fit.label_of_texel.iter().zip(&fitted) {
+                    uses[usize::from(*l)] += usize::from(*f);
+                }
+                let inverters = plain
+                    .into_iter()
+                    .zip(&uses)
+                    .map(|(inv, &u)| {
+                        if u > 0 && with_lookup(u) {
+                            Inverter::with_lookup(inv.slice().clone())
+                        } else {
+                            inv
+                        }
+                    })
+                    .collect();
+                (inverters, Some(fit))
+            }
+            _ => {
+                let slice = self.table.slice(beta);
+                let inv = if with_lookup(count) {
+                    Inverter::with_lookup(slice)
+                } else {
+                    Inverter::new(slice)
+                };
+                (vec![inv], None)
+            }
+        };
+        let labels: Option<&[u8]> = regions.as_ref().map(|r| r.label_of_texel.as_slice());
         let n = texels.len();
         let mut melanin = vec![0.0f32; n];
         let mut hemoglobin = vec![0.0f32; n];
@@ -460,7 +534,8 @@ impl MapsModel {
             .zip(delta_e.par_chunks_mut(CHUNK))
             .zip(in_gamut.par_chunks_mut(CHUNK))
             .zip(texels.par_chunks(CHUNK).zip(fitted.par_chunks(CHUNK)))
-            .map(|((((m, h), de), g), (t, f))| {
+            .enumerate()
+            .map(|(chunk, ((((m, h), de), g), (t, f)))| {
                 let mut invalid = 0;
                 // Textures decoded from 8- or 16-bit files repeat colours, mostly nearby: a
                 // small direct-mapped memo of exact texel values skips the repeats.
@@ -469,13 +544,14 @@ impl MapsModel {
                     if !f[k] {
                         continue;
                     }
+                    let label = labels.map_or(0, |l| l[chunk * CHUNK + k]);
                     let bits = t[k].map(f32::to_bits);
                     let slot = memo_slot(bits);
                     let (mk, hk, dk, bad) = match memo[slot] {
-                        Some((b, out)) if b == bits => out,
+                        Some((b, l, out)) if b == bits && l == label => out,
                         _ => {
                             let (lab, bad) = texel_lab(scaled(t[k], gain32));
-                            let r = inverter.invert_fast(&lab);
+                            let r = inverters[usize::from(label)].invert_fast(&lab);
                             // The residual at the texture's own exposure (module doc).
                             let (seen, fit) = if unit_gain {
                                 (lab, r.lab)
@@ -488,7 +564,7 @@ impl MapsModel {
                                 delta_e_2000_fast(&seen, &fit) as f32,
                                 bad,
                             );
-                            memo[slot] = Some((bits, out));
+                            memo[slot] = Some((bits, label, out));
                             out
                         }
                     };
@@ -548,11 +624,19 @@ impl MapsModel {
             eumelanin_spread: shared.beta_spread,
             exposure: gain,
             exposure_spread: shared.gain_spread,
+            regions: regions.as_ref().map(|r| r.summary),
         };
+        let eumelanin_map = regions.as_ref().map(|r| {
+            r.label_of_texel
+                .iter()
+                .map(|&l| r.betas[usize::from(l)] as f32)
+                .collect()
+        });
         Ok(Maps {
             melanin,
             hemoglobin,
-            eumelanin: beta,
+            eumelanin: regions.as_ref().map_or(beta, |r| r.summary.median),
+            eumelanin_map,
             delta_e,
             in_gamut,
             fitted,
@@ -568,7 +652,7 @@ impl MapsModel {
         let mut out = Shared {
             beta: match opts.eumelanin {
                 Eumelanin::Fixed(b) => b,
-                Eumelanin::Fit => 0.6,
+                Eumelanin::Fit | Eumelanin::PerRegion(_) => 0.6,
             },
             gain: match opts.exposure {
                 Exposure::Fixed(g) => g,
@@ -577,8 +661,13 @@ impl MapsModel {
             beta_spread: None,
             gain_spread: None,
         };
-        let fit_beta = opts.eumelanin == Eumelanin::Fit;
         let fit_gain = !matches!(opts.exposure, Exposure::Fixed(_));
+        // With regions, one β_m for the texture serves only the exposure fit.
+        let fit_beta = match opts.eumelanin {
+            Eumelanin::Fit => true,
+            Eumelanin::PerRegion(_) => fit_gain,
+            Eumelanin::Fixed(_) => false,
+        };
         if !(fit_beta || fit_gain) {
             return out;
         }
@@ -670,6 +759,38 @@ impl MapsModel {
                 lab_of(lab).to_xyz().to_linear_srgb().0.map(|c| c as f32)
             })
             .collect())
+    }
+}
+
+impl MapsModel {
+    /// The albedo of `maps` as [`MapsModel::albedo`], with β_m per texel where the maps have it
+    /// (each distinct β_m value gets its slice).
+    pub fn albedo_of(&self, maps: &Maps) -> Result<Vec<[f32; 3]>, MapsError> {
+        let Some(betas) = &maps.eumelanin_map else {
+            return self.albedo(&maps.melanin, maps.eumelanin, &maps.hemoglobin);
+        };
+        let n = maps.melanin.len();
+        if betas.len() != n || maps.hemoglobin.len() != n {
+            return Err(MapsError::Length {
+                what: "eumelanin or hemoglobin map",
+                found: betas.len().min(maps.hemoglobin.len()),
+                expected: n,
+            });
+        }
+        let mut distinct: Vec<u32> = betas.iter().map(|b| b.to_bits()).collect();
+        distinct.sort_unstable();
+        distinct.dedup();
+        let mut out = vec![[0.0f32; 3]; n];
+        for bits in distinct {
+            let beta = f64::from(f32::from_bits(bits));
+            let pick: Vec<usize> = (0..n).filter(|&k| betas[k].to_bits() == bits).collect();
+            let m: Vec<f32> = pick.iter().map(|&k| maps.melanin[k]).collect();
+            let h: Vec<f32> = pick.iter().map(|&k| maps.hemoglobin[k]).collect();
+            for (k, a) in pick.iter().zip(self.albedo(&m, beta.clamp(0.0, 1.0), &h)?) {
+                out[*k] = a;
+            }
+        }
+        Ok(out)
     }
 }
 

@@ -578,3 +578,75 @@ fn an_extended_parameter_is_fitted_per_texture() {
     assert!(!fit.values[0].kept, "{fit:?}");
     assert_eq!(fit.base, base);
 }
+
+/// A 16 × 8 texture whose left half has β_m 0.3 and right half 0.9 (C_m 0.01–0.3 and C_h
+/// 0.005–0.05 varying within each half): with 8 × 8 regions each half gets its own β_m within
+/// its regions' allowed range, the maps reproduce the texture (median ΔE2000 ≤ 0.5) and their
+/// albedo follows the per-texel β_m; a prior strong enough to forbid any step gives both
+/// regions one β_m.
+#[test]
+fn eumelanin_per_region_follows_the_texture() {
+    let m = exact();
+    let (w, h) = (16, 8);
+    let truth: Vec<[f64; 3]> = (0..w * h)
+        .map(|k| {
+            let (x, y) = (k % w, k / w);
+            let beta = if x < 8 { 0.3 } else { 0.9 };
+            let c_m = 0.01 * 30f64.powf((x % 8) as f64 / 7.0);
+            let c_h = 0.005 * 10f64.powf(y as f64 / 7.0);
+            [c_m, beta, c_h]
+        })
+        .collect();
+    let texels: Vec<[f32; 3]> = truth.iter().map(|p| exact_texel(&m, *p)).collect();
+    for smoothness in [DEFAULT_SMOOTHNESS, 1e9] {
+        let opts = MapsOptions {
+            eumelanin: Eumelanin::PerRegion(Regions {
+                width: w,
+                block: 8,
+                smoothness,
+            }),
+            beta_steps: 11,
+            ..MapsOptions::default()
+        };
+        let maps = model().fit(&texels, None, &opts, &|_| {}).unwrap();
+        let map = maps.eumelanin_map.clone().expect("per texel");
+        let r = maps.summary.regions.expect("regions");
+        assert_eq!(r.regions, 2);
+        if smoothness > 1e6 {
+            assert!(map.iter().all(|b| *b == map[0]), "{r:?}");
+            continue;
+        }
+        // The data pin a region's β_m to about ±0.1 (the allowed width, 0.2 here).
+        let (left, right) = (f64::from(map[0]), f64::from(map[15]));
+        assert!(
+            (left - 0.3).abs() <= 0.1 && (right - 0.9).abs() <= 0.1,
+            "{left} {right} {r:?}"
+        );
+        assert!(
+            r.median_allowed_width > 0.0 && r.median_allowed_width < 0.5,
+            "{r:?}"
+        );
+        let s = &maps.summary;
+        assert!(s.in_gamut == w * h && s.median_de <= 0.5, "{s:?}");
+        let back = model().albedo_of(&maps).unwrap();
+        let des: Vec<f64> = back
+            .iter()
+            .zip(&texels)
+            .map(|(a, t)| delta_e_2000(texel_to_lab(*a), texel_to_lab(*t)))
+            .collect();
+        assert!(quantile(des, 0.5) <= 0.5);
+    }
+    let odd = MapsOptions {
+        eumelanin: Eumelanin::PerRegion(Regions {
+            width: 5,
+            block: 8,
+            smoothness: DEFAULT_SMOOTHNESS,
+        }),
+        ..MapsOptions::default()
+    };
+    let e = model().fit(&texels, None, &odd, &|_| {}).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "maps option eumelanin regions width = 5 outside a divisor of the texel count"
+    );
+}
