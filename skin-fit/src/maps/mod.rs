@@ -19,7 +19,8 @@
 //! per texture: given ([`Eumelanin::Fixed`]) or fitted ([`Eumelanin::Fit`]) as the β_m whose slice
 //! passes closest to a sample of the texels (RMS of ΔE2000 capped at [`BETA_CAP_DE`], so hair and
 //! other non-skin texels weigh no more than a poor skin fit). [`EumelaninSpread`] reports the β_m
-//! range the data allow.
+//! range the data allow. [`Eumelanin::PerRegion`] lets it vary by region of the texture, with a
+//! smoothness prior (module `regions`).
 //!
 //! **Exposure.** Every texel may be multiplied by gains on R, G, B first ([`Exposure`]), given or
 //! fitted with β_m on the same sample; the residuals (reported and scored) compare the texel with
