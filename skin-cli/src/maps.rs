@@ -9,7 +9,11 @@ use clap::Args;
 use image_file::{LinearImage, SrgbEncoder};
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
-use skin_fit::maps::{Edit, Eumelanin, Maps, MapsModel, MapsOptions, apply_edits};
+use skin_fit::ModelChoice;
+use skin_fit::maps::{
+    DEFAULT_SMOOTHNESS, EXPOSURE_RANGE, Edit, Eumelanin, Exposure, ExtendedFit, Maps, MapsModel,
+    MapsOptions, Regions, apply_edits,
+};
 use skin_plot::{HeatMap, Panel};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -42,6 +46,27 @@ pub struct MapsArgs {
     /// Fit β_m over the texels (the default), and report the range the data allow.
     #[arg(long)]
     pub fit_eumelanin: bool,
+    /// β_m per square region of BLOCK texels a side, in [4, 4096], instead of one value: each
+    /// region's β_m fitted on its texels with a smoothness prior between neighbouring regions
+    /// (a β_m step of 0.1 costs as much as one sampled texel 1 ΔE2000 worse); the summary reports
+    /// the range of the regions' β_m and how wide a range each region's texels allow.
+    #[arg(long, value_name = "BLOCK", conflicts_with_all = ["eumelanin", "fit_eumelanin"], value_parser = clap::value_parser!(u32).range(4..=4096))]
+    pub eumelanin_regions: Option<u32>,
+    /// Gains on the linear texels before the fit, each in [0.125, 2]: G (all channels), R,G,B,
+    /// `auto` (one gain fitted with β_m: the one whose maps reproduce a sample of the texels best;
+    /// its range is reported) or `auto-rgb` (one per channel: exposure and white balance). For a
+    /// photograph whose light level or colour balance is not a measured albedo's; 1 takes the
+    /// texels as they are. Residuals are measured at the texture's own exposure; albedo.png is
+    /// the fitted skins' albedo, so the texture after the gains.
+    #[arg(long, value_name = "G|R,G,B|auto|auto-rgb", default_value = "1", allow_hyphen_values = true, value_parser = crate::args::Checked(parse_exposure))]
+    pub exposure: Exposure,
+    /// Parameters beyond C_m, β_m, C_h, as `skin fit --model`: `seed` (none), `full` (blood near
+    /// the surface, epidermis thickness, γ, scattering scales, bilirubin) or `auto` (those that
+    /// lower the sample's RMS capped ΔE2000 by more than 0.25). Each is one value per texture,
+    /// fitted over the texels as β_m is (three colour numbers per texel go to C_m and C_h); each
+    /// kept one adds a channel to maps.exr named as in `skin fit --json`.
+    #[arg(long, value_name = "MODEL", default_value = "seed", value_parser = crate::args::Checked(parse_model))]
+    pub model: ModelChoice,
     /// Edit the maps before writing them, in order (repeatable): melanin*S, melanin+D,
     /// melanin-D (tanning, pallor), hemoglobin*S, hemoglobin+D, hemoglobin-D (flush; under
     /// --edit-mask if given), eumelanin=B. albedo.png is then the forward model of the edited maps.
@@ -60,6 +85,42 @@ pub struct MapsArgs {
 pub fn parse_edit(s: &str) -> Result<Edit, String> {
     s.parse()
         .map_err(|e: skin_fit::maps::MapsError| e.to_string())
+}
+
+/// Parse `--model` (clap value parser).
+pub fn parse_model(s: &str) -> Result<ModelChoice, String> {
+    s.parse().map_err(|e: skin_fit::FitError| e.to_string())
+}
+
+/// Parse `--exposure` (clap value parser).
+pub fn parse_exposure(s: &str) -> Result<Exposure, String> {
+    match s.trim().to_ascii_lowercase().as_str() {
+        "auto" => return Ok(Exposure::Auto),
+        "auto-rgb" => return Ok(Exposure::WhiteBalance),
+        _ => {}
+    }
+    let [lo, hi] = EXPOSURE_RANGE;
+    let fields: Vec<&str> = s.split(',').collect();
+    if fields.len() != 1 && fields.len() != 3 {
+        return Err(format!(
+            "'{s}' is not G, R,G,B, auto or auto-rgb (gains in [0.125, 2])"
+        ));
+    }
+    let mut gains = [0.0; 3];
+    for (k, f) in fields.iter().enumerate() {
+        let g = crate::args::parse_number(f, "[0.125, 2]")?;
+        if !(lo..=hi).contains(&g) {
+            return Err(format!(
+                "gain {} outside [0.125, 2] (or auto, auto-rgb)",
+                skin_optics::echo::Num(g)
+            ));
+        }
+        gains[k] = g;
+    }
+    if fields.len() == 1 {
+        gains = [gains[0]; 3];
+    }
+    Ok(Exposure::Fixed(gains))
 }
 
 /// Luminance (Rec.709 Y) of the sRGB-encoded value of a linear texel, in [0, 1]: how a mask
@@ -107,7 +168,16 @@ pub fn run(args: &MapsArgs) -> anyhow::Result<()> {
     let read_s = start.elapsed().as_secs_f64();
 
     let opts = MapsOptions {
-        eumelanin: args.eumelanin.map_or(Eumelanin::Fit, Eumelanin::Fixed),
+        eumelanin: match (args.eumelanin, args.eumelanin_regions) {
+            (Some(b), _) => Eumelanin::Fixed(b),
+            (None, Some(block)) => Eumelanin::PerRegion(Regions {
+                width: texture.width,
+                block: block as usize,
+                smoothness: DEFAULT_SMOOTHNESS,
+            }),
+            (None, None) => Eumelanin::Fit,
+        },
+        exposure: args.exposure,
         cache_dir: if args.no_cache {
             None
         } else {
@@ -117,9 +187,27 @@ pub fn run(args: &MapsArgs) -> anyhow::Result<()> {
         ..MapsOptions::default()
     };
     let t = Instant::now();
-    let model = MapsModel::load(&opts).context("forward table")?;
+    let mut opts = opts;
+    let mut model = MapsModel::load(&opts).context("forward table")?;
+    let extended = if args.model == ModelChoice::Seed {
+        None
+    } else {
+        let spinner = ProgressBar::new_spinner();
+        spinner.enable_steady_tick(std::time::Duration::from_millis(200));
+        let fit = model.fit_extended(
+            &texture.texels,
+            mask.as_deref(),
+            &opts,
+            args.model,
+            &skin_fit::Parameter::CANDIDATES,
+            &|name| spinner.set_message(format!("fitting {name} over the texture")),
+        )?;
+        spinner.finish_and_clear();
+        opts.base = fit.base;
+        model = MapsModel::load(&opts).context("forward table of the extended skin")?;
+        Some(fit)
+    };
     let table_s = t.elapsed().as_secs_f64();
-
     let t = Instant::now();
     let n = texture.texels.len();
     let bar = ProgressBar::new(n as u64);
@@ -139,16 +227,26 @@ pub fn run(args: &MapsArgs) -> anyhow::Result<()> {
     apply_edits(&mut maps, &args.edits, weight.as_deref())?;
 
     let t = Instant::now();
-    let mut albedo = model.albedo(&maps.melanin, maps.eumelanin, &maps.hemoglobin)?;
+    let mut albedo = model.albedo_of(&maps)?;
+    // Texels not fitted are copied through at the same gain, so the image stays one exposure.
+    let gain = fitted.exposure.map(|g| g as f32);
     for (a, (t, f)) in albedo
         .iter_mut()
         .zip(texture.texels.iter().zip(&maps.fitted))
     {
         if !f {
-            *a = *t;
+            *a = [t[0] * gain[0], t[1] * gain[1], t[2] * gain[2]];
         }
     }
-    write_outputs(&args.out, &texture, &maps, &albedo)?;
+    let extra: Vec<(&'static str, f32)> = extended
+        .as_ref()
+        .map(|e| {
+            e.kept()
+                .map(|v| (v.parameter.name(), v.value as f32))
+                .collect()
+        })
+        .unwrap_or_default();
+    write_outputs(&args.out, &texture, &maps, &albedo, &extra)?;
     let write_s = t.elapsed().as_secs_f64();
 
     let s = &fitted;
@@ -166,12 +264,39 @@ pub fn run(args: &MapsArgs) -> anyhow::Result<()> {
         "residual ΔE2000 over fitted texels: median {:.3}, p95 {:.3}, max {:.3}",
         s.median_de, s.p95_de, s.max_de
     );
-    match &s.eumelanin_spread {
-        Some(r) => eprintln!(
+    match (&s.regions, &s.eumelanin_spread) {
+        (Some(r), _) => eprintln!(
+            "eumelanin β_m per region of {b}×{b} texels ({} regions): median {:.2}, {:.2}-{:.2}; each region's texels allow a range of median width {:.2} (RMS capped ΔE2000 within {} of its best); smoothness {} ΔE² per unit β_m²",
+            r.regions,
+            r.median,
+            r.min,
+            r.max,
+            r.median_allowed_width,
+            opts.beta_tolerance_de,
+            DEFAULT_SMOOTHNESS,
+            b = args.eumelanin_regions.unwrap_or(0),
+        ),
+        (None, Some(r)) => eprintln!(
             "eumelanin β_m {:.3} (fitted; the texels allow {:.2}-{:.2}: RMS capped ΔE2000 within {} of the best {:.3})",
             beta, r.min, r.max, r.tolerance_de, r.best_rms_de
         ),
-        None => eprintln!("eumelanin β_m {beta:.3} (given)"),
+        (None, None) => eprintln!("eumelanin β_m {beta:.3} (given)"),
+    }
+    let [gr, gg, gb] = s.exposure;
+    match (&s.exposure_spread, args.exposure) {
+        (Some(r), _) => eprintln!(
+            "exposure: gain {gr:.3} on every texel (fitted; the texels allow {:.3}-{:.3}: RMS capped ΔE2000 within {} of the best {:.3})",
+            r.min, r.max, r.tolerance_de, r.best_rms_de
+        ),
+        (None, Exposure::WhiteBalance) => eprintln!(
+            "exposure: gains R {gr:.3}, G {gg:.3}, B {gb:.3} on every texel (fitted with β_m)"
+        ),
+        (None, _) => {
+            eprintln!("exposure: gains R {gr:.3}, G {gg:.3}, B {gb:.3} on every texel (given)")
+        }
+    }
+    if let Some(e) = &extended {
+        print_extended(args.model, e);
     }
     if !args.edits.is_empty() {
         let list: Vec<String> = args.edits.iter().map(ToString::to_string).collect();
@@ -192,12 +317,44 @@ pub fn run(args: &MapsArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Write maps.exr, albedo.png and the previews as one group (all or none).
+/// The summary lines of the extended parameters.
+fn print_extended(model: ModelChoice, e: &ExtendedFit) {
+    let list: Vec<String> = e
+        .values
+        .iter()
+        .map(|v| {
+            format!(
+                "{} {:.4}{} (the texels allow {:.4}-{:.4})",
+                v.parameter.name(),
+                v.value,
+                if v.kept { "" } else { ", not kept" },
+                v.range.min,
+                v.range.max
+            )
+        })
+        .collect();
+    eprintln!(
+        "model {model}: one value per texture: {}",
+        if list.is_empty() {
+            "none".to_string()
+        } else {
+            list.join("; ")
+        }
+    );
+    eprintln!(
+        "  sample RMS capped ΔE2000: seed model {:.3}, with these {:.3}",
+        e.seed_rms_de, e.rms_de
+    );
+}
+
+/// Write maps.exr (with a constant channel per kept extended parameter in `extra`), albedo.png
+/// and the previews as one group (all or none).
 fn write_outputs(
     out: &Path,
     texture: &LinearImage,
     maps: &Maps,
     albedo: &[[f32; 3]],
+    extra: &[(&'static str, f32)],
 ) -> anyhow::Result<()> {
     let (w, h) = (texture.width, texture.height);
     let n = w * h;
@@ -206,17 +363,20 @@ fn write_outputs(
         .iter()
         .map(|g| f32::from(u8::from(*g)))
         .collect();
-    let exr = image_file::exr_bytes(
-        w,
-        h,
-        vec![
-            (CHANNELS[0], maps.melanin.clone()),
-            (CHANNELS[1], vec![maps.eumelanin as f32; n]),
-            (CHANNELS[2], maps.hemoglobin.clone()),
-            (CHANNELS[3], maps.delta_e.clone()),
-            (CHANNELS[4], flag),
-        ],
-    )?;
+    let mut channels = vec![
+        (CHANNELS[0], maps.melanin.clone()),
+        (
+            CHANNELS[1],
+            maps.eumelanin_map
+                .clone()
+                .unwrap_or_else(|| vec![maps.eumelanin as f32; n]),
+        ),
+        (CHANNELS[2], maps.hemoglobin.clone()),
+        (CHANNELS[3], maps.delta_e.clone()),
+        (CHANNELS[4], flag),
+    ];
+    channels.extend(extra.iter().map(|(name, v)| (*name, vec![*v; n])));
+    let exr = image_file::exr_bytes(w, h, channels)?;
     let encoder = SrgbEncoder::default();
     let rgb: Vec<u8> = albedo
         .par_iter()

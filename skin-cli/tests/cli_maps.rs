@@ -212,6 +212,100 @@ fn edits_retone_the_albedo() {
     }
 }
 
+/// A photograph 1.25× brighter than the albedo (16-bit, so within 1e-4 of it): `--exposure 0.8`
+/// brings every skin texel back in gamut with its melanin within 3 %, the summary names the gains,
+/// and the non-skin texels stay out.
+#[test]
+fn exposure_scales_a_brighter_photograph_back() {
+    let (tmp, out) = out_dir("exposure");
+    let png = tmp.path().join("bright.png");
+    let bright: Vec<[f32; 3]> = texture()
+        .iter()
+        .enumerate()
+        .map(|(k, t)| if k % 8 < 4 { t.map(|c| c * 1.25) } else { *t })
+        .collect();
+    write_png16(&png, 8, 4, &bright);
+    let o = skin_maps(&[
+        "--albedo",
+        png.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--eumelanin",
+        "0.6",
+        "--exposure",
+        "0.8",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(err.contains("32 fitted, 16 in gamut"), "{err}");
+    assert!(
+        err.contains("gains R 0.800, G 0.800, B 0.800 on every texel (given)"),
+        "{err}"
+    );
+    let maps = read_maps(&out);
+    for k in (0..32).filter(|k| k % 8 < 4) {
+        assert_eq!(
+            maps["in_gamut"][k], 1.0,
+            "texel {k}: {}",
+            maps["delta_e"][k]
+        );
+        let want = 0.01 * 3f32.powi((k % 8) as i32);
+        assert!((maps["melanin"][k] / want - 1.0).abs() < 0.03, "texel {k}");
+    }
+}
+
+/// `--eumelanin-regions 4` on the 8 × 4 texture: two regions, the eumelanin channel constant
+/// within each and in [0, 1], the summary names the regions, and the skins stay in gamut.
+#[test]
+fn eumelanin_per_region_fills_the_channel() {
+    let (tmp, out) = out_dir("regions");
+    let png = tmp.path().join("albedo.png");
+    write_png16(&png, 8, 4, &texture());
+    let o = skin_maps(&[
+        "--albedo",
+        png.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--eumelanin-regions",
+        "4",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(
+        err.contains("per region of 4×4 texels (2 regions)"),
+        "{err}"
+    );
+    let maps = read_maps(&out);
+    let b = &maps["eumelanin"];
+    for k in 0..32 {
+        assert!((0.0..=1.0).contains(&b[k]), "texel {k}: {}", b[k]);
+        assert_eq!(b[k], b[if k % 8 < 4 { 0 } else { 4 }], "texel {k}");
+        if k % 8 < 4 {
+            assert_eq!(
+                maps["in_gamut"][k], 1.0,
+                "texel {k}: {}",
+                maps["delta_e"][k]
+            );
+        }
+    }
+}
+
+/// Bad `--exposure` and `--model` values are usage errors naming the valid ones.
+#[test]
+fn bad_exposure_and_model_are_usage_errors() {
+    for (flag, value, want) in [
+        ("--exposure", "3", "outside [0.125, 2]"),
+        ("--exposure", "0.5,0.6", "is not G, R,G,B, auto or auto-rgb"),
+        ("--exposure", "bright", "[0.125, 2]"),
+        ("--model", "tiny", "valid: seed, full, auto"),
+        ("--eumelanin-regions", "2", "4..=4096"),
+    ] {
+        let o = skin_maps(&["--albedo", "x.png", flag, value]);
+        assert_eq!(o.status.code(), Some(2), "{flag} {value}: {}", stderr(&o));
+        assert!(stderr(&o).contains(want), "{flag} {value}: {}", stderr(&o));
+    }
+}
+
 /// NaN and negative texels of an EXR are fitted as replaced values and flagged, not an error.
 #[test]
 fn bad_exr_texels_are_flagged() {

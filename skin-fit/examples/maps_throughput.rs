@@ -6,7 +6,8 @@
 
 use cpu_time::ProcessTime;
 use skin_fit::maps::{
-    Eumelanin, Inverter, Lookup, MapsModel, MapsOptions, hemoglobin_of_v, melanin_of_u,
+    Eumelanin, Inverter, Lookup, MapsModel, MapsOptions, delta_e_2000_fast, hemoglobin_of_v,
+    melanin_of_u, texel_lab,
 };
 use std::time::Instant;
 
@@ -24,6 +25,29 @@ fn timed<T>(what: &str, texels: usize, f: impl FnOnce() -> T) -> T {
         println!("{what}: {w:.3} s wall, {c:.3} CPU-s");
     }
     out
+}
+
+/// Every texel through CIELAB, the lookup grid, one Gauss–Newton step and the residual ΔE2000,
+/// in chunks of a function of its own so that
+/// `valgrind --tool=callgrind --toggle-collect='*invert_chunk*'` counts them alone.
+fn invert_all(inv: &Inverter, texels: &[[f32; 3]]) -> f64 {
+    use rayon::prelude::*;
+    texels
+        .par_chunks(1 << 14)
+        .map(|chunk| invert_chunk(inv, chunk))
+        .sum::<f64>()
+}
+
+#[inline(never)]
+fn invert_chunk(inv: &Inverter, texels: &[[f32; 3]]) -> f64 {
+    texels
+        .iter()
+        .map(|t| {
+            let target = texel_lab(*t).0;
+            let r = inv.invert_fast(&target);
+            delta_e_2000_fast(&target, &r.lab)
+        })
+        .sum::<f64>()
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -71,34 +95,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     timed(
         "inversion itself (texel → Lab → lookup → one step → ΔE2000)",
         n,
-        || {
-            use rayon::prelude::*;
-            texels
-                .par_iter()
-                .with_min_len(1 << 14)
-                .map(|t| {
-                    let xyz = skin_optics::color::LinearSrgb(t.map(f64::from)).to_xyz();
-                    let lab = skin_optics::lab::Lab::from_xyz(xyz);
-                    let r = inv.invert_fast(&[lab.l, lab.a, lab.b]);
-                    let fit = skin_optics::lab::Lab {
-                        l: r.lab[0],
-                        a: r.lab[1],
-                        b: r.lab[2],
-                    };
-                    skin_optics::lab::delta_e_2000(lab, fit)
-                })
-                .sum::<f64>()
-        },
+        || invert_all(&inv, &texels),
     );
     timed("texel → CIELAB only", n, || {
         use rayon::prelude::*;
         texels
             .par_iter()
             .with_min_len(1 << 14)
-            .map(|t| {
-                let xyz = skin_optics::color::LinearSrgb(t.map(f64::from)).to_xyz();
-                skin_optics::lab::Lab::from_xyz(xyz).l
-            })
+            .map(|t| texel_lab(*t).0[0])
             .sum::<f64>()
     });
     timed("texel → CIELAB → inversion (no ΔE2000)", n, || {
@@ -106,11 +110,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         texels
             .par_iter()
             .with_min_len(1 << 14)
-            .map(|t| {
-                let xyz = skin_optics::color::LinearSrgb(t.map(f64::from)).to_xyz();
-                let lab = skin_optics::lab::Lab::from_xyz(xyz);
-                inv.invert_fast(&[lab.l, lab.a, lab.b]).u
-            })
+            .map(|t| inv.invert_fast(&texel_lab(*t).0).u)
             .sum::<f64>()
     });
     timed("albedo of the maps", n, || {

@@ -145,7 +145,12 @@ pub fn apply(
                     *c = (old + weight(k) * (new - old)) as f32;
                 }
             }
-            Edit::Eumelanin(b) => maps.eumelanin = b,
+            Edit::Eumelanin(b) => {
+                maps.eumelanin = b;
+                if let Some(map) = &mut maps.eumelanin_map {
+                    map.fill(b as f32);
+                }
+            }
         }
     }
     Ok(())

@@ -121,16 +121,21 @@ impl Inverter {
             base[c] = i;
             frac[c] = x - i as f64;
         }
-        let (mut u, mut v) = (0.0, 0.0);
-        for corner in 0..8 {
-            let d = [corner & 1, (corner >> 1) & 1, corner >> 2];
-            let w: f64 = (0..3)
-                .map(|c| if d[c] == 1 { frac[c] } else { 1.0 - frac[c] })
-                .product();
-            let node = self.lookup[((base[2] + d[2]) * na + base[1] + d[1]) * nl + base[0] + d[0]];
-            u += w * f64::from(node[0]);
-            v += w * f64::from(node[1]);
-        }
+        // Trilinear: along L* within each of the four (a*, b*) corner pairs, then a*, then b*.
+        let at = |da: usize, db: usize| -> [f64; 2] {
+            let k = (base[2] + db) * na * nl + (base[1] + da) * nl + base[0];
+            let (p, q) = (self.lookup[k], self.lookup[k + 1]);
+            let t = frac[0];
+            [
+                f64::from(p[0]) + t * (f64::from(q[0]) - f64::from(p[0])),
+                f64::from(p[1]) + t * (f64::from(q[1]) - f64::from(p[1])),
+            ]
+        };
+        let lerp =
+            |p: [f64; 2], q: [f64; 2], t: f64| [p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1])];
+        let near = lerp(at(0, 0), at(1, 0), frac[1]);
+        let far = lerp(at(0, 1), at(1, 1), frac[1]);
+        let [u, v] = lerp(near, far, frac[2]);
         let (f, fu, fv) = self.slice.lab_and_gradient(u, v);
         let r: [f64; 3] = std::array::from_fn(|k| f[k] - target[k]);
         let a11 = dot(&fu, &fu) + 1e-12;

@@ -12,27 +12,40 @@
 //! β_m its slice is interpolated (cubic along β_m), and each texel is inverted on the slice's
 //! bicubic interpolant: a seed from a grid over CIELAB, then damped Gauss–Newton steps minimising
 //! the CIELAB distance (ΔE76) plus the tiny C_h prior of `skin fit` ([`PRIOR_WEIGHT_DE`]).
-//! The reported residual is ΔE2000 between the texel and the fitted skin on the interpolant;
-//! a texel is in gamut when it is at most [`IN_GAMUT_DE`].
+//! The reported residual is ΔE2000 ([`delta_e_2000_fast`]) between the texel and the fitted skin
+//! on the interpolant; a texel is in gamut when it is at most [`IN_GAMUT_DE`].
 //!
 //! **β_m.** Three colour numbers per texel cannot pin three parameters well, so β_m is one value
 //! per texture: given ([`Eumelanin::Fixed`]) or fitted ([`Eumelanin::Fit`]) as the β_m whose slice
 //! passes closest to a sample of the texels (RMS of ΔE2000 capped at [`BETA_CAP_DE`], so hair and
 //! other non-skin texels weigh no more than a poor skin fit). [`EumelaninSpread`] reports the β_m
-//! range the data allow.
+//! range the data allow. [`Eumelanin::PerRegion`] lets it vary by region of the texture, with a
+//! smoothness prior (module `regions`).
+//!
+//! **Exposure.** Every texel may be multiplied by gains on R, G, B first ([`Exposure`]), given or
+//! fitted with β_m on the same sample; the residuals (reported and scored) compare the texel with
+//! the fitted skin seen at the texture's own exposure (docs/physics.md §18, "Exposure").
+//! The extended parameters of `skin fit --model` are one value per texture
+//! ([`MapsModel::fit_extended`]).
 //!
 //! **Bad texels.** A non-finite, negative or huge component ([`MAX_TEXEL`]) is replaced (NaN by 0,
 //! then clamped to [0, `MAX_TEXEL`]), fitted like any other and flagged out of gamut. Texels
 //! outside the mask are not fitted: they get the median of the fitted maps, ΔE 0 and the flag 0.
 
+mod delta_e;
 mod edit;
+mod extended;
 mod invert;
+mod regions;
 mod table;
 #[cfg(test)]
 mod tests;
 
+pub use delta_e::delta_e_2000_fast;
 pub use edit::{EDIT_SYNTAX, Edit, apply as apply_edits};
+pub use extended::{EXTENDED_STEPS, ExtendedFit, ExtendedValue};
 pub use invert::{Inverted, Inverter, LOOKUP_NODES, PRIOR_WEIGHT_DE};
+pub use regions::{DEFAULT_SMOOTHNESS, REGION_SAMPLES, RegionSummary, Regions};
 pub use table::{
     ForwardTable, MELANIN_KNEE, STEP_NM, Slice, TableSize, cache_key, hemoglobin_of_v,
     melanin_of_u, u_of_melanin, v_of_hemoglobin,
@@ -43,7 +56,7 @@ use rayon::prelude::*;
 use skin_io::cache::CacheOutcome;
 use skin_optics::SkinParams;
 use skin_optics::color::LinearSrgb;
-use skin_optics::lab::{Lab, delta_e_2000};
+use skin_optics::lab::Lab;
 use std::path::PathBuf;
 
 /// A texel is in gamut when the fitted skin reproduces it within this ΔE2000.
@@ -96,7 +109,28 @@ pub enum Eumelanin {
     Fixed(f64),
     /// Fitted over the texels (module doc).
     Fit,
+    /// One value per region of the texture, with a smoothness prior ([`Regions`]).
+    PerRegion(Regions),
 }
+
+/// How the texture's exposure is chosen: a gain on each linear channel (R, G, B) of every texel
+/// before the fit, for a photograph whose light level or white balance is not that of the D65
+/// white the texels are relative to (module doc).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Exposure {
+    /// These gains on R, G and B, each in [`EXPOSURE_RANGE`] (1: the texels as given).
+    Fixed([f64; 3]),
+    /// One gain on all three channels, fitted with β_m over the texels: the gain whose maps
+    /// pass closest to a sample of them.
+    Auto,
+    /// A gain per channel (exposure and white balance), fitted as [`Exposure::Auto`].
+    WhiteBalance,
+}
+
+/// Gains the exposure fit explores: 1/8 to 2 (three stops down, one up).
+pub const EXPOSURE_RANGE: [f64; 2] = [0.125, 2.0];
+/// Gain candidates of the exposure fit, evenly in log₂ g over [`EXPOSURE_RANGE`] (eighth stops).
+const EXPOSURE_STEPS: usize = 33;
 
 /// Whether texels are inverted through the inverse lookup grid ([`Inverter::invert_fast`]) or
 /// each by the full inversion ([`Inverter::invert`]).
@@ -133,6 +167,8 @@ pub struct MapsOptions {
     pub beta_tolerance_de: f64,
     /// The inverse lookup grid or the full inversion per texel (default [`Lookup::Auto`]).
     pub lookup: Lookup,
+    /// The gain on every texel, given or fitted (default 1: the texels as given).
+    pub exposure: Exposure,
 }
 
 impl Default for MapsOptions {
@@ -147,6 +183,7 @@ impl Default for MapsOptions {
             beta_steps: 21,
             beta_tolerance_de: 0.25,
             lookup: Lookup::Auto,
+            exposure: Exposure::Fixed([1.0; 3]),
         }
     }
 }
@@ -163,6 +200,32 @@ impl MapsOptions {
         };
         if let Eumelanin::Fixed(b) = self.eumelanin {
             check("eumelanin", b, (0.0..=1.0).contains(&b), "[0, 1]")?;
+        }
+        if let Eumelanin::PerRegion(r) = self.eumelanin {
+            check(
+                "eumelanin regions block",
+                r.block as f64,
+                (4..=4096).contains(&r.block),
+                "[4, 4096] texels",
+            )?;
+            check(
+                "eumelanin regions width",
+                r.width as f64,
+                r.width >= 1,
+                "[1, ∞) texels",
+            )?;
+            check(
+                "eumelanin smoothness",
+                r.smoothness,
+                r.smoothness >= 0.0,
+                "[0, ∞) ΔE² per unit β_m²",
+            )?;
+        }
+        if let Exposure::Fixed(gains) = self.exposure {
+            let [lo, hi] = EXPOSURE_RANGE;
+            for g in gains {
+                check("exposure", g, (lo..=hi).contains(&g), "[0.125, 2]")?;
+            }
         }
         for (name, n) in [
             ("table.melanin", self.table.melanin),
@@ -192,19 +255,23 @@ impl MapsOptions {
     }
 }
 
-/// The β_m range the texels allow: the connected candidates around the fit whose RMS capped
-/// ΔE2000 stays within `tolerance_de` of the best.
+/// The range of a per-texture value (β_m, the exposure, an extended parameter) that the texels
+/// allow: around the fit, where the sample's RMS capped ΔE2000 (linear between the candidates
+/// tried) stays within `tolerance_de` of the best candidate's.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct EumelaninSpread {
-    /// Lowest allowed β_m.
+pub struct FittedRange {
+    /// Lowest allowed value.
     pub min: f64,
-    /// Highest allowed β_m.
+    /// Highest allowed value.
     pub max: f64,
     /// The tolerance, ΔE2000.
     pub tolerance_de: f64,
-    /// RMS capped ΔE2000 of the sample at the fitted β_m.
+    /// RMS capped ΔE2000 of the sample at the fitted value.
     pub best_rms_de: f64,
 }
+
+/// The β_m range the texels allow.
+pub type EumelaninSpread = FittedRange;
 
 /// What a fit did, for the summary line.
 #[derive(Debug, Clone, PartialEq)]
@@ -223,6 +290,12 @@ pub struct MapsSummary {
     pub max_de: f64,
     /// The β_m range the data allow (`None` when β_m was given or nothing was fitted).
     pub eumelanin_spread: Option<EumelaninSpread>,
+    /// The gains on R, G and B applied to every texel before the fit.
+    pub exposure: [f64; 3],
+    /// The common gains the data allow (`None` unless [`Exposure::Auto`] fitted them).
+    pub exposure_spread: Option<FittedRange>,
+    /// β_m over the regions (`None` unless [`Eumelanin::PerRegion`]).
+    pub regions: Option<RegionSummary>,
 }
 
 /// The maps of a texture, one value per texel (row-major, as the texels given).
@@ -232,8 +305,10 @@ pub struct Maps {
     pub melanin: Vec<f32>,
     /// Hemoglobin volume fraction C_h, [0.001, 0.1].
     pub hemoglobin: Vec<f32>,
-    /// Eumelanin blend β_m of the whole texture, [0, 1].
+    /// Eumelanin blend β_m of the whole texture, [0, 1] (with regions: their median).
     pub eumelanin: f64,
+    /// β_m of every texel when it varies by region ([`Eumelanin::PerRegion`]).
+    pub eumelanin_map: Option<Vec<f32>>,
     /// ΔE2000 between the texel and the fitted skin (0 outside the mask).
     pub delta_e: Vec<f32>,
     /// Whether the texel was fitted and reproduced within [`IN_GAMUT_DE`].
@@ -264,9 +339,11 @@ fn memo_slot(bits: [u32; 3]) -> usize {
     (h >> (64 - MEMO_SLOTS.trailing_zeros())) as usize
 }
 
-/// CIELAB of a linear Rec.709 texel, and whether it had to be replaced (module doc).
+/// CIELAB (L*, a*, b*) of a linear Rec.709 texel, and whether it had to be replaced (module
+/// doc): CIE 015 eqs 8.1–8.4 as [`Lab::from_xyz`], with the cube root by Halley's iteration.
 #[inline]
-fn texel_lab(t: [f32; 3]) -> ([f64; 3], bool) {
+#[must_use]
+pub fn texel_lab(t: [f32; 3]) -> ([f64; 3], bool) {
     let bad = t
         .iter()
         .any(|c| !(c.is_finite() && (0.0..=MAX_TEXEL).contains(c)));
@@ -277,8 +354,45 @@ fn texel_lab(t: [f32; 3]) -> ([f64; 3], bool) {
             f64::from(c.clamp(0.0, MAX_TEXEL))
         }
     });
-    let lab = Lab::from_xyz(LinearSrgb(rgb).to_xyz());
-    ([lab.l, lab.a, lab.b], bad)
+    (lab_of_linear(rgb), bad)
+}
+
+/// CIELAB of linear Rec.709 `rgb` (non-negative): CIE 015 eqs 8.1–8.4 as [`Lab::from_xyz`], with
+/// the cube root by Halley's iteration.
+#[inline]
+fn lab_of_linear(rgb: [f64; 3]) -> [f64; 3] {
+    let xyz = LinearSrgb(rgb).to_xyz().0;
+    let w = skin_optics::lab::d65_white().0;
+    const DELTA3: f64 = (6.0 / 29.0) * (6.0 / 29.0) * (6.0 / 29.0);
+    let f = |x: f64| {
+        if x > DELTA3 {
+            cbrt(x)
+        } else {
+            x / (3.0 * (6.0 / 29.0) * (6.0 / 29.0)) + 4.0 / 29.0
+        }
+    };
+    let [fx, fy, fz] = [f(xyz[0] / w[0]), f(xyz[1] / w[1]), f(xyz[2] / w[2])];
+    [116.0 * fy - 16.0, 500.0 * (fx - fy), 200.0 * (fy - fz)]
+}
+
+/// CIELAB of a fitted colour `lab` (found for texels scaled by `gain`) seen at the texture's own
+/// exposure: its linear Rec.709 divided by the gains.
+#[inline]
+fn unscaled(lab: &[f64; 3], gain: [f64; 3]) -> [f64; 3] {
+    let rgb = lab_of(*lab).to_xyz().to_linear_srgb().0;
+    lab_of_linear(std::array::from_fn(|c| (rgb[c] / gain[c]).max(0.0)))
+}
+
+/// Cube root of a positive normal `x`: a first guess from the exponent bits (within 3.3 %), then
+/// two Halley steps y ← y (y³ + 2x)/(2y³ + x), each cubing the relative error (to below 1e-13).
+#[inline]
+fn cbrt(x: f64) -> f64 {
+    let mut y = f64::from_bits(x.to_bits() / 3 + 0x2A9F_7893_782D_A1CE);
+    for _ in 0..2 {
+        let y3 = y * y * y;
+        y *= (y3 + 2.0 * x) / (2.0 * y3 + x);
+    }
+    y
 }
 
 #[inline]
@@ -353,17 +467,63 @@ impl MapsModel {
             });
         }
         let fitted: Vec<bool> = mask.map_or_else(|| vec![true; texels.len()], <[bool]>::to_vec);
-        let (beta, spread) = match opts.eumelanin {
-            Eumelanin::Fixed(b) => (b, None),
-            Eumelanin::Fit => self.fit_eumelanin(texels, &fitted, opts),
-        };
+        let shared = self.fit_shared(texels, &fitted, opts);
+        let (beta, gain) = (shared.beta, shared.gain);
+        let gain32 = gain.map(|g| g as f32);
+        let unit_gain = gain == [1.0; 3];
         let count = fitted.iter().filter(|f| **f).count();
-        let slice = self.table.slice(beta);
-        let inverter = match opts.lookup {
-            Lookup::Always => Inverter::with_lookup(slice),
-            Lookup::Auto if count > LOOKUP_NODES => Inverter::with_lookup(slice),
-            _ => Inverter::new(slice),
+        let with_lookup = |texels: usize| match opts.lookup {
+            Lookup::Always => true,
+            Lookup::Auto => texels > LOOKUP_NODES,
+            Lookup::Never => false,
         };
+        // One inverter per β_m in use: the texture's, or each region's candidate.
+        let (inverters, regions): (Vec<Inverter>, Option<regions::RegionFit>) = match opts.eumelanin
+        {
+            Eumelanin::PerRegion(r) => {
+                let steps = opts.beta_steps;
+                let betas: Vec<f64> = (0..steps).map(|i| i as f64 / (steps - 1) as f64).collect();
+                let plain: Vec<Inverter> = betas
+                    .par_iter()
+                    .map(|&b| Inverter::new(self.table.slice(b)))
+                    .collect();
+                let fit = regions::fit_regions(
+                    texels,
+                    &fitted,
+                    r,
+                    &betas,
+                    &plain,
+                    gain,
+                    opts.beta_tolerance_de,
+                )?;
+                let mut uses = vec![0usize; betas.len()];
+                for (l, f) in fit.label_of_texel.iter().zip(&fitted) {
+                    uses[usize::from(*l)] += usize::from(*f);
+                }
+                let inverters = plain
+                    .into_iter()
+                    .zip(&uses)
+                    .map(|(inv, &u)| {
+                        if u > 0 && with_lookup(u) {
+                            Inverter::with_lookup(inv.slice().clone())
+                        } else {
+                            inv
+                        }
+                    })
+                    .collect();
+                (inverters, Some(fit))
+            }
+            _ => {
+                let slice = self.table.slice(beta);
+                let inv = if with_lookup(count) {
+                    Inverter::with_lookup(slice)
+                } else {
+                    Inverter::new(slice)
+                };
+                (vec![inv], None)
+            }
+        };
+        let labels: Option<&[u8]> = regions.as_ref().map(|r| r.label_of_texel.as_slice());
         let n = texels.len();
         let mut melanin = vec![0.0f32; n];
         let mut hemoglobin = vec![0.0f32; n];
@@ -375,7 +535,8 @@ impl MapsModel {
             .zip(delta_e.par_chunks_mut(CHUNK))
             .zip(in_gamut.par_chunks_mut(CHUNK))
             .zip(texels.par_chunks(CHUNK).zip(fitted.par_chunks(CHUNK)))
-            .map(|((((m, h), de), g), (t, f))| {
+            .enumerate()
+            .map(|(chunk, ((((m, h), de), g), (t, f)))| {
                 let mut invalid = 0;
                 // Textures decoded from 8- or 16-bit files repeat colours, mostly nearby: a
                 // small direct-mapped memo of exact texel values skips the repeats.
@@ -384,20 +545,27 @@ impl MapsModel {
                     if !f[k] {
                         continue;
                     }
+                    let label = labels.map_or(0, |l| l[chunk * CHUNK + k]);
                     let bits = t[k].map(f32::to_bits);
                     let slot = memo_slot(bits);
                     let (mk, hk, dk, bad) = match memo[slot] {
-                        Some((b, out)) if b == bits => out,
+                        Some((b, l, out)) if b == bits && l == label => out,
                         _ => {
-                            let (lab, bad) = texel_lab(t[k]);
-                            let r = inverter.invert_fast(&lab);
+                            let (lab, bad) = texel_lab(scaled(t[k], gain32));
+                            let r = inverters[usize::from(label)].invert_fast(&lab);
+                            // The residual at the texture's own exposure (module doc).
+                            let (seen, fit) = if unit_gain {
+                                (lab, r.lab)
+                            } else {
+                                (texel_lab(t[k]).0, unscaled(&r.lab, gain))
+                            };
                             let out = (
                                 melanin_of_u(r.u) as f32,
                                 hemoglobin_of_v(r.v) as f32,
-                                delta_e_2000(lab_of(lab), lab_of(r.lab)) as f32,
+                                delta_e_2000_fast(&seen, &fit) as f32,
                                 bad,
                             );
-                            memo[slot] = Some((bits, out));
+                            memo[slot] = Some((bits, label, out));
                             out
                         }
                     };
@@ -454,12 +622,22 @@ impl MapsModel {
             median_de: quantile(&mut residuals, 0.5),
             p95_de: quantile(&mut residuals, 0.95),
             max_de: residuals.iter().copied().fold(0.0f32, f32::max).into(),
-            eumelanin_spread: spread,
+            eumelanin_spread: shared.beta_spread,
+            exposure: gain,
+            exposure_spread: shared.gain_spread,
+            regions: regions.as_ref().map(|r| r.summary),
         };
+        let eumelanin_map = regions.as_ref().map(|r| {
+            r.label_of_texel
+                .iter()
+                .map(|&l| r.betas[usize::from(l)] as f32)
+                .collect()
+        });
         Ok(Maps {
             melanin,
             hemoglobin,
-            eumelanin: beta,
+            eumelanin: regions.as_ref().map_or(beta, |r| r.summary.median),
+            eumelanin_map,
             delta_e,
             in_gamut,
             fitted,
@@ -467,78 +645,87 @@ impl MapsModel {
         })
     }
 
-    /// β_m fitted over a sample of the fitted texels, and its spread (module doc); β_m 0.6 (the
-    /// medium preset's, the prior of `skin fit`) when nothing is fitted.
-    fn fit_eumelanin(
-        &self,
-        texels: &[[f32; 3]],
-        fitted: &[bool],
-        opts: &MapsOptions,
-    ) -> (f64, Option<EumelaninSpread>) {
-        let chosen: Vec<usize> = (0..texels.len()).filter(|&k| fitted[k]).collect();
-        if chosen.is_empty() {
-            return (0.6, None);
+    /// β_m and the exposure, each given or fitted over a sample of the fitted texels, with the
+    /// ranges the sample allows (module doc). Both fitted: alternately, the gain at β_m 0.6 (the
+    /// medium preset's, the prior of `skin fit`), β_m at that gain, the gain again, β_m again.
+    /// β_m 0.6 and gain 1 when nothing is fitted.
+    fn fit_shared(&self, texels: &[[f32; 3]], fitted: &[bool], opts: &MapsOptions) -> Shared {
+        let mut out = Shared {
+            beta: match opts.eumelanin {
+                Eumelanin::Fixed(b) => b,
+                Eumelanin::Fit | Eumelanin::PerRegion(_) => 0.6,
+            },
+            gain: match opts.exposure {
+                Exposure::Fixed(g) => g,
+                Exposure::Auto | Exposure::WhiteBalance => [1.0; 3],
+            },
+            beta_spread: None,
+            gain_spread: None,
+        };
+        let fit_gain = !matches!(opts.exposure, Exposure::Fixed(_));
+        // With regions, one β_m for the texture serves only the exposure fit.
+        let fit_beta = match opts.eumelanin {
+            Eumelanin::Fit => true,
+            Eumelanin::PerRegion(_) => fit_gain,
+            Eumelanin::Fixed(_) => false,
+        };
+        if !(fit_beta || fit_gain) {
+            return out;
         }
-        // Golden-ratio (Weyl) positions spread the sample over the texture without lining up
-        // with its rows, as a plain stride of a multiple of the width would.
-        let count = opts.beta_samples.min(chosen.len());
-        let golden = 0.5 * (5f64.sqrt() - 1.0);
-        let sample: Vec<[f64; 3]> = (0..count)
-            .map(|i| {
-                let at = ((i as f64 * golden).fract() * chosen.len() as f64) as usize;
-                texel_lab(texels[chosen[at.min(chosen.len() - 1)]]).0
-            })
-            .collect();
+        let sample = extended::sample_texels(texels, fitted, opts.beta_samples);
+        if sample.is_empty() {
+            return out;
+        }
+        let rms_of = |inv: &Inverter, gain: [f64; 3]| sample_rms(inv, &sample, gain);
         let steps = opts.beta_steps;
         let betas: Vec<f64> = (0..steps).map(|i| i as f64 / (steps - 1) as f64).collect();
-        let objective = |beta: f64| -> f64 {
-            let inv = Inverter::new(self.table.slice(beta));
-            let sum: f64 = sample
-                .iter()
-                .map(|lab| {
-                    let r = inv.invert(lab);
-                    delta_e_2000(lab_of(*lab), lab_of(r.lab))
-                        .min(BETA_CAP_DE)
-                        .powi(2)
-                })
-                .sum();
-            (sum / sample.len() as f64).sqrt()
-        };
-        let rms: Vec<f64> = betas.par_iter().map(|&b| objective(b)).collect();
-        let best = (0..steps)
-            .min_by(|&a, &b| rms[a].total_cmp(&rms[b]))
-            .unwrap_or(0);
-        // A parabola through the best candidate and its neighbours places β_m between candidates.
-        let beta = if best > 0 && best + 1 < steps {
-            let (a, b, c) = (rms[best - 1], rms[best], rms[best + 1]);
-            let curvature = a - 2.0 * b + c;
-            let shift = if curvature > 0.0 {
-                (0.5 * (a - c) / curvature).clamp(-0.5, 0.5)
-            } else {
-                0.0
-            };
-            betas[best] + shift * (betas[1] - betas[0])
-        } else {
-            betas[best]
-        };
-        let limit = rms[best] + opts.beta_tolerance_de;
-        let mut lo = best;
-        while lo > 0 && rms[lo - 1] <= limit {
-            lo -= 1;
+        let [lo, hi] = EXPOSURE_RANGE.map(f64::log2);
+        let stops: Vec<f64> = (0..EXPOSURE_STEPS)
+            .map(|i| lo + (hi - lo) * i as f64 / (EXPOSURE_STEPS - 1) as f64)
+            .collect();
+        let tolerance = opts.beta_tolerance_de;
+        let rounds = if fit_beta && fit_gain { 2 } else { 1 };
+        for _ in 0..rounds {
+            if fit_gain {
+                let inv = Inverter::new(self.table.slice(out.beta));
+                let rms: Vec<f64> = stops.iter().map(|s| rms_of(&inv, [s.exp2(); 3])).collect();
+                let (stop, range) = best_on_grid(&stops, &rms, tolerance);
+                out.gain = [stop.exp2(); 3];
+                out.gain_spread = Some(FittedRange {
+                    min: range.min.exp2(),
+                    max: range.max.exp2(),
+                    ..range
+                });
+                if opts.exposure == Exposure::WhiteBalance {
+                    // Per channel, from the common gain: Nelder–Mead in log₂ g over the range.
+                    let unit = |x: &[f64; 3]| x.map(|x| (lo + (hi - lo) * x).exp2());
+                    let start = [(stop - lo) / (hi - lo); 3];
+                    let budget = crate::nelder_mead::Budget {
+                        x_tol: 1e-3,
+                        f_tol: 1e-4,
+                        max_evals: 150,
+                    };
+                    let best = crate::nelder_mead::minimize(
+                        &mut |x: &[f64; 3]| rms_of(&inv, unit(x)),
+                        start,
+                        0.1,
+                        budget,
+                    );
+                    out.gain = unit(&best.x);
+                    out.gain_spread = None;
+                }
+            }
+            if fit_beta {
+                let rms: Vec<f64> = betas
+                    .par_iter()
+                    .map(|&b| rms_of(&Inverter::new(self.table.slice(b)), out.gain))
+                    .collect();
+                let (beta, range) = best_on_grid(&betas, &rms, tolerance);
+                out.beta = beta;
+                out.beta_spread = Some(range);
+            }
         }
-        let mut hi = best;
-        while hi + 1 < steps && rms[hi + 1] <= limit {
-            hi += 1;
-        }
-        (
-            beta,
-            Some(EumelaninSpread {
-                min: betas[lo].min(beta),
-                max: betas[hi].max(beta),
-                tolerance_de: opts.beta_tolerance_de,
-                best_rms_de: rms[best],
-            }),
-        )
+        out
     }
 
     /// The linear Rec.709 diffuse albedo of the skins C_m = `melanin`, C_h = `hemoglobin`
@@ -576,6 +763,38 @@ impl MapsModel {
     }
 }
 
+impl MapsModel {
+    /// The albedo of `maps` as [`MapsModel::albedo`], with β_m per texel where the maps have it
+    /// (each distinct β_m value gets its slice).
+    pub fn albedo_of(&self, maps: &Maps) -> Result<Vec<[f32; 3]>, MapsError> {
+        let Some(betas) = &maps.eumelanin_map else {
+            return self.albedo(&maps.melanin, maps.eumelanin, &maps.hemoglobin);
+        };
+        let n = maps.melanin.len();
+        if betas.len() != n || maps.hemoglobin.len() != n {
+            return Err(MapsError::Length {
+                what: "eumelanin or hemoglobin map",
+                found: betas.len().min(maps.hemoglobin.len()),
+                expected: n,
+            });
+        }
+        let mut distinct: Vec<u32> = betas.iter().map(|b| b.to_bits()).collect();
+        distinct.sort_unstable();
+        distinct.dedup();
+        let mut out = vec![[0.0f32; 3]; n];
+        for bits in distinct {
+            let beta = f64::from(f32::from_bits(bits));
+            let pick: Vec<usize> = (0..n).filter(|&k| betas[k].to_bits() == bits).collect();
+            let m: Vec<f32> = pick.iter().map(|&k| maps.melanin[k]).collect();
+            let h: Vec<f32> = pick.iter().map(|&k| maps.hemoglobin[k]).collect();
+            for (k, a) in pick.iter().zip(self.albedo(&m, beta.clamp(0.0, 1.0), &h)?) {
+                out[*k] = a;
+            }
+        }
+        Ok(out)
+    }
+}
+
 /// Fit maps to `texels` in one call: [`MapsModel::load`] then [`MapsModel::fit`].
 pub fn fit_maps(
     texels: &[[f32; 3]],
@@ -584,4 +803,95 @@ pub fn fit_maps(
     progress: &(dyn Fn(usize) + Sync),
 ) -> Result<Maps, MapsError> {
     MapsModel::load(opts)?.fit(texels, mask, opts, progress)
+}
+
+/// RMS over `sample` of the ΔE2000 (capped at [`BETA_CAP_DE`]) between each texel and its
+/// inversion by `inv` at the exposure `gain`, seen at the texture's own exposure.
+fn sample_rms(inv: &Inverter, sample: &[[f32; 3]], gain: [f64; 3]) -> f64 {
+    let g = gain.map(|g| g as f32);
+    let sum: f64 = sample
+        .par_iter()
+        .with_min_len(256)
+        .map(|t| {
+            let r = inv.invert(&texel_lab(scaled(*t, g)).0);
+            let seen = texel_lab(*t).0;
+            let fit = if gain == [1.0; 3] {
+                r.lab
+            } else {
+                unscaled(&r.lab, gain)
+            };
+            delta_e_2000_fast(&seen, &fit).min(BETA_CAP_DE).powi(2)
+        })
+        .sum();
+    (sum / sample.len().max(1) as f64).sqrt()
+}
+
+/// A texel with its channels scaled by `gain`.
+#[inline]
+fn scaled(t: [f32; 3], gain: [f32; 3]) -> [f32; 3] {
+    [t[0] * gain[0], t[1] * gain[1], t[2] * gain[2]]
+}
+
+/// β_m and the exposure of a texture, with the ranges the texels allow when fitted.
+struct Shared {
+    beta: f64,
+    gain: [f64; 3],
+    beta_spread: Option<FittedRange>,
+    gain_spread: Option<FittedRange>,
+}
+
+/// The best of candidates `xs` (evenly spaced) by their RMS capped ΔE2000 `rms`, placed between
+/// candidates by a parabola through the best and its neighbours, and the range around it where
+/// the RMS (linear between candidates) stays within `tolerance_de` of the best candidate's.
+fn best_on_grid(xs: &[f64], rms: &[f64], tolerance_de: f64) -> (f64, FittedRange) {
+    let n = xs.len();
+    let best = (0..n)
+        .min_by(|&a, &b| rms[a].total_cmp(&rms[b]))
+        .unwrap_or(0);
+    let x = if best > 0 && best + 1 < n {
+        let (a, b, c) = (rms[best - 1], rms[best], rms[best + 1]);
+        let curvature = a - 2.0 * b + c;
+        let shift = if curvature > 0.0 {
+            (0.5 * (a - c) / curvature).clamp(-0.5, 0.5)
+        } else {
+            0.0
+        };
+        xs[best] + shift * (xs[1] - xs[0])
+    } else {
+        xs[best]
+    };
+    let limit = rms[best] + tolerance_de;
+    let mut lo = best;
+    while lo > 0 && rms[lo - 1] <= limit {
+        lo -= 1;
+    }
+    let mut hi = best;
+    while hi + 1 < n && rms[hi + 1] <= limit {
+        hi += 1;
+    }
+    // Each end where the RMS, linear between candidates, crosses the limit.
+    let crossing = |inside: usize, outside: usize| -> f64 {
+        let (a, b) = (rms[inside], rms[outside]);
+        let t = if b > a {
+            ((limit - a) / (b - a)).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        xs[inside] + t * (xs[outside] - xs[inside])
+    };
+    let min = if lo > 0 { crossing(lo, lo - 1) } else { xs[lo] };
+    let max = if hi + 1 < n {
+        crossing(hi, hi + 1)
+    } else {
+        xs[hi]
+    };
+    (
+        x,
+        FittedRange {
+            min: min.min(x),
+            max: max.max(x),
+            tolerance_de,
+            best_rms_de: rms[best],
+        },
+    )
 }

@@ -139,6 +139,33 @@ impl ForwardTable {
         })
     }
 
+    /// The slice at one β_m straight from the exact model (`nu` × `nv` nodes on the table's u, v
+    /// axes, skins built on `base`): what [`ForwardTable::slice`] interpolates, without the β_m
+    /// axis, for a search over skins that differ in more than C_m, β_m, C_h.
+    pub fn exact_slice(
+        nu: usize,
+        nv: usize,
+        base: SkinParams,
+        beta: f64,
+    ) -> Result<Slice, FitError> {
+        let exact = Forward::Exact(AddingDoublingOptions::default().with_layer_cache(true));
+        let model = ColourModel::with_forward(STEP_NM, exact, base)?;
+        let nodes = (0..nu * nv)
+            .into_par_iter()
+            .map(|k| {
+                let (i, j) = (k % nu, k / nu);
+                let skin = model.skin(
+                    melanin_of_u(i as f64 / (nu - 1) as f64),
+                    beta,
+                    hemoglobin_of_v(j as f64 / (nv - 1) as f64),
+                )?;
+                let lab = model.lab(&skin)?;
+                Ok([lab.l, lab.a, lab.b])
+            })
+            .collect::<Result<Vec<_>, FitError>>()?;
+        Ok(Slice::new(nu, nv, &nodes, beta))
+    }
+
     /// The node counts.
     #[must_use]
     pub fn size(&self) -> TableSize {
@@ -192,36 +219,39 @@ impl ForwardTable {
     }
 }
 
-/// A (u, v) slice at one β_m: Catmull–Rom bicubic interpolation ([CR74]) of CIELAB, with one ghost node
-/// (linear extrapolation) on every side so that a lookup needs no bounds checks.
+/// A (u, v) slice at one β_m: Catmull–Rom bicubic interpolation ([CR74]) of CIELAB, with one ghost
+/// node (linear extrapolation) on every side. Each cell keeps its bicubic as 16 power-basis
+/// coefficients (the Catmull–Rom basis matrix applied to its 4 × 4 nodes on both sides), so that
+/// a lookup is three short Horner schemes on four-lane (L*, a*, b*, 0) values.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Slice {
     nu: usize,
     nv: usize,
-    /// (nu + 2) × (nv + 2) nodes, ghosts included, row-major in v.
-    padded: Vec<[f64; 3]>,
+    /// Per cell (row-major in v), coefficient of tu^k tv^l at `[l * 4 + k]`.
+    cells: Vec<[Lanes; 16]>,
     beta: f64,
 }
 
-/// Catmull–Rom weights at t ∈ [0, 1] and their derivatives.
-#[inline]
-fn catmull_rom(t: f64) -> ([f64; 4], [f64; 4]) {
-    let t2 = t * t;
-    let t3 = t2 * t;
-    (
-        [
-            0.5 * (-t3 + 2.0 * t2 - t),
-            0.5 * (3.0 * t3 - 5.0 * t2 + 2.0),
-            0.5 * (-3.0 * t3 + 4.0 * t2 + t),
-            0.5 * (t3 - t2),
-        ],
-        [
-            0.5 * (-3.0 * t2 + 4.0 * t - 1.0),
-            0.5 * (9.0 * t2 - 10.0 * t),
-            0.5 * (-9.0 * t2 + 8.0 * t + 1.0),
-            0.5 * (3.0 * t2 - 2.0 * t),
-        ],
-    )
+/// L*, a*, b* and a zero: four lanes that vectorise.
+type Lanes = [f64; 4];
+
+/// The Catmull–Rom weights w_a(t) = Σ_k `CATMULL_ROM[a][k]` t^k on the nodes a = 0..4 around a
+/// cell (nodes 1 and 2 its ends).
+const CATMULL_ROM: [[f64; 4]; 4] = [
+    [0.0, -0.5, 1.0, -0.5],
+    [1.0, 0.0, -2.5, 1.5],
+    [0.0, 0.5, 2.0, -1.5],
+    [0.0, 0.0, -0.5, 0.5],
+];
+
+#[inline(always)]
+fn fma4(acc: Lanes, x: Lanes, t: f64) -> Lanes {
+    [
+        acc[0] * t + x[0],
+        acc[1] * t + x[1],
+        acc[2] * t + x[2],
+        acc[3] * t + x[3],
+    ]
 }
 
 /// Cell index and offset of unit coordinate `x` on `n` nodes.
@@ -262,10 +292,31 @@ impl Slice {
                 padded[j * pu + i] = at(i as isize - 1, j as isize - 1);
             }
         }
+        let cells = (0..(nv - 1) * (nu - 1))
+            .map(|c| {
+                let (i, j) = (c % (nu - 1), c / (nu - 1));
+                let mut coef = [[0.0; 4]; 16];
+                for (kl, out) in coef.iter_mut().enumerate() {
+                    let (k, l) = (kl % 4, kl / 4);
+                    for b in 0..4 {
+                        for a in 0..4 {
+                            let w = CATMULL_ROM[a][k] * CATMULL_ROM[b][l];
+                            if w != 0.0 {
+                                let node = padded[(j + b) * pu + i + a];
+                                for ch in 0..3 {
+                                    out[ch] += w * node[ch];
+                                }
+                            }
+                        }
+                    }
+                }
+                coef
+            })
+            .collect();
         Self {
             nu,
             nv,
-            padded,
+            cells,
             beta,
         }
     }
@@ -276,41 +327,53 @@ impl Slice {
         self.beta
     }
 
+    #[inline(always)]
+    fn locate(&self, u: f64, v: f64) -> (&[Lanes; 16], f64, f64) {
+        let (i, tu) = cell(u, self.nu);
+        let (j, tv) = cell(v, self.nv);
+        (&self.cells[j * (self.nu - 1) + i], tu, tv)
+    }
+
     /// CIELAB at unit coordinates (u, v) ∈ [0, 1]² (clamped).
     #[inline]
     #[must_use]
     pub fn lab(&self, u: f64, v: f64) -> [f64; 3] {
-        self.lab_and_gradient(u, v).0
+        let (c, tu, tv) = self.locate(u, v);
+        let row = |l: usize| {
+            let r = fma4(c[l * 4 + 3], c[l * 4 + 2], tu);
+            let r = fma4(r, c[l * 4 + 1], tu);
+            fma4(r, c[l * 4], tu)
+        };
+        let f = fma4(fma4(fma4(row(3), row(2), tv), row(1), tv), row(0), tv);
+        [f[0], f[1], f[2]]
     }
 
     /// CIELAB at (u, v) and its derivatives ∂/∂u and ∂/∂v.
     #[inline]
     #[must_use]
     pub fn lab_and_gradient(&self, u: f64, v: f64) -> ([f64; 3], [f64; 3], [f64; 3]) {
-        let (i, tu) = cell(u, self.nu);
-        let (j, tv) = cell(v, self.nv);
-        let (wu, du) = catmull_rom(tu);
-        let (wv, dv) = catmull_rom(tv);
-        let pu = self.nu + 2;
-        let (mut f, mut fu, mut fv) = ([0.0; 3], [0.0; 3], [0.0; 3]);
-        for b in 0..4 {
-            let row = &self.padded[(j + b) * pu + i..(j + b) * pu + i + 4];
-            let mut r = [0.0; 3];
-            let mut ru = [0.0; 3];
-            for a in 0..4 {
-                for c in 0..3 {
-                    r[c] += wu[a] * row[a][c];
-                    ru[c] += du[a] * row[a][c];
-                }
-            }
-            for c in 0..3 {
-                f[c] += wv[b] * r[c];
-                fu[c] += wv[b] * ru[c];
-                fv[c] += dv[b] * r[c];
-            }
+        let (c, tu, tv) = self.locate(u, v);
+        // Per power of tv: the row polynomial in tu and its tu-derivative.
+        let mut r = [[0.0; 4]; 4];
+        let mut ru = [[0.0; 4]; 4];
+        for l in 0..4 {
+            let k = &c[l * 4..l * 4 + 4];
+            r[l] = fma4(fma4(fma4(k[3], k[2], tu), k[1], tu), k[0], tu);
+            let d3 = k[3].map(|x| 3.0 * x);
+            let d2 = k[2].map(|x| 2.0 * x);
+            ru[l] = fma4(fma4(d3, d2, tu), k[1], tu);
         }
+        let f = fma4(fma4(fma4(r[3], r[2], tv), r[1], tv), r[0], tv);
+        let fu = fma4(fma4(fma4(ru[3], ru[2], tv), ru[1], tv), ru[0], tv);
+        let d3 = r[3].map(|x| 3.0 * x);
+        let d2 = r[2].map(|x| 2.0 * x);
+        let fv = fma4(fma4(d3, d2, tv), r[1], tv);
         let su = (self.nu - 1) as f64;
         let sv = (self.nv - 1) as f64;
-        (f, fu.map(|x| x * su), fv.map(|x| x * sv))
+        (
+            [f[0], f[1], f[2]],
+            [fu[0] * su, fu[1] * su, fu[2] * su],
+            [fv[0] * sv, fv[1] * sv, fv[2] * sv],
+        )
     }
 }
