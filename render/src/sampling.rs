@@ -26,20 +26,21 @@ pub fn cosine_hemisphere(u: Vec2) -> Vec3 {
     Vec3::new(d.x, d.y, (1.0 - d.length_squared()).max(0.0).sqrt())
 }
 
-/// Uniform direction in the cone of half-angle θ_max around +Z (`cos_max` = cos θ_max), density
-/// 1 / (2π (1 − cos θ_max)).
+/// Uniform direction in the cone of half-angle θ_max around +Z, given by `one_minus_cos_max` =
+/// 1 − cos θ_max (so that a cap of 10⁻⁶ sr keeps its digits in f32), density 1 / (2π (1 − cos θ_max)).
 #[must_use]
-pub fn uniform_cone(u: Vec2, cos_max: f32) -> Vec3 {
-    let cos_t = 1.0 - u.x * (1.0 - cos_max);
-    let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
+pub fn uniform_cone(u: Vec2, one_minus_cos_max: f32) -> Vec3 {
+    // 1 − cos θ, and sin θ = √((1 − cos θ)(1 + cos θ)), both without the cancellation of 1 − cos².
+    let one_minus_cos = u.x * one_minus_cos_max;
+    let sin_t = (one_minus_cos * (2.0 - one_minus_cos)).max(0.0).sqrt();
     let phi = TAU * u.y;
-    Vec3::new(sin_t * phi.cos(), sin_t * phi.sin(), cos_t)
+    Vec3::new(sin_t * phi.cos(), sin_t * phi.sin(), 1.0 - one_minus_cos)
 }
 
 /// Density of [`uniform_cone`], sr⁻¹.
 #[must_use]
-pub fn uniform_cone_pdf(cos_max: f32) -> f32 {
-    1.0 / (TAU * (1.0 - cos_max))
+pub fn uniform_cone_pdf(one_minus_cos_max: f32) -> f32 {
+    1.0 / (TAU * one_minus_cos_max)
 }
 
 #[cfg(test)]
@@ -70,9 +71,9 @@ mod tests {
         let cos_max = 0.8;
         for i in 0..100 {
             let u = Vec2::new(i as f32 / 100.0, (i * 37 % 100) as f32 / 100.0);
-            let w = uniform_cone(u, cos_max);
+            let w = uniform_cone(u, 1.0 - cos_max);
             assert!((w.length() - 1.0).abs() < 1e-5 && w.z >= cos_max - 1e-6);
         }
-        assert!((uniform_cone(Vec2::new(1.0, 0.0), cos_max).z - cos_max).abs() < 1e-6);
+        assert!((uniform_cone(Vec2::new(1.0, 0.0), 1.0 - cos_max).z - cos_max).abs() < 1e-6);
     }
 }
