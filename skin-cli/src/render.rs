@@ -106,7 +106,8 @@ pub struct RenderArgs {
     #[arg(long, value_name = "off|LO,HI", value_parser = Checked(parse_lod))]
     pub lod: Option<LodSetting>,
     /// Volumetric walk instead of the BSSRDF where the body under a skin hit is thinner than this
-    /// many of the skin's largest 99% energy radii, in [0, 10] (0: never; auto: 1, full: 0).
+    /// many of the skin's largest 99% energy radii and its far face is lit, in [0, 10] (0: never;
+    /// auto: 1, full: 0).
     #[arg(long, value_name = "R99S", value_parser = Checked(parse_thin_walk), allow_hyphen_values = true)]
     pub thin_walk: Option<f64>,
     /// Photons of the universal shape table, in [1e4, 1e9] (auto: the fewest whose measured shape

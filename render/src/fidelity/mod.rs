@@ -39,8 +39,8 @@ use std::str::FromStr;
 use thiserror::Error;
 
 /// Factor of r₉₉ below which a hit's local thickness takes the volumetric walk
-/// (`crate::volumetric::thin`), as measured on the backlit slabs (`--thin-walk 1`; the walk is
-/// off unless asked for).
+/// (`crate::volumetric::thin`) under `Fidelity::Auto`, as measured on the backlit slabs (`--thin-walk
+/// K` sets another, 0 turns the walk off; `Fidelity::Full` never walks).
 pub const DEFAULT_THIN_WALK_R99: f64 = 1.0;
 /// Wavelength step of the skin reflectance tables in `Fidelity::Full` and without a BSSRDF, nm
 /// (interpolated to 5 nm).
@@ -270,11 +270,7 @@ impl FidelityKnobs {
                 });
             }
             Some(k) => (k > 0.0).then_some(k),
-            // Off unless asked for: at the default scene's footprints about 1% of subsurface hits
-            // are thin, and the walk's estimate is heavy-tailed (light reaches the walked body
-            // only through its exit rays), which multiplies the default image's noise at equal
-            // time (BENCHMARKS.md, "Fidelity").
-            None => None,
+            None => auto.then_some(DEFAULT_THIN_WALK_R99),
         };
         let photons = match (self.shape_photons, self.smallest_footprint_mm) {
             (Some(n), _) if !(1e4..=1e9).contains(&(n as f64)) => {
@@ -351,7 +347,7 @@ mod tests {
         assert_eq!(auto.energy_tolerance, Some(DEFAULT_ENERGY_TOLERANCE));
         assert!(matches!(auto.step, StepChoice::Colour { .. }));
         assert_eq!(auto.lod, Some(LodBand::default()));
-        assert_eq!(auto.thin_walk_r99, None);
+        assert_eq!(auto.thin_walk_r99, Some(DEFAULT_THIN_WALK_R99));
         let never = FidelityKnobs {
             thin_walk_r99: Some(0.0),
             ..FidelityKnobs::default()

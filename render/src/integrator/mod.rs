@@ -80,6 +80,22 @@ pub struct PathSettings {
     /// How the wavelength whose profile draws a probe's radius is chosen (default
     /// [`RadiusWavelength::RENDER`]: mostly by the lanes' luminance).
     pub radius_wavelength: RadiusWavelength,
+    /// How light leaves a thin part walked under the BSSRDF integrator (default
+    /// [`ThinExit::LightSampled`]; the volumetric reference always refracts).
+    pub thin_exit: ThinExit,
+}
+
+/// How the path leaves a thin part of skin after its volumetric walk (docs/physics.md §16.6).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ThinExit {
+    /// The walk gives the exit point and the energy that leaves there; the direction follows the
+    /// BSSRDF's S_ω, so the light at the exit is gathered by next-event estimation (MIS against
+    /// the cosine-weighted continuation), as at a BSSRDF exit.
+    #[default]
+    LightSampled,
+    /// The walk's own refracted direction, with no light sampling at the exit (the reference's
+    /// estimator: unbiased, heavy-tailed where a small light is seen through the part).
+    Refracted,
 }
 
 impl Default for PathSettings {
@@ -96,6 +112,7 @@ impl Default for PathSettings {
             subsurface_probes: 2,
             stratified_exit_lights: false,
             radius_wavelength: RadiusWavelength::RENDER,
+            thin_exit: ThinExit::LightSampled,
         }
     }
 }
@@ -159,7 +176,7 @@ impl BodyIntegrator {
         match self {
             Self::Volumetric(v) => v.medium(si.material),
             Self::Bssrdf(Some(thin)) if q_sss > 0.0 => {
-                thin.walk_at(&scene.geometry, si, ng, footprint_mm, rays)
+                thin.walk_at(scene, si, ng, footprint_mm, rays)
             }
             Self::Bssrdf(_) => None,
         }

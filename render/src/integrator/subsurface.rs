@@ -90,7 +90,7 @@ impl PathTracer<'_> {
     /// The subsurface branch was taken: continue from `exit` in a cosine-weighted direction
     /// (weight S_ω cos / (cos / π) = T / c, times `beta_exit` / q); `lit_exit` tells whether a
     /// light could reach the exit (its probabilities are in `Path::exit_pick`).
-    fn continue_from_exit(
+    pub(super) fn continue_from_exit(
         &self,
         path: &mut Path,
         hit: &Shading<'_>,
@@ -180,7 +180,7 @@ impl PathTracer<'_> {
     /// continuation): the mean of `settings.exit_light_samples` light samples sharing the exit
     /// (splitting), and whether any light can reach the point (`pick` gets its light
     /// probabilities).
-    fn exit_light(
+    pub(super) fn exit_light(
         &self,
         ss: &Subsurface,
         exit: &Exit,

@@ -1,9 +1,14 @@
-//! The volumetric branch of the path at a skin hit (`crate::volumetric`, docs/physics.md §15):
-//! refract into the body, random-walk through its two layers, leave where the walk does.
+//! The volumetric branch of the path at a skin hit (`crate::volumetric`, docs/physics.md §15,
+//! §16.6): refract into the body, random-walk through its two layers, leave where the walk does.
+//! Under the volumetric reference the path leaves along the walk's refracted direction; at a thin
+//! part under the BSSRDF integrator ([`ThinExit::LightSampled`]) the walk gives the exit point and
+//! the energy leaving there, and the exit is shaded as a BSSRDF exit: light sampled with S_ω, the
+//! path continued cosine-weighted.
 
-use super::{Path, PathTracer, Random, Shading, Step, russian_roulette};
+use super::{BodyIntegrator, Path, PathTracer, Random, Shading, Step, ThinExit, russian_roulette};
+use crate::bssrdf::Exit;
 use crate::material::Material;
-use crate::spectrum::SampledWavelengths;
+use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::volumetric::{self, SkinVolume};
 
 impl PathTracer<'_> {
@@ -41,7 +46,29 @@ impl PathTracer<'_> {
         let Some(exit) = walk.exit else {
             return Step::Stop;
         };
-        path.beta = volumetric::hero_only(path.beta) * (exit.weight * t_o / hit.q_sss);
+        let beta_exit = volumetric::hero_only(path.beta) * (exit.weight * t_o);
+        let thin = matches!(self.body, BodyIntegrator::Bssrdf(_));
+        if thin && self.settings.thin_exit == ThinExit::LightSampled {
+            // The walk chose to leave here (with probability T(θ) at its own direction): its
+            // weight is the energy leaving, which S_ω spreads over the outgoing directions.
+            let at = Exit {
+                p: exit.p,
+                ng: exit.ng,
+                ns: exit.ng,
+                hit: None,
+                weight: SampledSpectrum::splat(1.0),
+            };
+            let (direct, lit) = self.exit_light(
+                ss,
+                &at,
+                wl,
+                (&mut *sampler, &mut *rays),
+                &mut path.exit_pick,
+            );
+            path.l += beta_exit * direct / hit.q_sss;
+            return self.continue_from_exit(path, hit, ss, &at, (beta_exit, lit), sampler);
+        }
+        path.beta = beta_exit / hit.q_sss;
         // No light was sampled at the exit: emission found next takes MIS weight 1.
         path.prev = None;
         if path.beta.is_black()
