@@ -129,35 +129,44 @@ fn ear(side: usize, spp: u32, ref_spp: u32) -> anyhow::Result<()> {
         };
         Scene::from_toml(&toml, "ear.toml", None, &knobs)
     };
-    let (default, alone) = (load(None)?, load(Some(0.0))?);
-    println!("configuration,spp,mean_y,se,error_pct,error_sigma,cpu_s,se_sqrt_cpu,walked_pct");
-    let vol = BodyIntegrator::build(&default, IntegratorKind::Volumetric)?;
-    let reference = run(&default, &vol, ThinExit::Refracted, side, ref_spp, 2)?;
-    println!(
-        "volumetric reference,{ref_spp},{:.5},{:.5},0,0,{:.2},{:.5},0",
-        reference.y,
-        reference.se,
-        reference.cpu,
-        reference.se / reference.y * reference.cpu.sqrt()
-    );
-    for (label, scene, exit) in [
-        ("BSSRDF alone", &alone, ThinExit::LightSampled),
-        ("default (walk, light sampled at exits)", &default, ThinExit::LightSampled),
-        ("walk, refracted exits", &default, ThinExit::Refracted),
-    ] {
-        let body = BodyIntegrator::build(scene, IntegratorKind::Bssrdf)?;
-        let r = run(scene, &body, exit, side, spp, 1)?;
-        let walked = body.thin_parts().and_then(|t| (0..2).find_map(|i| t.part(i))).map_or(0.0, |p| {
-            let (t, w) = p.counts();
-            100.0 * w as f64 / t.max(1) as f64
-        });
-        let diff = r.y / reference.y - 1.0;
+    println!("configuration,spp,mean_y,se,cpu_s,se_sqrt_cpu,walked_pct");
+    let default = load(None)?;
+    // The reference is optional (REF_SPP 0): its heavy tail (a small light found only by refracted
+    // exits) needs thousands of samples per pixel; the walk everywhere (k = 10) is the low-noise
+    // comparison, checked against it within its noise.
+    if ref_spp > 0 {
+        let vol = BodyIntegrator::build(&default, IntegratorKind::Volumetric)?;
+        let r = run(&default, &vol, ThinExit::Refracted, side, ref_spp, 2)?;
         println!(
-            "{label},{spp},{:.5},{:.5},{:+.1},{:+.1},{:.2},{:.5},{walked:.1}",
+            "volumetric reference,{ref_spp},{:.5},{:.5},{:.2},{:.5},0",
             r.y,
             r.se,
-            100.0 * diff,
-            diff / (r.se.hypot(reference.se) / reference.y),
+            r.cpu,
+            r.se / r.y * r.cpu.sqrt()
+        );
+    }
+    for (label, k, exit) in [
+        ("BSSRDF alone (k 0)", Some(0.0), ThinExit::LightSampled),
+        ("default (k 1, light sampled at exits)", None, ThinExit::LightSampled),
+        ("k 1, refracted exits", None, ThinExit::Refracted),
+        ("k 2", Some(2.0), ThinExit::LightSampled),
+        ("k 3", Some(3.0), ThinExit::LightSampled),
+        ("k 10 (walk everywhere)", Some(10.0), ThinExit::LightSampled),
+    ] {
+        let scene = load(k)?;
+        let body = BodyIntegrator::build(&scene, IntegratorKind::Bssrdf)?;
+        let r = run(&scene, &body, exit, side, spp, 1)?;
+        let walked = body
+            .thin_parts()
+            .and_then(|t| (0..2).find_map(|i| t.part(i)))
+            .map_or(0.0, |p| {
+                let (t, w) = p.counts();
+                100.0 * w as f64 / t.max(1) as f64
+            });
+        println!(
+            "{label},{spp},{:.5},{:.5},{:.2},{:.5},{walked:.1}",
+            r.y,
+            r.se,
             r.cpu,
             r.se / r.y * r.cpu.sqrt()
         );
