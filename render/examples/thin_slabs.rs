@@ -35,7 +35,9 @@ fn main() -> anyhow::Result<()> {
         "type = \"quad\"\ncenter_mm = [0, 0, -60]\nlook_at_mm = [0, 0, 0]\nsize_mm = [200, 200]\nintensity = 5"
     };
     let dir = tempfile::tempdir()?;
-    println!("tone,mm,configuration,spp,mean_y,se,error_pct,error_sigma,cpu_s,se_sqrt_cpu,walked_pct");
+    println!(
+        "tone,mm,configuration,spp,mean_y,se,error_pct,error_sigma,cpu_s,se_sqrt_cpu,walked_pct"
+    );
     for tone in &tones {
         for mm in [1.0f32, 2.0, 4.0] {
             let obj = dir.path().join(format!("thin{mm}.obj"));
@@ -68,10 +70,34 @@ fn main() -> anyhow::Result<()> {
                 2,
             )?;
             let rows = [
-                ("volumetric reference", &default, IntegratorKind::Volumetric, ThinExit::Refracted, ref_spp),
-                ("BSSRDF alone", &alone, IntegratorKind::Bssrdf, ThinExit::LightSampled, spp),
-                ("default (walk, light sampled at exits)", &default, IntegratorKind::Bssrdf, ThinExit::LightSampled, spp),
-                ("walk, refracted exits", &default, IntegratorKind::Bssrdf, ThinExit::Refracted, spp),
+                (
+                    "volumetric reference",
+                    &default,
+                    IntegratorKind::Volumetric,
+                    ThinExit::Refracted,
+                    ref_spp,
+                ),
+                (
+                    "BSSRDF alone",
+                    &alone,
+                    IntegratorKind::Bssrdf,
+                    ThinExit::LightSampled,
+                    spp,
+                ),
+                (
+                    "default (walk, light sampled at exits)",
+                    &default,
+                    IntegratorKind::Bssrdf,
+                    ThinExit::LightSampled,
+                    spp,
+                ),
+                (
+                    "walk, refracted exits",
+                    &default,
+                    IntegratorKind::Bssrdf,
+                    ThinExit::Refracted,
+                    spp,
+                ),
             ];
             for (label, scene, kind, exit, n) in rows {
                 let body = BodyIntegrator::build(scene, kind)?;
@@ -80,13 +106,10 @@ fn main() -> anyhow::Result<()> {
                 } else {
                     run(scene, &body, exit, side, n, 1)?
                 };
-                let walked = body
-                    .thin_parts()
-                    .and_then(|t| t.part(0))
-                    .map_or(0.0, |p| {
-                        let (t, w) = p.counts();
-                        100.0 * w as f64 / t.max(1) as f64
-                    });
+                let walked = body.thin_parts().and_then(|t| t.part(0)).map_or(0.0, |p| {
+                    let (t, w) = p.counts();
+                    100.0 * w as f64 / t.max(1) as f64
+                });
                 let diff = r.y / reference.y - 1.0;
                 let sigma = r.se.hypot(reference.se) / reference.y;
                 println!(
@@ -94,7 +117,11 @@ fn main() -> anyhow::Result<()> {
                     r.y,
                     r.se,
                     100.0 * diff,
-                    if kind == IntegratorKind::Volumetric { 0.0 } else { diff / sigma },
+                    if kind == IntegratorKind::Volumetric {
+                        0.0
+                    } else {
+                        diff / sigma
+                    },
                     r.cpu,
                     r.se / r.y * r.cpu.sqrt()
                 );
@@ -147,7 +174,11 @@ fn ear(side: usize, spp: u32, ref_spp: u32) -> anyhow::Result<()> {
     }
     for (label, k, exit) in [
         ("BSSRDF alone (k 0)", Some(0.0), ThinExit::LightSampled),
-        ("default (k 1, light sampled at exits)", None, ThinExit::LightSampled),
+        (
+            "default (k 1, light sampled at exits)",
+            None,
+            ThinExit::LightSampled,
+        ),
         ("k 1, refracted exits", None, ThinExit::Refracted),
         ("k 2", Some(2.0), ThinExit::LightSampled),
         ("k 3", Some(3.0), ThinExit::LightSampled),

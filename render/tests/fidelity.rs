@@ -372,4 +372,3 @@ fn a_thin_slab_lit_only_from_the_front_keeps_the_bssrdf() {
     let (_, _, b) = mean_y(&alone, &bssrdf, 8, 4, 7);
     assert_eq!(film, b);
 }
-

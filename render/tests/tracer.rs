@@ -164,8 +164,14 @@ fn a_far_small_light_lights_every_pixel_without_outliers() {
         .map(|i| f64::from(film.xyz(i % 16, i / 16)[1]))
         .collect();
     let mean = ys.iter().sum::<f64>() / ys.len() as f64;
-    assert!((mean / want - 1.0).abs() < 0.01, "mean Y {mean} against {want}");
+    assert!(
+        (mean / want - 1.0).abs() < 0.01,
+        "mean Y {mean} against {want}"
+    );
     ys.sort_by(f64::total_cmp);
     let (median, max) = (ys[ys.len() / 2], ys[ys.len() - 1]);
-    assert!(max <= 1.05 * median, "brightest pixel {max} against median {median}");
+    assert!(
+        max <= 1.05 * median,
+        "brightest pixel {max} against median {median}"
+    );
 }
