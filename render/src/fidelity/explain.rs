@@ -205,8 +205,9 @@ pub fn explain_table(skins: &[(&str, &SkinChoices)]) -> String {
                 walk_below_mm: Some(t),
             } => format!(
                 "BSSRDF; the volumetric walk where the body under a hit is thinner than {t:.2} mm \
-                 along the inward normal ({:.1} × r99; dermis transport mean free path \
-                 {transport_mfp_mm:.3} mm); share of hits walked printed after the render",
+                 along the inward normal and its far face is lit ({:.1} × r99; dermis transport \
+                 mean free path {transport_mfp_mm:.3} mm); share of hits walked printed after the \
+                 render",
                 t / c.r99_mm.max(f32::MIN_POSITIVE)
             ),
             TransportChoice::Bssrdf {

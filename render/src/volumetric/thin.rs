@@ -239,10 +239,10 @@ fn direct_proxy(scene: &Scene, (p, n): (Vec3, Vec3), rays: &mut u64) -> f32 {
             e += w;
         }
     }
-    if let Some(env) = &scene.environment {
-        if clear(n, f32::INFINITY, rays) {
-            e += env.selection_weight();
-        }
+    if let Some(env) = &scene.environment
+        && clear(n, f32::INFINITY, rays)
+    {
+        e += env.selection_weight();
     }
     e
 }
