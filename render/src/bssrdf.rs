@@ -6,6 +6,7 @@
 //!   radii the table needs for an interpolation error target.
 //! - [`sampling`]: axis choice, probe segments and the one-sample MIS density over the axes.
 //! - [`separable`]: S = T(θ_o) R(r) S_ω(ω_i), the energy split with the specular layer, the texture.
+//! - [`incidence`]: the gain a(θ, λ) of the total at oblique incidence that multiplies T.
 //!
 //! [`Subsurface`] ties them together for a path tracer in the manner of pbrt-v4's `SampleSp` →
 //! intersect → `ProbeIntersectionToSample`: [`Subsurface::sample_probe`] says which segment to
@@ -40,10 +41,12 @@
 //! crosses it and finds the far side, so backlit ears transmit (red) light.
 
 pub mod extent;
+pub mod incidence;
 pub mod sampling;
 pub mod separable;
 pub mod table;
 
+pub use incidence::{Incidence, IncidenceGain};
 pub use sampling::{Probe, ProbeAxes, ProbeFrame, RadiusWavelength, pdf_exit, probe};
 pub use separable::{Directional, EnergySplit, texture_modulation};
 pub use table::{ProfileTable, RENDER_SHAPE_STEP_NM, RowsAt, TableOptions};

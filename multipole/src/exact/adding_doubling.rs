@@ -193,12 +193,102 @@ pub fn solve(
     medium: &LayeredMedium,
     options: &AddingDoublingOptions,
 ) -> Result<SlabTotals, AddingDoublingError> {
+    let folded = fold(medium, options)?;
+    let normal = folded.angles.n() - 1; // μ = 1 is the last node of every rule.
+    let totals = folded.totals(normal)?;
+    debug_assert!(totals.diffuse_reflectance.is_finite() && totals.transmittance.is_finite());
+    Ok(totals)
+}
+
+/// The diffuse reflectance of `medium` for a collimated beam at each incidence the angular grid
+/// resolves: one entry per quadrature direction inside that refracts out of the top face, from
+/// grazing to normal incidence (docs/physics.md §10; the same solve as [`solve`], which keeps
+/// only the normal column).
+pub fn reflectance_by_angle(
+    medium: &LayeredMedium,
+    options: &AddingDoublingOptions,
+) -> Result<Vec<AngularReflectance>, AddingDoublingError> {
+    let folded = fold(medium, options)?;
+    let eta = folded.eta;
+    let ratio = medium.n_above() / eta;
+    (0..folded.angles.n())
+        .filter_map(|j| {
+            let mu_in = folded.angles.mu[j];
+            // Snell: sin θ_out = (η / n_above) sin θ_in; directions beyond the critical one stay inside.
+            let sin2_out = (1.0 - mu_in * mu_in) / (ratio * ratio);
+            (sin2_out < 1.0).then(|| (j, mu_in, (1.0 - sin2_out).sqrt()))
+        })
+        .map(|(j, mu_in, mu_out)| {
+            let t = folded.totals(j)?;
+            Ok(AngularReflectance {
+                mu_outside: mu_out,
+                mu_inside: mu_in,
+                totals: t,
+            })
+        })
+        .collect()
+}
+
+/// The diffuse reflectance for one incidence of [`reflectance_by_angle`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AngularReflectance {
+    /// cos θ of the incident beam above the surface.
+    pub mu_outside: f64,
+    /// cos θ of the refracted beam inside.
+    pub mu_inside: f64,
+    /// Totals per incident photon at this incidence (the specular part is F at this angle).
+    pub totals: SlabTotals,
+}
+
+impl AngularReflectance {
+    /// Diffuse reflectance per unit flux *entering* the skin at this incidence.
+    #[must_use]
+    pub fn per_entering(&self) -> f64 {
+        self.totals.diffuse_reflectance / (1.0 - self.totals.specular_reflectance)
+    }
+}
+
+/// A layered medium folded into the operators that give any column's totals.
+struct Folded {
+    eta: f64,
+    angles: Angles,
+    top: Operator,
+    /// The reflection under the top face (semi-infinite), or the whole slab's operator.
+    body: Body,
+}
+
+enum Body {
+    SemiInfinite(Mat),
+    Finite(Operator),
+}
+
+impl Folded {
+    /// Totals for a unit beam arriving along quadrature column `j` (paired with its outside direction).
+    fn totals(&self, j: usize) -> Result<SlabTotals, AddingDoublingError> {
+        let specular = self.top.r_down[(j, j)];
+        Ok(match &self.body {
+            Body::SemiInfinite(below) => SlabTotals {
+                diffuse_reflectance: escape_through_top(&self.top, below, j)?,
+                specular_reflectance: specular,
+                transmittance: 0.0,
+            },
+            Body::Finite(whole) => SlabTotals {
+                diffuse_reflectance: whole.r_down.column_sum(j) - specular,
+                specular_reflectance: specular,
+                transmittance: whole.t_down.column_sum(j),
+            },
+        })
+    }
+}
+
+fn fold(
+    medium: &LayeredMedium,
+    options: &AddingDoublingOptions,
+) -> Result<Folded, AddingDoublingError> {
     let eta = stack_index(medium)?;
     let angles = angles(medium, eta, options.quadrature_points);
     let n = angles.n();
-    let normal = n - 1; // μ = 1 is the last node of every rule.
     let top = layer::interface(&angles, eta, medium.n_above());
-    let specular = top.r_down[(normal, normal)];
 
     // Fold from the bottom up: a semi-infinite bottom needs reflection only.
     let mu_c = critical_cosine(medium, eta);
@@ -217,9 +307,7 @@ pub fn solve(
             Rc::new(build_layer(&angles, l)?)
         });
     }
-    let diffuse;
-    let transmittance;
-    if medium.is_semi_infinite() {
+    let body = if medium.is_semi_infinite() {
         let mut below = ops
             .pop()
             .map(|o| o.r_down.clone())
@@ -229,8 +317,7 @@ pub fn solve(
                 .reflect_over(&below)
                 .map_err(|_| AddingDoublingError::Singular("adding layers"))?;
         }
-        diffuse = escape_through_top(&top, &below, normal)?;
-        transmittance = 0.0;
+        Body::SemiInfinite(below)
     } else {
         let mut acc = layer::interface(&angles, eta, medium.n_below());
         while let Some(op) = ops.pop() {
@@ -238,32 +325,26 @@ pub fn solve(
                 .add(&acc)
                 .map_err(|_| AddingDoublingError::Singular("adding layers"))?;
         }
-        let whole = top
-            .add(&acc)
-            .map_err(|_| AddingDoublingError::Singular("adding the top surface"))?;
-        diffuse = whole.r_down.column_sum(normal) - specular;
-        transmittance = whole.t_down.column_sum(normal);
-    }
-    let totals = SlabTotals {
-        diffuse_reflectance: diffuse,
-        specular_reflectance: specular,
-        transmittance,
+        Body::Finite(
+            top.add(&acc)
+                .map_err(|_| AddingDoublingError::Singular("adding the top surface"))?,
+        )
     };
-    debug_assert!(totals.diffuse_reflectance.is_finite() && totals.transmittance.is_finite());
-    Ok(totals)
+    Ok(Folded {
+        eta,
+        angles,
+        top,
+        body,
+    })
 }
 
-/// Diffuse flux leaving through the top surface for a unit normally incident beam, given the reflection
-/// operator `below` of everything under the surface: T₁₀ (I − R_below R₁₀)⁻¹ R_below T₀₁ e_normal,
-/// computed for that one column only.
-fn escape_through_top(
-    top: &Operator,
-    below: &Mat,
-    normal: usize,
-) -> Result<f64, AddingDoublingError> {
+/// Diffuse flux leaving through the top surface for a unit beam along column `j` (μ = 1: normal
+/// incidence), given the reflection operator `below` of everything under the surface:
+/// T₁₀ (I − R_below R₁₀)⁻¹ R_below T₀₁ e_j, computed for that one column only.
+fn escape_through_top(top: &Operator, below: &Mat, j: usize) -> Result<f64, AddingDoublingError> {
     let n = below.n();
-    let entering = top.t_down[(normal, normal)];
-    let source: Vec<f64> = below.column(normal).iter().map(|v| v * entering).collect();
+    let entering = top.t_down[(j, j)];
+    let source: Vec<f64> = below.column(j).iter().map(|v| v * entering).collect();
     let lhs = below.mul(&top.r_up).identity_minus();
     let up = lhs
         .solve_vec(&source)

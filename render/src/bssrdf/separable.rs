@@ -16,9 +16,12 @@
 //! product form T(θ_o) T(θ_i) keeps S reciprocal. [`EnergySplit::Fresnel`] is kept as the paper's
 //! variant (both are normalised by their own c).
 
+use super::incidence::IncidenceGain;
+use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use brdf::TorranceSparrow;
 use brdf::fresnel::{dielectric_reflectance, fresnel_moment};
 use std::f32::consts::FRAC_1_PI;
+use std::sync::Arc;
 
 /// Which transmittance couples the subsurface term to the surface layer.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -33,13 +36,16 @@ pub enum EnergySplit {
 /// Nodes of the μ-midpoint rule for c (T is smooth; 1024 nodes are far below f32 noise).
 const NORMALISATION_NODES: usize = 1024;
 
-/// The directional part of the separable BSSRDF for one material: T(cos θ) and S_ω.
+/// The directional part of the separable BSSRDF for one material: T(cos θ), the incidence gain
+/// a(cos θ, λ) (docs/physics.md §8.1) and S_ω.
 #[derive(Debug, Clone)]
 pub struct Directional {
     split: EnergySplit,
     surface: TorranceSparrow,
     /// c = ∫₀¹ T(μ) 2μ dμ, dimensionless.
     c: f32,
+    /// a(μ, λ), and c(λ) = ∫₀¹ T(μ) a(μ, λ) 2μ dμ per row of it (None: a = 1).
+    incidence: Option<(Arc<IncidenceGain>, Vec<f32>)>,
 }
 
 impl Directional {
@@ -50,6 +56,7 @@ impl Directional {
             split,
             surface,
             c: 1.0,
+            incidence: None,
         };
         d.c = match split {
             // docs/physics.md §8: c = 1 − 2 F̄₁, F̄₁ from the brdf crate's Fresnel moments.
@@ -67,6 +74,31 @@ impl Directional {
             }
         };
         d
+    }
+
+    /// The same term with the incidence gain `gain` (docs/physics.md §8.1): the angular factor
+    /// becomes T(μ) a(μ, λ), normalised per wavelength.
+    #[must_use]
+    pub fn with_incidence(mut self, gain: Arc<IncidenceGain>) -> Self {
+        let n = NORMALISATION_NODES;
+        let c = (0..gain.wavelengths())
+            .map(|i| {
+                (0..n)
+                    .map(|k| {
+                        let mu = (k as f32 + 0.5) / n as f32;
+                        self.transmittance(mu) * gain.row_gain(i, mu) * 2.0 * mu / n as f32
+                    })
+                    .sum()
+            })
+            .collect();
+        self.incidence = Some((gain, c));
+        self
+    }
+
+    /// The incidence gain, if any.
+    #[must_use]
+    pub fn incidence(&self) -> Option<&IncidenceGain> {
+        self.incidence.as_ref().map(|(g, _)| g.as_ref())
     }
 
     /// The energy split in use.
@@ -96,16 +128,65 @@ impl Directional {
         }
     }
 
-    /// S_ω(ω) = T(cos θ) / (c π), sr⁻¹: the directional factor at the point where light enters.
+    /// The angular factor T(cos θ) a(cos θ, λ) at wavelength `nm` (T alone without a gain).
     #[must_use]
-    pub fn s_omega(&self, cos_theta: f32) -> f32 {
-        self.transmittance(cos_theta) * FRAC_1_PI / self.c
+    pub fn factor(&self, cos_theta: f32, nm: f32) -> f32 {
+        let t = self.transmittance(cos_theta);
+        match &self.incidence {
+            Some((gain, _)) if t > 0.0 => t * gain.gain(cos_theta.min(1.0), nm),
+            _ => t,
+        }
     }
 
-    /// The cosine-weighted continuation weight S_ω cos θ / (cos θ / π) = T(cos θ) / c.
+    /// The normalisation c(λ) = ∫₀¹ T(μ) a(μ, λ) 2μ dμ at `nm` ([`Self::normalisation`] without
+    /// a gain). Linear in λ between the gain's rows, as a is.
     #[must_use]
-    pub fn cosine_sample_weight(&self, cos_theta: f32) -> f32 {
-        self.transmittance(cos_theta) / self.c
+    pub fn normalisation_at(&self, nm: f32) -> f32 {
+        match &self.incidence {
+            Some((gain, c)) if c.len() > 1 => {
+                let (i, t) = gain.rows_at(nm);
+                c[i] + t * (c[i + 1] - c[i])
+            }
+            Some((_, c)) if c.len() == 1 => c[0],
+            _ => self.c,
+        }
+    }
+
+    /// S_ω(ω) = T(cos θ) a(cos θ, λ) / (c(λ) π), sr⁻¹, at `nm`: the directional factor at the
+    /// point where light enters.
+    #[must_use]
+    pub fn s_omega(&self, cos_theta: f32, nm: f32) -> f32 {
+        self.factor(cos_theta, nm) * FRAC_1_PI / self.normalisation_at(nm)
+    }
+
+    /// The cosine-weighted continuation weight S_ω cos θ / (cos θ / π) = T a / c at `nm`.
+    #[must_use]
+    pub fn cosine_sample_weight(&self, cos_theta: f32, nm: f32) -> f32 {
+        self.factor(cos_theta, nm) / self.normalisation_at(nm)
+    }
+
+    /// [`Self::factor`] at each of the path's wavelengths.
+    #[must_use]
+    pub fn factors(&self, cos_theta: f32, wl: &SampledWavelengths) -> SampledSpectrum {
+        SampledSpectrum(std::array::from_fn(|k| self.factor(cos_theta, wl.nm(k))))
+    }
+
+    /// [`Self::s_omega`] at each of the path's wavelengths.
+    #[must_use]
+    pub fn s_omegas(&self, cos_theta: f32, wl: &SampledWavelengths) -> SampledSpectrum {
+        SampledSpectrum(std::array::from_fn(|k| self.s_omega(cos_theta, wl.nm(k))))
+    }
+
+    /// [`Self::cosine_sample_weight`] at each of the path's wavelengths.
+    #[must_use]
+    pub fn cosine_sample_weights(
+        &self,
+        cos_theta: f32,
+        wl: &SampledWavelengths,
+    ) -> SampledSpectrum {
+        SampledSpectrum(std::array::from_fn(|k| {
+            self.cosine_sample_weight(cos_theta, wl.nm(k))
+        }))
     }
 }
 
@@ -141,7 +222,8 @@ mod tests {
             let s: f64 = (0..n)
                 .map(|i| {
                     let mu = (i as f64 + 0.5) / f64::from(n);
-                    f64::from(d.s_omega(mu as f32)) * mu * 2.0 * std::f64::consts::PI / f64::from(n)
+                    f64::from(d.s_omega(mu as f32, 550.0)) * mu * 2.0 * std::f64::consts::PI
+                        / f64::from(n)
                 })
                 .sum();
             assert!((s - 1.0).abs() < 1e-4, "{split:?}: ∫ S_ω cos dω = {s}");

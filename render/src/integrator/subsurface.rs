@@ -84,7 +84,7 @@ impl PathTracer<'_> {
         if !hit.take_sss {
             return Step::Surface;
         }
-        self.continue_from_exit(path, hit, ss, &exit, (beta_exit, lit_exit), sampler)
+        self.continue_from_exit(path, hit, ss, &exit, (beta_exit, lit_exit), (wl, sampler))
     }
 
     /// The subsurface branch was taken: continue from `exit` in a cosine-weighted direction
@@ -97,7 +97,7 @@ impl PathTracer<'_> {
         ss: &Subsurface,
         exit: &Exit,
         (beta_exit, lit_exit): (SampledSpectrum, bool),
-        sampler: &mut PathSampler,
+        (wl, sampler): (&SampledWavelengths, &mut PathSampler),
     ) -> Step {
         let (eng, ens) = (exit.ng, exit.ns);
         sampler.seek(dims::EXIT_CONTINUATION);
@@ -106,7 +106,7 @@ impl PathTracer<'_> {
         if local.z <= 0.0 || wi.dot(eng) <= 0.0 {
             return Step::Stop;
         }
-        path.beta = beta_exit * (ss.directional.cosine_sample_weight(local.z) / hit.q_sss);
+        path.beta = beta_exit * ss.directional.cosine_sample_weights(local.z, wl) / hit.q_sss;
         let vertex = (exit.p, ens, local.z * FRAC_1_PI);
         PrevVertex::record(
             &mut path.prev,
@@ -168,7 +168,7 @@ impl PathTracer<'_> {
             .hit
             .map_or(m_o, |h| skin.texture_factor(h.uv, &scene.textures));
         let m = texture_modulation(m_o, m_i);
-        let t_o = ss.directional.transmittance(hit.wo.dot(hit.ns));
+        let t_o = ss.directional.factors(hit.wo.dot(hit.ns), wl);
         let cap = SampledSpectrum(std::array::from_fn(|k| {
             m.min(1.0 / ss.table.total(wl.nm(k)).max(1e-6))
         }));
@@ -225,7 +225,7 @@ impl PathTracer<'_> {
                 |wi| {
                     let c = wi.dot(ens);
                     (
-                        SampledSpectrum::splat(ss.directional.s_omega(c) * c.max(0.0)),
+                        ss.directional.s_omegas(c, wl) * c.max(0.0),
                         c.max(0.0) * FRAC_1_PI,
                     )
                 },

@@ -8,7 +8,7 @@
 //! the Lambertian stand-in tabulates the same model's totals (`multipole::skin::total_reflectance`)
 //! on the same 10-nm grid.
 
-use crate::bssrdf::{Directional, EnergySplit, Subsurface};
+use crate::bssrdf::{Directional, EnergySplit, Incidence, IncidenceGain, Subsurface};
 use crate::fidelity::SKIN_TABLE_STEP_NM;
 use crate::fidelity::wavelengths::FROM_NM;
 use crate::material::{SurfaceKind, TextureRef};
@@ -43,6 +43,9 @@ pub struct SkinKnobs {
     pub phase_g: Option<f64>,
     /// The surface model (scene key `surface`; default oily).
     pub surface: SurfaceKind,
+    /// How the BSSRDF's angular factor treats oblique incidence (default the adding-doubling
+    /// gain, docs/physics.md §8.1).
+    pub incidence: Incidence,
 }
 
 /// Why a skin material could not be built.
@@ -134,7 +137,12 @@ impl SkinMaterial {
             SurfaceKind::Oily => EnergySplit::SpecularLobe,
             SurfaceKind::Smooth => EnergySplit::Fresnel,
         };
-        let directional = Directional::new(surface.clone(), split);
+        let directional = match knobs.incidence {
+            Incidence::Normal => Directional::new(surface.clone(), split),
+            Incidence::AddingDoubling => Directional::new(surface.clone(), split).with_incidence(
+                Arc::new(IncidenceGain::build(&params, g).map_err(SkinBuildError::Profiles)?),
+            ),
+        };
         let subsurface = Subsurface::new(Arc::new(table), directional);
         let mut skin = Self::new(params, surface, totals, albedo_texture, media)
             .with_surface_kind(knobs.surface)
