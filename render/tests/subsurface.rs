@@ -187,15 +187,16 @@ fn furnace(radius_mm: f32) -> render::scene::Scene {
         .load()
 }
 
-/// Image means of the surface lobe's albedo ρ_dr(θ_o) and of T(θ_o) = 1 − ρ_dr(θ_o) over the
-/// film: 4×4 points per pixel, each a camera ray against the scene's own mesh, θ_o from its
-/// shading normal.
-fn image_mean_albedo(scene: &render::scene::Scene, w: usize, h: usize) -> (f64, f64) {
+/// The image mean of the surface lobe's albedo ρ_dr(θ_o) over the film, and the exit cosines it
+/// was taken at: 4×4 points per pixel, each a camera ray against the scene's own mesh, θ_o from
+/// its shading normal.
+fn image_mean_albedo(scene: &render::scene::Scene, w: usize, h: usize) -> (f64, Vec<f32>) {
     let Material::Skin(skin) = &scene.materials[0] else {
         unreachable!("the furnace holds one skin")
     };
     let k = 4;
-    let (mut rho, mut t) = (0.0, 0.0);
+    let mut rho = 0.0;
+    let mut mus = Vec::with_capacity(w * h * k * k);
     for (py, px, j, i) in film_points(w, h, k) {
         let ndc = Vec2::new(
             (px as f32 + (i as f32 + 0.5) / k as f32) / w as f32,
@@ -209,10 +210,9 @@ fn image_mean_albedo(scene: &render::scene::Scene, w: usize, h: usize) -> (f64, 
         };
         let mu = (-d).dot(si.ns).clamp(0.0, 1.0);
         rho += f64::from(skin.surface.directional_albedo(mu));
-        t += f64::from(skin.surface.transmitted_fraction(mu));
+        mus.push(mu);
     }
-    let n = (w * h * k * k) as f64;
-    (rho / n, t / n)
+    (rho / mus.len() as f64, mus)
 }
 
 /// Every (row, column, sub-row, sub-column) of a `w`×`h` film with `k`×`k` points per pixel.
@@ -240,10 +240,11 @@ fn pixel_standard_error(film: &render::film::Film, mean: [f64; 3]) -> [f64; 3] {
 /// A closed sphere of skin in a white furnace renders to what the separable BSSRDF gives there,
 /// two-sided, and never outshines the environment.
 ///
-/// Each pixel sees ρ_dr(θ_o) of the environment off the surface lobe plus T(θ_o) R_tot through the
-/// skin: light leaving the sphere anywhere sees the whole uniform environment (the sphere is
-/// convex) and S_ω integrates to 1. So the image mean is ρ̄ E + T̄ R_tot (ρ̄, T̄ the image means of
-/// ρ_dr and T from the film's own rays, `image_mean_albedo`; E the environment):
+/// Each pixel sees ρ_dr(θ_o) of the environment off the surface lobe plus T(θ_o) a(θ_o) R_tot
+/// through the skin (a the incidence gain, docs/physics.md §8.1): light leaving the sphere
+/// anywhere sees the whole uniform environment (the sphere is convex) and S_ω integrates to 1. So
+/// the image mean is ρ̄ E + mean(T a) R_tot (ρ̄ and the mean of T a over the film's own rays,
+/// `image_mean_albedo`; E the environment):
 /// - radius 100 mm, far larger than the profiles' 99% radius (5 mm), where the probes find the
 ///   sphere as they find a plane: R_tot = `multipole::skin::total_reflectance`;
 /// - radius 2 mm, smaller than the profiles: the probes find the sphere's points at chord
@@ -273,7 +274,17 @@ fn skin_sphere_in_a_white_furnace_renders_the_separable_closed_form() {
     for radius in [100.0f32, 2.0] {
         let s = furnace(radius);
         let (w, h) = (24, 24);
-        let (rho, t) = image_mean_albedo(&s, w, h);
+        let (rho, mus) = image_mean_albedo(&s, w, h);
+        let Material::Skin(skin) = &s.materials[0] else {
+            unreachable!("the furnace holds one skin")
+        };
+        let dir = &skin.subsurface.as_ref().unwrap().directional;
+        let t = |nm: f64| {
+            mus.iter()
+                .map(|&mu| f64::from(dir.factor(mu, nm as f32)))
+                .sum::<f64>()
+                / mus.len() as f64
+        };
         let found = |nm: f64| {
             multipole::skin::total_reflectance(
                 &bloodless,
@@ -282,12 +293,12 @@ fn skin_sphere_in_a_white_furnace_renders_the_separable_closed_form() {
             )
             .unwrap()
         };
-        let body = xyz_of(|nm| found(nm) / y);
+        let body = xyz_of(|nm| t(nm) * found(nm) / y);
         let film = run(&s, w, h, 32, SEED);
         let got = mean_xyz(&film);
         let se = pixel_standard_error(&film, got);
         for c in 0..3 {
-            let want = rho * env[c] + t * body[c];
+            let want = rho * env[c] + body[c];
             assert!(
                 (got[c] - want).abs() <= 4.0 * se[c] + 2e-3 * want,
                 "radius {radius}: channel {c}: {got:?} vs {want} (± {})",
