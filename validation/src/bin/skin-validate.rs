@@ -157,6 +157,10 @@ struct RenderStudyArgs {
     /// Worker threads of every render, [1, 1024] (default: all cores).
     #[arg(long, value_name = "N", value_parser = Checked(parse_threads))]
     threads: Option<u32>,
+    /// Only the error-against-time charts (thin slab, ear, sphere; BSSRDF, default configuration,
+    /// volumetric), no case table; with --only, the chart cases whose label contains the text.
+    #[arg(long)]
+    charts: bool,
 }
 
 fn parse_case_spp(s: &str) -> Result<(String, u32), String> {
@@ -461,6 +465,7 @@ fn main() {
                 reference_spp_for: args.reference_spp.clone(),
                 reference_cache: args.reference_cache.clone(),
                 threads: args.threads.map(|t| t as usize),
+                charts_only: args.charts,
             };
             run_render(study, &run, &args.out).map(|md| println!("{md}"))
         }

@@ -14,9 +14,12 @@
 //! then the BSSRDF's totals (adding-doubling under a Fresnel boundary) and the walk's boundary are
 //! the same physics, and what differs is geometry (docs/physics.md §15).
 //!
-//! The error-against-time chart renders one case (the sphere, light skin) with both integrators at
-//! increasing spp, each image's RMS relative error taken against a separate volumetric run at the
-//! largest count, CPU seconds of the process on the x axis.
+//! The error-against-time charts render the cases where a method fails (the 2-mm backlit slab,
+//! the backlit ear, the 5-mm sphere under a sky; light skin) with the BSSRDF alone, the default
+//! configuration (whatever `skin render` does with the scene, thin-part walks included) and the
+//! volumetric walk at increasing spp, each image's RMS relative error and region error taken
+//! against a separate volumetric run at 4× the largest count, CPU seconds of the process on the x
+//! axis (`--charts` renders only these).
 //!
 //! `timed` builds its `RenderOptions` like `render`'s test helper `tests/common::run` does: a
 //! library crate cannot use another crate's test scaffolding, and here the CPU time is measured
@@ -83,6 +86,9 @@ pub struct StudyRun {
     pub reference_cache: Option<PathBuf>,
     /// Worker threads of every render (None = all cores).
     pub threads: Option<usize>,
+    /// Only the error-against-time charts (of the chart cases `only` selects, every one when
+    /// empty), no case table.
+    pub charts_only: bool,
 }
 
 impl StudyRun {
@@ -107,12 +113,65 @@ struct Case {
     height: usize,
     /// The built-in ear or head (sampled at `builtin_reference_spp`).
     builtin: bool,
+    /// The region error above which (and above 3σ) the BSSRDF fails the case.
+    tolerance: f64,
 }
+
+/// Region error above which (and above 3σ) the BSSRDF fails a case.
+const TOLERANCE: f64 = 0.05;
+
+/// The stricter verdict of the curved cases: the BSSRDF within 2% of the walk on a sphere.
+const SPHERE_TOLERANCE: f64 = 0.02;
 
 const TONES: [&str; 3] = ["light", "medium", "dark"];
 
-/// The analytic cases: a flat slab (central quarter of the view, away from the edges), a 10-mm
-/// sphere, and 1-, 2- and 3-mm slabs lit from behind; each skin tone.
+/// Radii of the curved cases, mm: around and below the profiles' reach (r₉₉ 2–5 mm), where the
+/// planar BSSRDF meets curvature (docs/physics.md §8.1).
+const SPHERE_RADII_MM: [f32; 3] = [5.0, 10.0, 20.0];
+
+/// How a sphere case is lit.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum SphereLight {
+    /// A uniform D65 sky of luminance 1.
+    Sky,
+    /// A sphere lamp 42° off the view axis (8.6° across) over a dim sky (0.02).
+    Lamp,
+}
+
+impl SphereLight {
+    const ALL: [Self; 2] = [Self::Sky, Self::Lamp];
+
+    fn label(self) -> &'static str {
+        match self {
+            Self::Sky => "sky",
+            Self::Lamp => "lamp",
+        }
+    }
+}
+
+/// A sphere of `radius_mm` filling 80% of the view, with the skin material `skin`, lit by `light`.
+fn sphere_toml(skin: &str, radius_mm: f32, light: SphereLight) -> String {
+    let lights = match light {
+        SphereLight::Sky => "[environment]\nspectrum = \"d65\"\nintensity = 1\n".to_string(),
+        SphereLight::Lamp => format!(
+            "[environment]\nspectrum = \"d65\"\nintensity = 0.02\n\
+             [[lights]]\ntype = \"sphere\"\ncenter_mm = [{x}, {y}, {z}]\nradius_mm = {lr}\nintensity = 12\n",
+            x = 24.0 * radius_mm,
+            y = 12.0 * radius_mm,
+            z = 30.0 * radius_mm,
+            lr = 3.0 * radius_mm,
+        ),
+    };
+    format!(
+        "[camera]\nposition_mm = [0, 0, {d}]\nlook_at_mm = [0, 0, 0]\nfov_deg = 11\n\
+         {lights}{skin}[[meshes]]\nshape = \"sphere\"\nmaterial = \"skin\"\nunits_mm = {radius_mm}\n",
+        d = 12.0 * radius_mm
+    )
+}
+
+/// The analytic cases: a flat slab (central quarter of the view, away from the edges), spheres of
+/// 5, 10 and 20 mm under a uniform sky and under a lamp, and 1-, 2- and 3-mm slabs lit from
+/// behind; each skin tone.
 fn analytic_cases(side: usize, dir: &Path) -> anyhow::Result<Vec<Case>> {
     let slab = dir.join("slab.obj");
     std::fs::write(&slab, box_obj([100.0, 100.0, 20.0]))?;
@@ -130,13 +189,18 @@ fn analytic_cases(side: usize, dir: &Path) -> anyhow::Result<Vec<Case>> {
             slab.display()
         );
         cases.push(case("slab", tone, slab_toml, side));
-        let sphere = format!(
-            "[camera]\nposition_mm = [0, 0, 120]\nlook_at_mm = [0, 0, 0]\nfov_deg = 11\n\
-             [environment]\nspectrum = \"d65\"\nintensity = 0.2\n{skin}\
-             [[meshes]]\nshape = \"sphere\"\nmaterial = \"skin\"\nunits_mm = 10\n\
-             [[lights]]\ntype = \"sphere\"\ncenter_mm = [120, 60, 80]\nradius_mm = 30\nintensity = 12\n"
-        );
-        cases.push(case("sphere r=10 mm", tone, sphere, side));
+        for r in SPHERE_RADII_MM {
+            for light in SphereLight::ALL {
+                let mut c = case(
+                    &format!("sphere r={r} mm, {}", light.label()),
+                    tone,
+                    sphere_toml(&skin, r, light),
+                    side,
+                );
+                c.tolerance = SPHERE_TOLERANCE;
+                cases.push(c);
+            }
+        }
         for mm in [1.0f32, 2.0, 3.0] {
             let file = dir.join(format!("thin{mm}.obj"));
             std::fs::write(&file, box_obj([60.0, 60.0, mm]))?;
@@ -168,6 +232,7 @@ fn case(name: &str, tone: &'static str, toml: String, side: usize) -> Case {
         width: side,
         height: side,
         builtin: false,
+        tolerance: TOLERANCE,
     }
 }
 
@@ -183,6 +248,7 @@ fn builtin_cases(side: usize) -> Vec<Case> {
             width: 2 * side,
             height: 2 * side,
             builtin: true,
+            tolerance: TOLERANCE,
         })
         .collect();
     cases.push(Case {
@@ -192,6 +258,7 @@ fn builtin_cases(side: usize) -> Vec<Case> {
         width: 4 * side,
         height: 2 * side,
         builtin: true,
+        tolerance: TOLERANCE,
     });
     cases
 }
@@ -320,9 +387,48 @@ struct Loaded {
     body: BodyIntegrator,
 }
 
+/// How skin's body is rendered in a run of the study.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Config {
+    /// The BSSRDF at every hit (no volumetric walk at thin parts).
+    BssrdfOnly,
+    /// What `skin render` does with the scene as written (the default knobs).
+    Default,
+    /// The volumetric walk at every hit (the reference).
+    Volumetric,
+}
+
+impl Config {
+    const ALL: [Self; 3] = [Self::BssrdfOnly, Self::Default, Self::Volumetric];
+
+    fn label(self) -> &'static str {
+        match self {
+            Self::BssrdfOnly => "BSSRDF",
+            Self::Default => "default",
+            Self::Volumetric => "volumetric",
+        }
+    }
+}
+
 fn load(toml: &str, volumetric: bool) -> anyhow::Result<Loaded> {
-    let scene = Scene::from_toml(toml, "study.toml", None, &SkinKnobs::default())?;
-    let kind = if volumetric {
+    load_as(
+        toml,
+        if volumetric {
+            Config::Volumetric
+        } else {
+            Config::Default
+        },
+    )
+}
+
+fn load_as(toml: &str, config: Config) -> anyhow::Result<Loaded> {
+    let mut knobs = SkinKnobs::default();
+    if config == Config::BssrdfOnly {
+        // A thin-walk length of 0 never walks (the BSSRDF at every hit), whatever the default.
+        knobs.fidelity.thin_walk_r99 = Some(0.0);
+    }
+    let scene = Scene::from_toml(toml, "study.toml", None, &knobs)?;
+    let kind = if config == Config::Volumetric {
         IntegratorKind::Volumetric
     } else {
         IntegratorKind::Bssrdf
@@ -432,8 +538,8 @@ fn heat(title: &str, film: &Film, map: Vec<f64>) -> Panel {
     })
 }
 
-/// Run the study into `out`: error maps, `render_cases.csv`, `render_time.csv`, `render_time.png`
-/// and `render.md` (the table).
+/// Run the study into `out`: error maps, `render_cases.csv`, per chart case
+/// `render_time_<case>.csv` and `.png`, and `render.md` (the table and the charts' lines).
 pub fn run_render(study: RenderStudy, run: &StudyRun, out: &Path) -> anyhow::Result<String> {
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let meshes = tempfile::tempdir()?;
@@ -447,14 +553,11 @@ pub fn run_render(study: RenderStudy, run: &StudyRun, out: &Path) -> anyhow::Res
         "| case | tone | volumetric spp | pixels | mean error | mean abs error | noise (1σ) | BSSRDF fails? | CPU s (BSSRDF / volumetric) |\n|---|---|---|---|---|---|---|---|---|\n",
     );
     let mut chart = String::new();
-    let skip_chart = !run.only.is_empty();
+    let skip_chart = !run.only.is_empty() && !run.charts_only;
     for (k, c) in cases.iter().enumerate() {
         let label = format!("{} ({})", c.name, c.tone);
-        if !run.wants(&label) {
+        if run.charts_only || !run.wants(&label) {
             continue;
-        }
-        if c.builtin && chart.is_empty() && !skip_chart {
-            chart = time_chart(study, &cases[1], run.threads, out)?;
         }
         log::info!("[{}/{}] {label}", k + 1, cases.len());
         let bssrdf = load(&c.toml, false)?;
@@ -471,7 +574,7 @@ pub fn run_render(study: RenderStudy, run: &StudyRun, out: &Path) -> anyhow::Res
         let pixels = compared_pixels(&pilot, &skin);
         let map = error_map(&test, &reference, &pixels);
         let r = measure(&test, &reference, &pixels, &map);
-        let fails = r.mean_signed.abs() > 0.05 && r.mean_signed.abs() > 3.0 * r.noise;
+        let fails = r.mean_signed.abs() > c.tolerance && r.mean_signed.abs() > 3.0 * r.noise;
         let stem = stem(c);
         let title = format!("{} ({}): BSSRDF vs volumetric", c.name, c.tone);
         save_png(
@@ -502,11 +605,32 @@ pub fn run_render(study: RenderStudy, run: &StudyRun, out: &Path) -> anyhow::Res
         skin_io::atomic::write_bytes(&out.join("render_cases.csv"), csv.as_bytes())?;
         write_md(study, out, &table, &chart)?;
     }
-    if chart.is_empty() && !skip_chart {
-        chart = time_chart(study, &cases[1], run.threads, out)?;
+    if !skip_chart {
+        for label in CHART_CASES {
+            let Some(c) = cases
+                .iter()
+                .find(|c| format!("{} ({})", c.name, c.tone) == label)
+            else {
+                anyhow::bail!("no case {label}");
+            };
+            if !run.wants(label) {
+                continue;
+            }
+            log::info!("error against time: {label}");
+            chart.push_str(&time_chart(study, c, run, out)?);
+            write_md(study, out, &table, &chart)?;
+        }
     }
     write_md(study, out, &table, &chart)
 }
+
+/// The cases of the error-against-time charts: where a method fails (a thin backlit slab, the
+/// backlit ear, a small sphere).
+const CHART_CASES: [&str; 3] = [
+    "thin slab 2 mm (backlit) (light)",
+    "backlit ear (light)",
+    "sphere r=5 mm, sky (light)",
+];
 
 /// Write `render.md` (the case table so far and the chart's lines); returns its text.
 fn write_md(study: RenderStudy, out: &Path, table: &str, chart: &str) -> anyhow::Result<String> {
@@ -525,55 +649,76 @@ fn rms_error(test: &Film, reference: &Film, pixels: &[usize]) -> f64 {
     (pixels.iter().map(|&i| map[i] * map[i]).sum::<f64>() / n).sqrt()
 }
 
-/// Error against CPU time for both integrators on `case`; returns the markdown lines.
+/// Error against CPU time on `case` for each [`Config`]: every image's RMS relative error and
+/// region error against a volumetric run at 4× the ladder's top spp (another seed), CPU seconds of
+/// the process on the x axis; `render_time_<case>.csv` and `.png`. Returns the markdown lines.
 fn time_chart(
     study: RenderStudy,
     case: &Case,
-    threads: Option<usize>,
+    run: &StudyRun,
     out: &Path,
 ) -> anyhow::Result<String> {
     let top = *study.ladder.last().unwrap_or(&16);
-    let vol = load(&case.toml, true)?;
-    let bssrdf = load(&case.toml, false)?;
-    let (reference, t_ref) = timed(&vol, case.width, case.height, 4 * top, 99, threads)?;
-    let (pilot, _) = timed(
-        &bssrdf,
-        case.width,
-        case.height,
-        study.bssrdf_spp,
-        3,
-        threads,
-    )?;
-    let skin = Passes::first_hit(&bssrdf.scene, case.width, case.height).skin;
+    let threads = run.threads;
+    let (w, h) = (case.width, case.height);
+    let vol = load_as(&case.toml, Config::Volumetric)?;
+    let (reference, t_ref) = timed(&vol, w, h, 4 * top, 99, threads)?;
+    let default = load_as(&case.toml, Config::Default)?;
+    let (pilot, _) = timed(&default, w, h, study.bssrdf_spp, 3, threads)?;
+    let skin = Passes::first_hit(&default.scene, w, h).skin;
     let pixels = compared_pixels(&pilot, &skin);
-    let mut csv = String::from("integrator,spp,cpu_s,rms_relative_error,paths_per_cpu_s\n");
+    let stem = stem(case);
+    let mut csv = String::from(
+        "configuration,spp,cpu_s,rms_relative_error,region_error,region_noise,paths_per_cpu_s\n",
+    );
     let mut lines = format!(
-        "Error against time ({} {}, reference: volumetric at {} spp, {:.1} CPU s):\n\n| integrator | spp | CPU s | RMS rel. error | camera paths per CPU-s |\n|---|---|---|---|---|\n",
+        "Error against time, {} ({}) (reference: volumetric at {} spp, {:.1} CPU s; `render_time_{stem}.png`):\n\n\
+         | configuration | spp | CPU s | RMS rel. error | region error | noise (1σ) | camera paths per CPU-s |\n|---|---|---|---|---|---|---|\n",
         case.name,
         case.tone,
         4 * top,
         t_ref
     );
     let mut series = Vec::new();
-    for (name, scene) in [("BSSRDF", &bssrdf), ("volumetric", &vol)] {
+    for config in Config::ALL {
+        let loaded = if config == Config::Volumetric {
+            &vol
+        } else if config == Config::Default {
+            &default
+        } else {
+            &load_as(&case.toml, config)?
+        };
         let mut pts = Vec::new();
         for &spp in study.ladder {
-            let (film, t) = timed(scene, case.width, case.height, spp, 7, threads)?;
+            let (film, t) = timed(loaded, w, h, spp, 7, threads)?;
             let e = rms_error(&film, &reference, &pixels);
-            let paths = (case.width * case.height) as f64 * f64::from(spp) / t.max(1e-9);
-            let _ = writeln!(csv, "{name},{spp},{t:.3},{e:.5},{paths:.0}");
+            let map = error_map(&film, &reference, &pixels);
+            let r = measure(&film, &reference, &pixels, &map);
+            let paths = (w * h) as f64 * f64::from(spp) / t.max(1e-9);
+            let name = config.label();
+            let _ = writeln!(
+                csv,
+                "{name},{spp},{t:.3},{e:.5},{:.5},{:.5},{paths:.0}",
+                r.mean_signed, r.noise
+            );
             let _ = writeln!(
                 lines,
-                "| {name} | {spp} | {t:.2} | {:.1}% | {paths:.0} |",
-                100.0 * e
+                "| {name} | {spp} | {t:.2} | {:.1}% | {:+.1}% | {:.1}% | {paths:.0} |",
+                100.0 * e,
+                100.0 * r.mean_signed,
+                100.0 * r.noise
             );
             pts.push((t, e));
         }
-        series.push(Series::line(name, pts).with_style(SeriesStyle::LinePoints));
+        series.push(Series::line(config.label(), pts).with_style(SeriesStyle::LinePoints));
     }
-    skin_io::atomic::write_bytes(&out.join("render_time.csv"), csv.as_bytes())?;
+    lines.push('\n');
+    skin_io::atomic::write_bytes(&out.join(format!("render_time_{stem}.csv")), csv.as_bytes())?;
     let mut chart = LineChart::new(
-        "Image error against render time",
+        &format!(
+            "{} ({}): image error against render time",
+            case.name, case.tone
+        ),
         "CPU seconds",
         "RMS relative luminance error",
     )
@@ -582,8 +727,12 @@ fn time_chart(
     for s in series {
         chart = chart.with_series(s);
     }
-    let png = out.join("render_time.png");
-    save_png(&png, &[Panel::Line(chart)], 900, 600)?;
+    save_png(
+        &out.join(format!("render_time_{stem}.png")),
+        &[Panel::Line(chart)],
+        900,
+        600,
+    )?;
     Ok(lines)
 }
 

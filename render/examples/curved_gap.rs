@@ -1,0 +1,209 @@
+//! Scratch: BSSRDF vs volumetric on tilted slabs and spheres, one wavelength, uniform sky.
+use glam::Vec2;
+use render::film::Film;
+use render::integrator::{BodyIntegrator, IntegratorKind};
+use render::material::SkinKnobs;
+use render::renderer::{RenderOptions, render_with};
+use render::scene::{Hit, Scene};
+use render::volumetric::shapes::box_obj;
+
+fn region(scene: &Scene, side: usize, keep: impl Fn(glam::Vec3) -> bool) -> Vec<usize> {
+    (0..side * side)
+        .filter(|&i| {
+            let (x, y) = (i % side, i / side);
+            let ndc = Vec2::new((x as f32 + 0.5) / side as f32, (y as f32 + 0.5) / side as f32);
+            let (o, d) = scene.camera.generate_ray(ndc, 1.0, Vec2::ZERO);
+            matches!(scene.intersect(o, d, 0.0, f32::INFINITY), Some(Hit::Surface(si)) if keep(si.p))
+        })
+        .collect()
+}
+
+fn mean(film: &Film, px: &[usize], side: usize) -> (f64, f64) {
+    let (mut s, mut v) = (0.0, 0.0);
+    for &i in px {
+        s += f64::from(film.xyz(i % side, i / side)[1]);
+        v += film.variance(i % side, i / side);
+    }
+    let n = px.len() as f64;
+    (s / n, v.sqrt() / n)
+}
+
+fn knobs() -> SkinKnobs {
+    SkinKnobs {
+        incidence: if std::env::var("INC").is_ok_and(|v| v == "normal") {
+            render::bssrdf::Incidence::Normal
+        } else {
+            render::bssrdf::Incidence::AddingDoubling
+        },
+        ..SkinKnobs::default()
+    }
+}
+
+/// Volumetric film cached on disk by key (the walk does not depend on the BSSRDF's knobs).
+fn vol(scene: &Scene, side: usize, spp: u32, nm: f32, key: &str) -> Film {
+    let f = format!("/tmp/cg/vol-{key}-{side}-{spp}-{nm}.txt");
+    if let Ok(t) = std::fs::read_to_string(&f) {
+        let v: Vec<f64> = t.split_whitespace().map(|x| x.parse().unwrap()).collect();
+        let means = (0..side * side).map(|i| [v[2 * i]; 3]).collect();
+        let var = (0..side * side).map(|i| v[2 * i + 1]).collect();
+        return Film::from_means(side, side, means, var, spp);
+    }
+    let film = run(scene, IntegratorKind::Volumetric, side, spp, nm);
+    let mut t = String::new();
+    for i in 0..side * side {
+        t += &format!(
+            "{:e} {:e}\n",
+            film.xyz(i % side, i / side)[1],
+            film.variance(i % side, i / side)
+        );
+    }
+    std::fs::write(&f, t).unwrap();
+    film
+}
+
+fn run(scene: &Scene, kind: IntegratorKind, side: usize, spp: u32, nm: f32) -> Film {
+    let body = BodyIntegrator::build(scene, kind).unwrap();
+    let opts = RenderOptions {
+        width: side,
+        height: side,
+        spp,
+        seed: 1,
+        wavelength_nm: Some(nm),
+        ..Default::default()
+    };
+    render_with(scene, &body, &opts.validate().unwrap(), None)
+        .unwrap()
+        .0
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let what = args.get(1).map_or("slab", String::as_str);
+    let spp: u32 = args.get(2).map_or(64, |s| s.parse().unwrap());
+    let vspp: u32 = args.get(3).map_or(64, |s| s.parse().unwrap());
+    let skin = std::env::var("SKIN")
+        .unwrap_or("melanin = 0.05\neumelanin = 0.7\nhemoglobin = 0.02".into());
+    let keys = format!("{skin}\nsurface = \"smooth\"\nphase_g = 0");
+    let dir = tempfile::tempdir().unwrap();
+    let nms: Vec<f32> = std::env::var("NM")
+        .unwrap_or("450,550,650".into())
+        .split(',')
+        .map(|s| s.parse().unwrap())
+        .collect();
+    if what == "angles" {
+        use multipole::exact::adding_doubling::{AddingDoublingOptions, reflectance_by_angle};
+        let params = skin_optics::SkinParams::new(0.05, 0.7, 0.02, 0.25).unwrap();
+        let g: f64 = std::env::var("G").map_or(0.0, |s| s.parse().unwrap());
+        for &nm in &nms {
+            let m = multipole::LayeredMedium::skin(
+                &params,
+                skin_optics::Wavelength::new(f64::from(nm)).unwrap(),
+                g,
+            )
+            .unwrap();
+            let rows =
+                reflectance_by_angle(&m, &AddingDoublingOptions::new(24, g).unwrap()).unwrap();
+            let r1 = rows.last().unwrap().per_entering();
+            for r in &rows {
+                println!(
+                    "{nm} mu_out {:.3} (θ {:.1}°) F {:.4} Rd/entering {:.5} ratio {:.4}",
+                    r.mu_outside,
+                    r.mu_outside.acos().to_degrees(),
+                    r.totals.specular_reflectance,
+                    r.per_entering(),
+                    r.per_entering() / r1
+                );
+            }
+        }
+        return;
+    }
+    if what == "slab" {
+        std::fs::write(dir.path().join("box.obj"), box_obj([200.0, 200.0, 40.0])).unwrap();
+        for tilt in [0.0f32, 30.0, 50.0, 64.0] {
+            let text = format!(
+                "[camera]\nposition_mm = [0, 0, 400]\nlook_at_mm = [0, 0, 0]\nfov_deg = 1\n\
+                 [environment]\nspectral_radiance = 1\n\
+                 [materials.skin]\ntype = \"skin\"\n{keys}\n\
+                 [[meshes]]\nfile = \"box.obj\"\nmaterial = \"skin\"\nrotate_deg = [{tilt}, 0, 0]\n"
+            );
+            let scene = Scene::from_toml(&text, "box.toml", Some(dir.path()), &knobs()).unwrap();
+            let side = 4;
+            let px: Vec<usize> = (0..side * side).collect();
+            for &nm in &nms {
+                let b = mean(
+                    &run(&scene, IntegratorKind::Bssrdf, side, spp, nm),
+                    &px,
+                    side,
+                );
+                let v = mean(
+                    &vol(&scene, side, vspp, nm, &format!("slab{tilt}{}", skin.len())),
+                    &px,
+                    side,
+                );
+                println!(
+                    "slab tilt {tilt} nm {nm}: bssrdf {:.5}±{:.5} vol {:.5}±{:.5} gap {:+.2}% ± {:.2}",
+                    b.0,
+                    b.1,
+                    v.0,
+                    v.1,
+                    100.0 * (b.0 / v.0 - 1.0),
+                    100.0 * (b.1.hypot(v.1)) / v.0
+                );
+            }
+        }
+    } else {
+        let r: f32 = what.parse().unwrap();
+        let text = format!(
+            "[camera]\nposition_mm = [0, 0, {}]\nlook_at_mm = [0, 0, 0]\nfov_deg = 11\n\
+             {}[materials.skin]\ntype = \"skin\"\n{keys}\n\
+             [[meshes]]\nshape = \"sphere\"\nmaterial = \"skin\"\nunits_mm = {r}\n{}",
+            12.0 * r,
+            if std::env::var("LIGHT").is_ok_and(|v| !v.is_empty()) {
+                ""
+            } else {
+                "[environment]\nspectral_radiance = 1\n"
+            },
+            if std::env::var("LIGHT").is_ok_and(|v| !v.is_empty()) {
+                "[[lights]]\ntype = \"sphere\"\ncenter_mm = [300, 150, 300]\nradius_mm = 60\nintensity = 20\n"
+            } else {
+                ""
+            }
+        );
+        let scene = Scene::from_toml(&text, "s.toml", None, &knobs()).unwrap();
+        let side = 24;
+        let rings: Vec<(f32, f32)> =
+            vec![(0.0, 0.9), (0.0, 0.3), (0.3, 0.6), (0.6, 0.8), (0.8, 0.9)];
+        for &nm in &nms {
+            let bf = run(&scene, IntegratorKind::Bssrdf, side, spp, nm);
+            let vf = vol(
+                &scene,
+                side,
+                vspp,
+                nm,
+                &format!(
+                    "sphere{r}-{}-{}",
+                    skin.replace(['\n', ' ', '"', '='], ""),
+                    std::env::var("LIGHT").is_ok_and(|v| !v.is_empty())
+                ),
+            );
+            for &(a, b) in &rings {
+                let px = region(&scene, side, |p| {
+                    let q = p.truncate().length() / r;
+                    q >= a && q < b
+                });
+                let bm = mean(&bf, &px, side);
+                let vm = mean(&vf, &px, side);
+                println!(
+                    "sphere r {r} nm {nm} ring {a}-{b} ({} px): bssrdf {:.5}±{:.5} vol {:.5}±{:.5} gap {:+.2}% ± {:.2}",
+                    px.len(),
+                    bm.0,
+                    bm.1,
+                    vm.0,
+                    vm.1,
+                    100.0 * (bm.0 / vm.0 - 1.0),
+                    100.0 * (bm.1.hypot(vm.1)) / vm.0
+                );
+            }
+        }
+    }
+}
