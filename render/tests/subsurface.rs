@@ -44,7 +44,8 @@ fn slab_closed_form(preset: &str, wi: Vec3, wo: Vec3) -> [f64; 3] {
         skin.eta() as f32,
     )
     .unwrap();
-    let gain = IncidenceGain::build(&skin, multipole::DEFAULT_G).unwrap();
+    let media = render::media::SkinMedia::new(&skin, multipole::DEFAULT_G).unwrap();
+    let gain = IncidenceGain::build(media.every_10nm(), multipole::DEFAULT_G).unwrap();
     let dir = Directional::new(ts.clone(), EnergySplit::default()).with_incidence(Arc::new(gain));
     let cos_i = f64::from(wi.z);
     let specular = f64::from(ts.eval(wo, wi));
@@ -451,9 +452,8 @@ fn sphere_under_a_sky_matches_the_volumetric_walk() {
         .with("[[meshes]]\nshape = \"sphere\"\nmaterial = \"skin\"\nunits_mm = 10")
         .load();
     for nm in [450.0, 550.0] {
-        let (g, se) = against_the_walk::gap(&scene, 16, (128, 1024), nm, |p| {
-            p.truncate().length() < 9.0
-        });
+        let (g, se) =
+            against_the_walk::gap(&scene, 16, (128, 1024), nm, |p| p.truncate().length() < 9.0);
         assert!(
             g.abs() <= 0.01 + 3.0 * se,
             "{nm} nm: BSSRDF / walk − 1 = {g:+.4} ± {se:.4}"

@@ -3,16 +3,20 @@
 //! gain a(μ, λ) = R_d(μ, λ) / R_d(1, λ), R_d(μ) the diffuse reflectance per unit flux entering
 //! from a collimated beam at incidence cosine μ (outside), comes from adding-doubling's reflection
 //! operator (`multipole::exact::adding_doubling::reflectance_by_angle`, §10) at the skin's own
-//! parameters and g, tabulated every [`SKIN_TABLE_STEP_NM`] nm at the quadrature's angles.
+//! parameters and g, tabulated every [`INCIDENCE_STEP_NM`] nm at the quadrature's angles.
 
-use crate::fidelity::SKIN_TABLE_STEP_NM;
-use crate::fidelity::wavelengths::{FROM_NM, TO_NM};
-use multipole::MultipoleError;
+use crate::spectrum::{LAMBDA_MAX_NM, LAMBDA_MIN_NM};
 use multipole::exact::adding_doubling::{
     AddingDoublingOptions, DEFAULT_QUADRATURE_POINTS, reflectance_by_angle,
 };
+use multipole::{LayeredMedium, MultipoleError};
 use rayon::prelude::*;
-use skin_optics::{SkinParams, Wavelength};
+
+/// Wavelength step of the gain's rows, nm (the skin tables' 10 nm), interpolated linearly.
+pub const INCIDENCE_STEP_NM: f64 = 10.0;
+
+const FROM_NM: f64 = LAMBDA_MIN_NM as f64;
+const TO_NM: f64 = LAMBDA_MAX_NM as f64;
 
 /// How the separable BSSRDF's angular factor treats the incidence (the knob of §8.1).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -26,7 +30,7 @@ pub enum Incidence {
     AddingDoubling,
 }
 
-/// a(μ, λ) of one skin: rows every [`SKIN_TABLE_STEP_NM`] nm from 380 nm, columns at the
+/// a(μ, λ) of one skin: rows every [`INCIDENCE_STEP_NM`] nm from 380 nm, columns at the
 /// outside cosines of the adding-doubling quadrature (ascending, the last 1).
 #[derive(Debug, Clone, PartialEq)]
 pub struct IncidenceGain {
@@ -35,19 +39,32 @@ pub struct IncidenceGain {
 }
 
 impl IncidenceGain {
-    /// The gain of `params` at HG anisotropy `g`, one adding-doubling solve per tabulated
-    /// wavelength (in parallel).
-    pub fn build(params: &SkinParams, g: f64) -> Result<Self, MultipoleError> {
-        let n = ((TO_NM - FROM_NM) / SKIN_TABLE_STEP_NM) as usize + 1;
+    /// The gain of the skin layers `rows` (each wavelength, nm, from 380 nm every
+    /// [`INCIDENCE_STEP_NM`] nm with its layered medium, as `media::SkinMedia::every_10nm` lists
+    /// them) at HG anisotropy `g`: one adding-doubling solve per row, in parallel.
+    pub fn build<'m>(
+        rows: impl Iterator<Item = (f64, &'m LayeredMedium)>,
+        g: f64,
+    ) -> Result<Self, MultipoleError> {
         let options = AddingDoublingOptions::new(DEFAULT_QUADRATURE_POINTS, g)?;
-        let solved = (0..n)
+        let rows: Vec<(f64, &LayeredMedium)> = rows.collect();
+        let expected = ((TO_NM - FROM_NM) / INCIDENCE_STEP_NM) as usize + 1;
+        if rows.len() != expected
+            || rows
+                .iter()
+                .enumerate()
+                .any(|(i, (nm, _))| (nm - (FROM_NM + INCIDENCE_STEP_NM * i as f64)).abs() > 1e-9)
+        {
+            return Err(MultipoleError::InvalidOption {
+                name: "incidence gain rows",
+                value: rows.len() as f64,
+                range: "380–780 nm every 10 nm",
+            });
+        }
+        let solved = rows
             .into_par_iter()
-            .map(|i| {
-                let nm = FROM_NM + SKIN_TABLE_STEP_NM * i as f64;
-                let medium = multipole::LayeredMedium::skin(params, Wavelength::new(nm)?, g)?;
-                Ok(reflectance_by_angle(&medium, &options)?)
-            })
-            .collect::<Result<Vec<_>, MultipoleError>>()?;
+            .map(|(_, medium)| reflectance_by_angle(medium, &options))
+            .collect::<Result<Vec<_>, _>>()?;
         let mu = solved[0].iter().map(|r| r.mu_outside as f32).collect();
         let rows = solved
             .iter()
@@ -74,7 +91,7 @@ impl IncidenceGain {
     /// The wavelength of row `i`, nm.
     #[must_use]
     pub fn row_nm(i: usize) -> f32 {
-        (FROM_NM + SKIN_TABLE_STEP_NM * i as f64) as f32
+        (FROM_NM + INCIDENCE_STEP_NM * i as f64) as f32
     }
 
     /// a(μ) of row `i`, linear in μ between the quadrature's angles and held at the grazing-most
@@ -97,7 +114,7 @@ impl IncidenceGain {
     /// The row index and weight of the next row for wavelength `nm` (linear in λ).
     #[must_use]
     pub fn rows_at(&self, nm: f32) -> (usize, f32) {
-        let x = ((f64::from(nm) - FROM_NM) / SKIN_TABLE_STEP_NM)
+        let x = ((f64::from(nm) - FROM_NM) / INCIDENCE_STEP_NM)
             .clamp(0.0, (self.rows.len() - 1) as f64);
         let i = (x as usize).min(self.rows.len().saturating_sub(2));
         (i, (x - i as f64) as f32)

@@ -18,22 +18,27 @@
 //! not reflect, T(θ) = 1 − ρ_dr(θ) (`ts.transmitted_fraction`), enters; R_d of it comes back out,
 //! leaving with the same split. Reciprocal and energy conserving:
 //!
-//! f_body(ωi, ωo; λ) = R_d(λ) · m(uv) · T(θi) · T(θo) / (π T̄),  T̄ = ∫ T(θ) 2 cosθ d cosθ,
+//! f_body(ωi, ωo; λ) = R_d(λ) · m(uv) · T(θi) a(θi, λ) · T(θo) a(θo, λ) / (π c(λ)),
+//! c(λ) = ∫ T(θ) a(θ, λ) 2 cosθ d cosθ,
 //!
-//! so the body reflects R_d · T(θi) of the incident flux and surface + body ≤ ρ_dr + (1 − ρ_dr) R_d ≤ 1.
+//! the BSSRDF's own angular factor (`bssrdf::Directional`, with the incidence gain a of
+//! docs/physics.md §8.1; a = 1 with `Incidence::Normal`), so the body reflects R_d · T(θi) a(θi) of
+//! the incident flux and surface + body ≤ ρ_dr + (1 − ρ_dr) R_d(θi) ≤ 1 (R_d a is the
+//! adding-doubling reflectance at that incidence).
 //! (The observable `multipole::skin::diffuse_reflectance` is the same R_d with the smooth-surface
 //! split (1 − F(0)) instead of T(0°); the two differ by under 2% for ρ_s ≤ 0.25.)
 //! `m(uv)` is the optional albedo texture's luminance relative to its mean, so the texture adds
 //! spatial detail (brows, lips, pores) without replacing the model's spectral colour; the product
 //! is clamped at 1.
 
+use crate::bssrdf::Directional;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths, SpectrumTable, linear_srgb_at_nm};
 use crate::texture::Texture;
 use brdf::Frame;
 #[cfg(test)]
 use brdf::TorranceSparrow;
 use glam::{Vec2, Vec3};
-use std::f32::consts::FRAC_1_PI;
+use std::f32::consts::{FRAC_1_PI, PI};
 
 mod skin;
 mod surface;
@@ -81,8 +86,11 @@ pub struct Bsdf<'a> {
 enum Lobes<'a> {
     Skin {
         surface: Surface<'a>,
-        /// R_d(λ) m(uv) / (π T̄).
+        /// R_d(λ) m(uv).
         body: SampledSpectrum,
+        /// T(θ) a(θ, λ) / c(λ) on both sides (the BSSRDF's angular factor).
+        directional: &'a Directional,
+        wl: SampledWavelengths,
     },
     Lambert {
         /// ρ(λ) / π.
@@ -173,7 +181,9 @@ impl Material {
                 let rd = s.total_reflectance.eval(wl).map(|r| (r * m).min(1.0));
                 Lobes::Skin {
                     surface: Surface::of(s),
-                    body: rd * (FRAC_1_PI / s.mean_transmitted),
+                    body: rd,
+                    directional: &s.directional,
+                    wl: *wl,
                 }
             }
             Material::Diffuse(d) => {
@@ -203,8 +213,17 @@ impl Bsdf<'_> {
             return SampledSpectrum::zero();
         }
         match &self.lobes {
-            Lobes::Skin { surface, body } => {
-                let split = surface.transmitted(i.z) * surface.transmitted(o.z);
+            Lobes::Skin {
+                surface,
+                body,
+                directional,
+                wl,
+            } => {
+                let split = SampledSpectrum(std::array::from_fn(|k| {
+                    let nm = wl.nm(k);
+                    directional.factor(i.z, nm) * directional.factor(o.z, nm)
+                        / (PI * directional.normalisation_at(nm))
+                }));
                 *body * split + SampledSpectrum::splat(surface.eval(o, i))
             }
             Lobes::Lambert { body } => *body,
@@ -227,8 +246,13 @@ impl Bsdf<'_> {
     /// the lobe's albedo against the body's mean albedo.
     fn specular_probability(&self, o_z: f32) -> f32 {
         match &self.lobes {
-            Lobes::Skin { surface, body } => {
-                let d = body.average() * std::f32::consts::PI * surface.transmitted(o_z);
+            Lobes::Skin {
+                surface,
+                body,
+                directional,
+                ..
+            } => {
+                let d = body.average() * surface.transmitted(o_z) / directional.normalisation();
                 surface_share(surface.albedo(o_z), d, 0.0)
             }
             Lobes::SkinSurface {

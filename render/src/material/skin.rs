@@ -85,8 +85,9 @@ pub struct SkinMaterial {
     pub total_reflectance: SpectrumTable,
     /// Optional albedo texture (relative luminance modulation).
     pub albedo_texture: Option<TextureRef>,
-    /// T̄ = ∫ T(θ) 2 cosθ dcosθ, the cosine-weighted mean of the transmitted fraction.
-    pub mean_transmitted: f32,
+    /// The angular factor of the body: T(θ) a(θ, λ) and its normalisation (the BSSRDF's own,
+    /// `bssrdf::Directional`; the Lambertian stand-in and the level of detail shade with it).
+    pub directional: Arc<Directional>,
     /// The BSSRDF; when present it replaces the Lambertian body term.
     pub subsurface: Option<Subsurface>,
     /// What the fidelity chose for this skin's tables (`None` without a BSSRDF).
@@ -112,10 +113,18 @@ impl SkinMaterial {
             TorranceSparrow::new(roughness_m, params.oiliness() as f32, params.eta() as f32)?;
         let g = knobs.phase_g.unwrap_or(multipole::DEFAULT_G);
         let media = Arc::new(SkinMedia::new(&params, g)?);
+        let directional = Directional::new(surface.clone(), split_of(knobs.surface));
+        let directional = match knobs.incidence {
+            Incidence::Normal => directional,
+            Incidence::AddingDoubling => directional.with_incidence(Arc::new(
+                IncidenceGain::build(media.every_10nm(), g).map_err(SkinBuildError::Profiles)?,
+            )),
+        };
         if knobs.no_subsurface {
             let totals = total_table(&media, knobs.method)?;
             return Ok(Self::new(params, surface, totals, albedo_texture, media)
-                .with_surface_kind(knobs.surface));
+                .with_surface_kind(knobs.surface)
+                .with_directional(directional));
         }
         let (table, choices) = crate::fidelity::tables::skin_table(
             &params,
@@ -133,19 +142,10 @@ impl SkinMaterial {
             return Err(SkinBuildError::OutOfRange(bad));
         }
         let totals = SpectrumTable::from_fn(|nm| f64::from(table.total(nm as f32)));
-        let split = match knobs.surface {
-            SurfaceKind::Oily => EnergySplit::SpecularLobe,
-            SurfaceKind::Smooth => EnergySplit::Fresnel,
-        };
-        let directional = match knobs.incidence {
-            Incidence::Normal => Directional::new(surface.clone(), split),
-            Incidence::AddingDoubling => Directional::new(surface.clone(), split).with_incidence(
-                Arc::new(IncidenceGain::build(&params, g).map_err(SkinBuildError::Profiles)?),
-            ),
-        };
-        let subsurface = Subsurface::new(Arc::new(table), directional);
+        let subsurface = Subsurface::new(Arc::new(table), directional.clone());
         let mut skin = Self::new(params, surface, totals, albedo_texture, media)
             .with_surface_kind(knobs.surface)
+            .with_directional(directional)
             .with_subsurface(subsurface);
         skin.choices = Some(Box::new(choices));
         Ok(skin)
@@ -160,20 +160,13 @@ impl SkinMaterial {
         albedo_texture: Option<TextureRef>,
         media: Arc<SkinMedia>,
     ) -> Self {
-        // Midpoint rule in μ = cosθ; T is smooth, 256 nodes are far below f32 noise.
-        let n = 256;
-        let mean_transmitted = (0..n)
-            .map(|i| {
-                let mu = (i as f32 + 0.5) / n as f32;
-                surface.transmitted_fraction(mu) * 2.0 * mu / n as f32
-            })
-            .sum();
+        let directional = Arc::new(Directional::new(surface.clone(), EnergySplit::SpecularLobe));
         Self {
             params,
             surface,
             total_reflectance,
             albedo_texture,
-            mean_transmitted,
+            directional,
             subsurface: None,
             choices: None,
             surface_kind: SurfaceKind::Oily,
@@ -181,21 +174,19 @@ impl SkinMaterial {
         }
     }
 
-    /// The same skin with surface model `kind` (T̄ recomputed for the smooth surface's Fresnel
-    /// split, T = 1 − F(θ)).
+    /// The same skin with surface model `kind` (the smooth surface's Fresnel split,
+    /// T = 1 − F(θ), for the body).
     #[must_use]
     pub fn with_surface_kind(mut self, kind: SurfaceKind) -> Self {
         self.surface_kind = kind;
-        if kind == SurfaceKind::Smooth {
-            let eta = self.surface.eta();
-            let n = 256;
-            self.mean_transmitted = (0..n)
-                .map(|i| {
-                    let mu = (i as f32 + 0.5) / n as f32;
-                    (1.0 - brdf::fresnel::dielectric_reflectance_f32(mu, eta)) * 2.0 * mu / n as f32
-                })
-                .sum();
-        }
+        self.directional = Arc::new(Directional::new(self.surface.clone(), split_of(kind)));
+        self
+    }
+
+    /// The same skin with the body's angular factor `directional` (with its incidence gain).
+    #[must_use]
+    pub fn with_directional(mut self, directional: Directional) -> Self {
+        self.directional = Arc::new(directional);
         self
     }
 
@@ -218,6 +209,14 @@ impl SkinMaterial {
         self.albedo_texture.map_or(1.0, |t| {
             textures[t.index].lookup_luminance(uv) / t.mean_luminance
         })
+    }
+}
+
+/// The energy split of surface model `kind`: the oily lobe's own, or Fresnel's.
+fn split_of(kind: SurfaceKind) -> EnergySplit {
+    match kind {
+        SurfaceKind::Oily => EnergySplit::SpecularLobe,
+        SurfaceKind::Smooth => EnergySplit::Fresnel,
     }
 }
 
