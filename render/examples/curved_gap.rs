@@ -1,4 +1,11 @@
-//! Scratch: BSSRDF vs volumetric on tilted slabs and spheres, one wavelength, uniform sky.
+//! The BSSRDF against the volumetric walk on curved skin (docs/physics.md §8.1,
+//! docs/accuracy_evidence.md §3): spheres and tilted slabs at one wavelength under a uniform sky
+//! (or a lamp), smooth surface, g = 0; prints each region's means and the BSSRDF's error.
+//!
+//! `cargo run --release -p render --features studies --example curved_gap -- RADIUS|slab|angles
+//! [BSSRDF_SPP] [WALK_SPP]`; environment: `SKIN` (the material's keys; default C_m 0.05, β_m 0.7,
+//! C_h 0.02), `NM` (comma-separated wavelengths), `INC=normal` (the former angular factor),
+//! `LIGHT=1` (a sphere lamp and no sky). Walk renders are kept in /tmp/cg and reused.
 use glam::Vec2;
 use render::film::Film;
 use render::integrator::{BodyIntegrator, IntegratorKind};
@@ -41,6 +48,7 @@ fn knobs() -> SkinKnobs {
 
 /// Volumetric film cached on disk by key (the walk does not depend on the BSSRDF's knobs).
 fn vol(scene: &Scene, side: usize, spp: u32, nm: f32, key: &str) -> Film {
+    let _ = std::fs::create_dir_all("/tmp/cg");
     let f = format!("/tmp/cg/vol-{key}-{side}-{spp}-{nm}.txt");
     if let Ok(t) = std::fs::read_to_string(&f) {
         let v: Vec<f64> = t.split_whitespace().map(|x| x.parse().unwrap()).collect();

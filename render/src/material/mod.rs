@@ -66,6 +66,9 @@ pub struct DiffuseMaterial {
 }
 
 /// A surface material.
+// A scene holds a handful of materials, read at every hit: a box would add an indirection there
+// to save a few hundred bytes per material.
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug, Clone)]
 pub enum Material {
     /// Human skin ([DJ06]).
