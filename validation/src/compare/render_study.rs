@@ -717,13 +717,11 @@ fn time_chart(
     }
     lines.push('\n');
     skin_io::atomic::write_bytes(&out.join(format!("render_time_{stem}.csv")), csv.as_bytes())?;
+    let title = format!("{} ({}): error against render time", case.name, case.tone);
     let mut chart = LineChart::new(
-        &format!(
-            "{} ({}): image error against render time",
-            case.name, case.tone
-        ),
+        title,
         "CPU seconds",
-        "RMS relative luminance error",
+        "|region luminance error| against the volumetric reference",
     )
     .log_x()
     .log_y();
