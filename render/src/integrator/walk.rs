@@ -66,7 +66,7 @@ impl PathTracer<'_> {
                 &mut path.exit_pick,
             );
             path.l += beta_exit * direct / hit.q_sss;
-            return self.continue_from_exit(path, hit, ss, &at, (beta_exit, lit), sampler);
+            return self.continue_from_exit(path, hit, ss, &at, (beta_exit, lit), (wl, sampler));
         }
         path.beta = beta_exit / hit.q_sss;
         // No light was sampled at the exit: emission found next takes MIS weight 1.
