@@ -94,21 +94,46 @@ impl IncidenceGain {
         (FROM_NM + INCIDENCE_STEP_NM * i as f64) as f32
     }
 
+    /// Where `mu` falls among the quadrature's angles: the two columns and the weight of the
+    /// second, found once for every row and wavelength read at that angle.
+    #[must_use]
+    pub fn column(&self, mu: f32) -> Column {
+        let k = self.mu.partition_point(|&m| m < mu);
+        if k == 0 {
+            return Column {
+                k0: 0,
+                k1: 0,
+                t: 0.0,
+            };
+        }
+        if k >= self.mu.len() {
+            let last = self.mu.len() - 1;
+            return Column {
+                k0: last,
+                k1: last,
+                t: 0.0,
+            };
+        }
+        let (m0, m1) = (self.mu[k - 1], self.mu[k]);
+        Column {
+            k0: k - 1,
+            k1: k,
+            t: (mu - m0) / (m1 - m0),
+        }
+    }
+
+    /// a of row `i` at the column `c` (linear between the quadrature's angles).
+    #[must_use]
+    pub fn row_gain_at(&self, i: usize, c: Column) -> f32 {
+        let row = &self.rows[i.min(self.rows.len() - 1)];
+        row[c.k0] + c.t * (row[c.k1] - row[c.k0])
+    }
+
     /// a(μ) of row `i`, linear in μ between the quadrature's angles and held at the grazing-most
     /// one below it (where T(θ) → 0 anyway).
     #[must_use]
     pub fn row_gain(&self, i: usize, mu: f32) -> f32 {
-        let row = &self.rows[i.min(self.rows.len() - 1)];
-        let k = self.mu.partition_point(|&m| m < mu);
-        if k == 0 {
-            return row[0];
-        }
-        if k >= self.mu.len() {
-            return row[self.mu.len() - 1];
-        }
-        let (m0, m1) = (self.mu[k - 1], self.mu[k]);
-        let t = (mu - m0) / (m1 - m0);
-        row[k - 1] + t * (row[k] - row[k - 1])
+        self.row_gain_at(i, self.column(mu))
     }
 
     /// The row index and weight of the next row for wavelength `nm` (linear in λ).
@@ -123,11 +148,25 @@ impl IncidenceGain {
     /// a(μ, λ) at outside incidence cosine `mu` and wavelength `nm` (1 at μ = 1).
     #[must_use]
     pub fn gain(&self, mu: f32, nm: f32) -> f32 {
+        self.gain_at(self.column(mu), nm)
+    }
+
+    /// a(μ, λ) at the column `c` of μ and wavelength `nm`.
+    #[must_use]
+    pub fn gain_at(&self, c: Column, nm: f32) -> f32 {
         let (i, t) = self.rows_at(nm);
         if self.rows.len() < 2 {
-            return self.row_gain(0, mu);
+            return self.row_gain_at(0, c);
         }
-        let (a, b) = (self.row_gain(i, mu), self.row_gain(i + 1, mu));
+        let (a, b) = (self.row_gain_at(i, c), self.row_gain_at(i + 1, c));
         a + t * (b - a)
     }
+}
+
+/// Where an incidence cosine falls among the gain's tabulated angles ([`IncidenceGain::column`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Column {
+    k0: usize,
+    k1: usize,
+    t: f32,
 }

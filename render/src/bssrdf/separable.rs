@@ -17,7 +17,7 @@
 //! variant (both are normalised by their own c).
 
 use super::incidence::IncidenceGain;
-use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use crate::spectrum::{N_WAVELENGTHS, SampledSpectrum, SampledWavelengths};
 use brdf::TorranceSparrow;
 use brdf::fresnel::{dielectric_reflectance, fresnel_moment};
 use std::f32::consts::FRAC_1_PI;
@@ -165,16 +165,26 @@ impl Directional {
         self.factor(cos_theta, nm) / self.normalisation_at(nm)
     }
 
-    /// [`Self::factor`] at each of the path's wavelengths.
+    /// [`Self::factor`] at each of the path's wavelengths: T and the gain's angle are found once.
     #[must_use]
     pub fn factors(&self, cos_theta: f32, wl: &SampledWavelengths) -> SampledSpectrum {
-        SampledSpectrum(std::array::from_fn(|k| self.factor(cos_theta, wl.nm(k))))
+        let t = self.transmittance(cos_theta);
+        match &self.incidence {
+            Some((gain, _)) if t > 0.0 => {
+                let column = gain.column(cos_theta.min(1.0));
+                SampledSpectrum(std::array::from_fn(|k| t * gain.gain_at(column, wl.nm(k))))
+            }
+            _ => SampledSpectrum([t; N_WAVELENGTHS]),
+        }
     }
 
     /// [`Self::s_omega`] at each of the path's wavelengths.
     #[must_use]
     pub fn s_omegas(&self, cos_theta: f32, wl: &SampledWavelengths) -> SampledSpectrum {
-        SampledSpectrum(std::array::from_fn(|k| self.s_omega(cos_theta, wl.nm(k))))
+        let f = self.factors(cos_theta, wl);
+        SampledSpectrum(std::array::from_fn(|k| {
+            f.0[k] * FRAC_1_PI / self.normalisation_at(wl.nm(k))
+        }))
     }
 
     /// [`Self::cosine_sample_weight`] at each of the path's wavelengths.
@@ -184,8 +194,9 @@ impl Directional {
         cos_theta: f32,
         wl: &SampledWavelengths,
     ) -> SampledSpectrum {
+        let f = self.factors(cos_theta, wl);
         SampledSpectrum(std::array::from_fn(|k| {
-            self.cosine_sample_weight(cos_theta, wl.nm(k))
+            f.0[k] / self.normalisation_at(wl.nm(k))
         }))
     }
 }

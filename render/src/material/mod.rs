@@ -222,10 +222,9 @@ impl Bsdf<'_> {
                 directional,
                 wl,
             } => {
+                let (fi, fo) = (directional.factors(i.z, wl), directional.factors(o.z, wl));
                 let split = SampledSpectrum(std::array::from_fn(|k| {
-                    let nm = wl.nm(k);
-                    directional.factor(i.z, nm) * directional.factor(o.z, nm)
-                        / (PI * directional.normalisation_at(nm))
+                    fi.0[k] * fo.0[k] / (PI * directional.normalisation_at(wl.nm(k)))
                 }));
                 *body * split + SampledSpectrum::splat(surface.eval(o, i))
             }
