@@ -59,10 +59,12 @@ fn exposure_of(kind: &str, gains: [f64; 3]) -> Result<Exposure, Bad> {
 /// where `mask` (N,) is true if given, with β_m `eumelanin`, fitted per texture (`None`) or per
 /// square region of `eumelanin_regions` texels a side, under the exposure `exposure` (`"gains"`
 /// with `gains`, `"auto"`, `"auto-rgb"`) and the skin model `model` (`seed`, `full`, `auto`)
-/// over the extended `parameters` (their `skin fit --json` names; `None`: all of them).
+/// over the extended `parameters` (their `skin fit --json` names; `None`: all of them); texels
+/// out of gamut fitted again under a thin epidermis if `thin_epidermis` (`thin_epidermis_mm`,
+/// `None`: the default).
 /// Returns flat (N,) maps and the summary.
 #[pyfunction]
-#[pyo3(signature = (texels, width, mask, eumelanin, eumelanin_regions, exposure, gains, model, parameters, cache, threads=None))]
+#[pyo3(signature = (texels, width, mask, eumelanin, eumelanin_regions, exposure, gains, model, parameters, thin_epidermis, thin_epidermis_mm, cache, threads=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn maps<'py>(
     py: Python<'py>,
@@ -75,6 +77,8 @@ pub fn maps<'py>(
     gains: [f64; 3],
     model: &str,
     parameters: Option<Vec<String>>,
+    thin_epidermis: bool,
+    thin_epidermis_mm: Option<f64>,
     cache: bool,
     threads: Option<usize>,
 ) -> PyResult<Bound<'py, PyDict>> {
@@ -130,6 +134,8 @@ pub fn maps<'py>(
             (None, None) => Eumelanin::Fit,
         },
         exposure: exposure_of(exposure, gains)?,
+        thin_epidermis_mm: thin_epidermis
+            .then_some(thin_epidermis_mm.unwrap_or(skin_fit::maps::THIN_EPIDERMIS_MM)),
         cache_dir: if cache {
             skin_io::cache::cache_dir()
         } else {
@@ -171,6 +177,11 @@ pub fn maps<'py>(
     d.set_item("delta_e", out1(py, wide(&maps.delta_e)))?;
     d.set_item("in_gamut", maps.in_gamut.into_pyarray(py))?;
     d.set_item("fitted", maps.fitted.into_pyarray(py))?;
+    let thin = maps
+        .thin_epidermis
+        .as_ref()
+        .map_or_else(|| vec![false; maps.melanin.len()], |t| t.texels.clone());
+    d.set_item("thin_epidermis", thin.into_pyarray(py))?;
     if let Some(b) = &maps.eumelanin_map {
         d.set_item("eumelanin_map", out1(py, wide(b)))?;
     }
@@ -209,6 +220,7 @@ pub fn maps<'py>(
         .transpose()?;
     summary.set_item("regions", regions)?;
     summary.set_item("model", choice.to_string())?;
+    summary.set_item("thin_epidermis", s.thin_epidermis)?;
     let extended = extended
         .map(|e| {
             let ed = PyDict::new(py);

@@ -536,6 +536,8 @@ def maps(
     exposure: float | tuple[float, float, float] | str = 1.0,
     model: str = "seed",
     parameters: Sequence[str] | None = None,
+    thin_epidermis: bool = True,
+    thin_epidermis_mm: float | None = None,
     cache: bool = True,
     threads: int | None = None,
 ) -> dict[str, Any]:
@@ -558,7 +560,10 @@ def maps(
     residual). ``parameters``: the extended parameters ``model`` tries, by name
     (``epidermis_blood``, ``epidermis_thickness_mm``, ``oxygenation``, ``mie_scale``,
     ``rayleigh_scale``, ``dermis_scattering_scale``, ``bilirubin_g_per_l``; default all).
-    ``cache``: keep the forward table (built once, a few CPU-seconds) in the disk cache
+    ``thin_epidermis``: fit texels out of gamut again under a thin epidermis of
+    ``thin_epidermis_mm`` (in [0.04, 0.3] mm; None: 0.05 mm, the lip vermilion's; ``skin maps
+    --thin-epidermis``) and keep that skin where it reproduces the texel at least 1 ΔE2000 closer
+    (docs/physics.md §18). ``cache``: keep the forward table (built once, a few CPU-seconds) in the disk cache
     (``$SKIN_CACHE_DIR``, else ``$XDG_CACHE_HOME/skin``, else ``~/.cache/skin``).
 
     Non-finite, negative or huge (> 16) components are replaced (NaN by 0, then clamped), fitted
@@ -567,14 +572,15 @@ def maps(
 
     Returns a dict of (H, W) arrays:
 
-    ================ ==================================================================
-    ``melanin``      melanin volume fraction C_m, float64 in [0, 0.5]
-    ``eumelanin``    eumelanin blend β_m (the same for every texel), float64 in [0, 1]
-    ``hemoglobin``   hemoglobin volume fraction C_h, float64 in [0.001, 0.1]
-    ``delta_e``      CIEDE2000 between the texel and the fitted skin, float64 (0 off the mask)
-    ``in_gamut``     bool: fitted and reproduced within ΔE2000 ≤ 1
-    ``fitted``       bool: inside the mask
-    ================ ==================================================================
+    =================== ==================================================================
+    ``melanin``         melanin volume fraction C_m, float64 in [0, 0.5]
+    ``eumelanin``       eumelanin blend β_m (the same for every texel), float64 in [0, 1]
+    ``hemoglobin``      hemoglobin volume fraction C_h, float64 in [0.001, 0.1]
+    ``delta_e``         CIEDE2000 between the texel and the fitted skin, float64 (0 off the mask)
+    ``in_gamut``        bool: fitted and reproduced within ΔE2000 ≤ 1
+    ``fitted``          bool: inside the mask
+    ``thin_epidermis``  bool: fitted under the thin epidermis (C_m, C_h are that skin's)
+    =================== ==================================================================
 
     With ``eumelanin_regions`` the ``eumelanin`` array holds each texel's region's β_m (and the
     summary's ``eumelanin`` their median).
@@ -588,7 +594,7 @@ def maps(
     ``exposure`` (the R, G, B gains applied), ``exposure_range`` (for ``"auto"``: ``min``, ``max``,
     ``tolerance_de``, ``rms_de`` of the gains the texels allow; else None), ``regions`` (with
     ``eumelanin_regions``: ``block``, ``regions``, ``min``, ``median``, ``max`` β_m and
-    ``median_allowed_width``; else None), ``model`` and ``extended`` (for ``"full"``/``"auto"``:
+    ``median_allowed_width``; else None), ``model``, ``thin_epidermis`` (the count of such texels) and ``extended`` (for ``"full"``/``"auto"``:
     ``seed_rms_de``, ``rms_de`` and ``values``, per parameter name its ``value``, ``kept`` and
     ``range``; else None).
 
@@ -652,6 +658,8 @@ def maps(
         gains,
         model,
         parameters,
+        bool(thin_epidermis),
+        None if thin_epidermis_mm is None else float(thin_epidermis_mm),
         bool(cache),
         threads,
     )
@@ -668,6 +676,7 @@ def maps(
         "delta_e": d["delta_e"].reshape(shape),
         "in_gamut": np.asarray(d["in_gamut"], dtype=bool).reshape(shape),
         "fitted": np.asarray(d["fitted"], dtype=bool).reshape(shape),
+        "thin_epidermis": np.asarray(d["thin_epidermis"], dtype=bool).reshape(shape),
         "summary": summary,
     }
     return out

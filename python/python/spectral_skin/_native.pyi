@@ -113,6 +113,8 @@ def maps(
     gains: tuple[float, float, float],
     model: str,
     parameters: list[str] | None,
+    thin_epidermis: bool,
+    thin_epidermis_mm: float | None,
     cache: bool,
     threads: int | None = None,
 ) -> dict[str, Any]:
