@@ -135,6 +135,7 @@ def test_mask_leaves_texels_unfitted(texture):
             "not both",
         ),
         (lambda: ss.maps(np.full((2, 2, 3), 0.3), model="best"), "model", "seed"),
+        (lambda: ss.maps(np.full((2, 2, 3), 0.3), thin_epidermis_mm=0.5), "thin_epidermis_mm", "[0.04, 0.3]"),
         (lambda: ss.maps(np.full((2, 2, 3), 0.3), model="full", parameters=["gloss"]), "parameters", "mie_scale"),
     ],
 )
@@ -208,3 +209,26 @@ def test_model_fits_an_extended_parameter_per_texture(texture):
     plain = ss.maps(albedo(c_m, c_h, beta), eumelanin=beta, model="auto", parameters="bilirubin_g_per_l")
     assert list(plain["summary"]["extended"]["values"]) == ["bilirubin_g_per_l"]
     assert not plain["summary"]["extended"]["values"]["bilirubin_g_per_l"]["kept"]
+
+
+def test_thin_epidermis_reaches_lip_red():
+    """Lip-like texels made under a 0.05 mm epidermis (C_m 0.02, C_h 0.06-0.09) beside skin of the
+    default epidermis: with one skin the lips are out of gamut; with the thin-epidermis skin
+    (default) they come in, flagged, with C_m within 5 % and C_h within 10 % (the Rust test's
+    tolerances), and the default-epidermis texel keeps its skin."""
+    c_h = np.array([[0.06, 0.075, 0.09]])
+    r = ss.diffuse_reflectance(
+        WL, method="exact", geometry="sce", melanin=0.02, eumelanin=0.6, hemoglobin=c_h, epidermis_thickness_mm=0.05
+    )
+    lips = ss.xyz(WL, r) @ TO_REC709.T
+    rgb = np.concatenate([lips, albedo(0.05, 0.02, 0.6)[None, None, :]], axis=1)
+    one = ss.maps(rgb, eumelanin=0.6, thin_epidermis=False)
+    assert (one["delta_e"][0, :3] > 1.0).all() and not one["thin_epidermis"].any(), one["delta_e"]
+    m = ss.maps(rgb, eumelanin=0.6)
+    np.testing.assert_array_equal(m["thin_epidermis"][0], [True, True, True, False])
+    assert m["in_gamut"].all(), m["delta_e"]
+    np.testing.assert_allclose(m["melanin"][0, :3], 0.02, rtol=0.05)
+    np.testing.assert_allclose(m["hemoglobin"][0, :3], c_h[0], rtol=0.1)
+    assert m["summary"]["thin_epidermis"] == 3
+    thicker = ss.maps(rgb, eumelanin=0.6, thin_epidermis_mm=0.3)
+    assert not thicker["in_gamut"][0, :3].any()

@@ -34,6 +34,9 @@ pub struct ThinEpidermis {
 /// Thin-epidermis tables loaded by a model, by cache key: each is built or read once.
 pub(super) type Tables = Arc<Mutex<Vec<(String, ForwardTable)>>>;
 
+/// A memo slot: the texel's bits, its label and its refit (C_m, C_h, ΔE2000).
+type MemoEntry = Option<([u32; 3], usize, (f32, f32, f32))>;
+
 /// One texel's refit: index, C_m, C_h, ΔE2000.
 type Refit = (usize, f32, f32, f32);
 
@@ -113,7 +116,7 @@ pub(super) fn refit(
     let refits = candidates
         .par_chunks(CHUNK)
         .flat_map_iter(|chunk| {
-            let mut memo: Vec<Option<([u32; 3], usize, (f32, f32, f32))>> = vec![None; MEMO_SLOTS];
+            let mut memo: Vec<MemoEntry> = vec![None; MEMO_SLOTS];
             let mut out = Vec::new();
             for &k in chunk {
                 let label = label_of(k);
