@@ -124,6 +124,19 @@ def test_mask_leaves_texels_unfitted(texture):
         (lambda: ss.maps(np.full((2, 2, 3), 0.3), eumelanin=np.nan), "eumelanin", "[0, 1]"),
         (lambda: ss.maps([["a", "b", "c"]]), "albedo_rgb", "real"),
         (lambda: ss.maps(np.full((2, 2, 3), 0.3), threads=0), "threads", "[1, 1024]"),
+        (lambda: ss.maps(np.full((2, 2, 3), 0.3), exposure=3.0), "exposure", "[0.125, 2]"),
+        (lambda: ss.maps(np.full((2, 2, 3), 0.3), exposure=(1.0, 0.5)), "exposure", "[0.125, 2]"),
+        (lambda: ss.maps(np.full((2, 2, 3), 0.3), exposure="bright"), "exposure", "auto-rgb"),
+        (lambda: ss.maps(np.full((2, 2, 3), 0.3), eumelanin_regions=2), "eumelanin_regions", "[4, 4096]"),
+        (lambda: ss.maps(np.full((2, 2, 3), 0.3), eumelanin_regions=4.5), "eumelanin_regions", "[4, 4096]"),
+        (
+            lambda: ss.maps(np.full((2, 2, 3), 0.3), eumelanin=0.5, eumelanin_regions=8),
+            "eumelanin_regions",
+            "not both",
+        ),
+        (lambda: ss.maps(np.full((2, 2, 3), 0.3), model="best"), "model", "seed"),
+        (lambda: ss.maps(np.full((2, 2, 3), 0.3), thin_epidermis_mm=0.5), "thin_epidermis_mm", "[0.04, 0.3]"),
+        (lambda: ss.maps(np.full((2, 2, 3), 0.3), model="full", parameters=["gloss"]), "parameters", "mie_scale"),
     ],
 )
 def test_bad_input_names_the_parameter(call, name, text):
@@ -131,3 +144,91 @@ def test_bad_input_names_the_parameter(call, name, text):
         call()
     assert str(e.value).startswith(name), str(e.value)
     assert text in str(e.value), str(e.value)
+
+
+def test_exposure_given_and_fitted(texture):
+    """A texture photographed at gain 0.7 on every channel: the given gain 0.7 undoes it exactly
+    (the same maps as the texture itself, to the f32 texels' rounding), and `auto` finds it within
+    2 % (eighth-stop candidates and a parabola; the Rust test pins 1 % on a larger texture)."""
+    c_m, _, beta, rgb = texture
+    truth = ss.maps(rgb, eumelanin=beta)
+    given = ss.maps(rgb * 0.7, eumelanin=beta, exposure=1 / 0.7)
+    np.testing.assert_allclose(given["melanin"], truth["melanin"], rtol=1e-3)
+    assert given["summary"]["exposure"] == pytest.approx([1 / 0.7] * 3)
+    assert given["summary"]["exposure_range"] is None and given["in_gamut"].all()
+    fitted = ss.maps(rgb * 0.7, eumelanin=beta, exposure="auto")
+    g = fitted["summary"]["exposure"]
+    assert g[0] == g[1] == g[2] and g[0] == pytest.approx(1 / 0.7, rel=0.02), g
+    r = fitted["summary"]["exposure_range"]
+    assert r["min"] <= g[0] <= r["max"] and r["tolerance_de"] > 0, r
+    np.testing.assert_allclose(fitted["melanin"], c_m, rtol=0.05)
+    balanced = ss.maps(rgb * np.array([0.7, 0.8, 0.9]), eumelanin=beta, exposure="auto-rgb")
+    np.testing.assert_allclose(balanced["summary"]["exposure"], 1 / np.array([0.7, 0.8, 0.9]), rtol=0.03)
+    assert balanced["summary"]["exposure_range"] is None
+
+
+def test_eumelanin_per_region_follows_the_texture():
+    """Halves of β_m 0.3 and 0.9 (C_m and C_h varying within each): 8 × 8 regions take β_m within
+    0.2 of their half's (three colour numbers pin β_m only to about ±0.1-0.15 over 64 texels, the
+    allowed widths of docs/physics.md §18; one candidate step is 0.05), and the eumelanin array
+    holds each texel's region's value."""
+    x = np.linspace(0.0, 1.0, 16)
+    c_m = np.tile(0.01 * (0.12 / 0.01) ** x, (8, 1))
+    c_h = np.tile(0.005 * (0.05 / 0.005) ** np.linspace(0.0, 1.0, 8)[:, None], (1, 16))
+    beta = np.where(np.arange(16)[None, :] < 8, 0.3, 0.9) * np.ones((8, 1))
+    rgb = albedo(c_m, c_h, beta)
+    m = ss.maps(rgb, eumelanin_regions=8)
+    left, right = m["eumelanin"][:, :8], m["eumelanin"][:, 8:]
+    assert (left == left[0, 0]).all() and (right == right[0, 0]).all()
+    assert abs(left[0, 0] - 0.3) <= 0.2 and abs(right[0, 0] - 0.9) <= 0.2, (left[0, 0], right[0, 0])
+    r = m["summary"]["regions"]
+    assert r["block"] == 8 and r["regions"] == 2
+    assert r["min"] == pytest.approx(left[0, 0]) and r["max"] == pytest.approx(right[0, 0])
+    assert m["summary"]["median_delta_e"] < 1.0
+
+
+def test_model_fits_an_extended_parameter_per_texture(texture):
+    """A texture whose skins all have a Mie scale of 1.5: `full` over that parameter returns it
+    within 5 % (candidates 0.375 apart, a parabola between them; the Rust test pins the same) and
+    the maps then reproduce the texture; `auto` over bilirubin, absent from the texture, keeps
+    nothing."""
+    c_m, c_h, beta, _ = texture
+    r = ss.diffuse_reflectance(
+        WL, method="exact", geometry="sce", melanin=c_m, eumelanin=beta, hemoglobin=c_h, mie_scale=1.5
+    )
+    rgb = ss.xyz(WL, r) @ TO_REC709.T
+    seed = ss.maps(rgb, eumelanin=beta)
+    assert seed["summary"]["model"] == "seed" and seed["summary"]["extended"] is None
+    m = ss.maps(rgb, eumelanin=beta, model="full", parameters=["mie_scale"])
+    e = m["summary"]["extended"]
+    v = e["values"]["mie_scale"]
+    assert v["kept"] and v["value"] == pytest.approx(1.5, rel=0.05), e
+    assert v["range"]["min"] <= 1.5 <= v["range"]["max"], e
+    assert e["rms_de"] < 0.25 * e["seed_rms_de"], e
+    assert m["summary"]["median_delta_e"] < seed["summary"]["median_delta_e"]
+    plain = ss.maps(albedo(c_m, c_h, beta), eumelanin=beta, model="auto", parameters="bilirubin_g_per_l")
+    assert list(plain["summary"]["extended"]["values"]) == ["bilirubin_g_per_l"]
+    assert not plain["summary"]["extended"]["values"]["bilirubin_g_per_l"]["kept"]
+
+
+def test_thin_epidermis_reaches_lip_red():
+    """Lip-like texels made under a 0.05 mm epidermis (C_m 0.02, C_h 0.06-0.09) beside skin of the
+    default epidermis: with one skin the lips are out of gamut; with the thin-epidermis skin
+    (default) they come in, flagged, with C_m within 5 % and C_h within 10 % (the Rust test's
+    tolerances), and the default-epidermis texel keeps its skin."""
+    c_h = np.array([[0.06, 0.075, 0.09]])
+    r = ss.diffuse_reflectance(
+        WL, method="exact", geometry="sce", melanin=0.02, eumelanin=0.6, hemoglobin=c_h, epidermis_thickness_mm=0.05
+    )
+    lips = ss.xyz(WL, r) @ TO_REC709.T
+    rgb = np.concatenate([lips, albedo(0.05, 0.02, 0.6)[None, None, :]], axis=1)
+    one = ss.maps(rgb, eumelanin=0.6, thin_epidermis=False)
+    assert (one["delta_e"][0, :3] > 1.0).all() and not one["thin_epidermis"].any(), one["delta_e"]
+    m = ss.maps(rgb, eumelanin=0.6)
+    np.testing.assert_array_equal(m["thin_epidermis"][0], [True, True, True, False])
+    assert m["in_gamut"].all(), m["delta_e"]
+    np.testing.assert_allclose(m["melanin"][0, :3], 0.02, rtol=0.05)
+    np.testing.assert_allclose(m["hemoglobin"][0, :3], c_h[0], rtol=0.1)
+    assert m["summary"]["thin_epidermis"] == 3
+    thicker = ss.maps(rgb, eumelanin=0.6, thin_epidermis_mm=0.3)
+    assert not thicker["in_gamut"][0, :3].any()

@@ -67,6 +67,12 @@ pub struct MapsArgs {
     /// kept one adds a channel to maps.exr named as in `skin fit --json`.
     #[arg(long, value_name = "MODEL", default_value = "seed", value_parser = crate::args::Checked(parse_model))]
     pub model: ModelChoice,
+    /// Texels out of gamut are fitted again under a thin epidermis of this thickness, mm, in
+    /// [0.04, 0.3] (lip vermilion), and keep that skin where it reproduces them at least 1
+    /// ΔE2000 closer; `off`: one skin for every texel. maps.exr gets a channel
+    /// `thin_epidermis` (1 where a texel has it).
+    #[arg(long, value_name = "MM|off", default_value = "0.05", value_parser = crate::args::Checked(parse_thin_epidermis))]
+    pub thin_epidermis: ThinEpidermisArg,
     /// Edit the maps before writing them, in order (repeatable): melanin*S, melanin+D,
     /// melanin-D (tanning, pallor), hemoglobin*S, hemoglobin+D, hemoglobin-D (flush; under
     /// --edit-mask if given), eumelanin=B. albedo.png is then the forward model of the edited maps.
@@ -90,6 +96,26 @@ pub fn parse_edit(s: &str) -> Result<Edit, String> {
 /// Parse `--model` (clap value parser).
 pub fn parse_model(s: &str) -> Result<ModelChoice, String> {
     s.parse().map_err(|e: skin_fit::FitError| e.to_string())
+}
+
+/// `--thin-epidermis`: the thickness, mm, or `None` for `off`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ThinEpidermisArg(pub Option<f64>);
+
+/// Parse `--thin-epidermis` (clap value parser).
+pub fn parse_thin_epidermis(s: &str) -> Result<ThinEpidermisArg, String> {
+    if s.trim().eq_ignore_ascii_case("off") {
+        return Ok(ThinEpidermisArg(None));
+    }
+    let t = crate::args::parse_number(s, "[0.04, 0.3] mm")?;
+    let [lo, hi] = skin_fit::Parameter::EpidermisThickness.range();
+    if !(lo..=hi).contains(&t) {
+        return Err(format!(
+            "{} mm outside [0.04, 0.3] mm (or off)",
+            skin_optics::echo::Num(t)
+        ));
+    }
+    Ok(ThinEpidermisArg(Some(t)))
 }
 
 /// Parse `--exposure` (clap value parser).
@@ -178,6 +204,7 @@ pub fn run(args: &MapsArgs) -> anyhow::Result<()> {
             (None, None) => Eumelanin::Fit,
         },
         exposure: args.exposure,
+        thin_epidermis_mm: args.thin_epidermis.0,
         cache_dir: if args.no_cache {
             None
         } else {
@@ -298,6 +325,14 @@ pub fn run(args: &MapsArgs) -> anyhow::Result<()> {
     if let Some(e) = &extended {
         print_extended(args.model, e);
     }
+    if let Some(t) = &maps.thin_epidermis {
+        eprintln!(
+            "thin epidermis ({} mm): {} texels ({:.1}%) fitted under it",
+            t.epidermis_mm,
+            s.thin_epidermis,
+            pct(s.thin_epidermis)
+        );
+    }
     if !args.edits.is_empty() {
         let list: Vec<String> = args.edits.iter().map(ToString::to_string).collect();
         eprintln!(
@@ -376,6 +411,12 @@ fn write_outputs(
         (CHANNELS[4], flag),
     ];
     channels.extend(extra.iter().map(|(name, v)| (*name, vec![*v; n])));
+    if let Some(t) = &maps.thin_epidermis {
+        channels.push((
+            "thin_epidermis",
+            t.texels.iter().map(|f| f32::from(u8::from(*f))).collect(),
+        ));
+    }
     let exr = image_file::exr_bytes(w, h, channels)?;
     let encoder = SrgbEncoder::default();
     let rgb: Vec<u8> = albedo

@@ -299,6 +299,8 @@ fn bad_exposure_and_model_are_usage_errors() {
         ("--exposure", "bright", "[0.125, 2]"),
         ("--model", "tiny", "valid: seed, full, auto"),
         ("--eumelanin-regions", "2", "4..=4096"),
+        ("--thin-epidermis", "0.5", "outside [0.04, 0.3] mm"),
+        ("--thin-epidermis", "thin", "[0.04, 0.3] mm"),
     ] {
         let o = skin_maps(&["--albedo", "x.png", flag, value]);
         assert_eq!(o.status.code(), Some(2), "{flag} {value}: {}", stderr(&o));

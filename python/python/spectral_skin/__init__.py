@@ -532,6 +532,12 @@ def maps(
     mask: ArrayLike | None = None,
     *,
     eumelanin: float | None = None,
+    eumelanin_regions: int | None = None,
+    exposure: float | tuple[float, float, float] | str = 1.0,
+    model: str = "seed",
+    parameters: Sequence[str] | None = None,
+    thin_epidermis: bool = True,
+    thin_epidermis_mm: float | None = None,
     cache: bool = True,
     threads: int | None = None,
 ) -> dict[str, Any]:
@@ -543,7 +549,21 @@ def maps(
     the XYZ → linear Rec.709 matrix. ``mask``: optional (H, W) flags (True: fit the texel); texels
     outside it are not fitted and get the median of the fitted maps, ΔE 0 and ``in_gamut`` False.
     ``eumelanin``: the texture's eumelanin blend β_m in [0, 1], or None to fit one β_m over the
-    texels. ``cache``: keep the forward table (built once, a few CPU-seconds) in the disk cache
+    texels (or per region, below). ``eumelanin_regions``: a block size B in [4, 4096] to fit one
+    β_m per square region of B × B texels with a smoothness prior between neighbours (``skin maps
+    --eumelanin-regions B``; not with ``eumelanin``). ``exposure``: gains on the linear texels
+    before the fit (``--exposure``): one gain for R = G = B, three (R, G, B), each in [0.125, 2],
+    ``"auto"`` (one gain fitted with β_m) or ``"auto-rgb"`` (one per channel: exposure and white
+    balance); residuals are measured at the texture's own exposure. ``model``: ``"seed"`` (C_m,
+    β_m, C_h only), ``"full"`` (every parameter of :func:`fit`'s ``model="full"`` fitted once per
+    texture, each costing a few CPU-seconds) or ``"auto"`` (each kept only where it lowers the
+    residual). ``parameters``: the extended parameters ``model`` tries, by name
+    (``epidermis_blood``, ``epidermis_thickness_mm``, ``oxygenation``, ``mie_scale``,
+    ``rayleigh_scale``, ``dermis_scattering_scale``, ``bilirubin_g_per_l``; default all).
+    ``thin_epidermis``: fit texels out of gamut again under a thin epidermis of
+    ``thin_epidermis_mm`` (in [0.04, 0.3] mm; None: 0.05 mm, the lip vermilion's; ``skin maps
+    --thin-epidermis``) and keep that skin where it reproduces the texel at least 1 ΔE2000 closer
+    (docs/physics.md §18). ``cache``: keep the forward table (built once, a few CPU-seconds) in the disk cache
     (``$SKIN_CACHE_DIR``, else ``$XDG_CACHE_HOME/skin``, else ``~/.cache/skin``).
 
     Non-finite, negative or huge (> 16) components are replaced (NaN by 0, then clamped), fitted
@@ -552,21 +572,31 @@ def maps(
 
     Returns a dict of (H, W) arrays:
 
-    ================ ==================================================================
-    ``melanin``      melanin volume fraction C_m, float64 in [0, 0.5]
-    ``eumelanin``    eumelanin blend β_m (the same for every texel), float64 in [0, 1]
-    ``hemoglobin``   hemoglobin volume fraction C_h, float64 in [0.001, 0.1]
-    ``delta_e``      CIEDE2000 between the texel and the fitted skin, float64 (0 off the mask)
-    ``in_gamut``     bool: fitted and reproduced within ΔE2000 ≤ 1
-    ``fitted``       bool: inside the mask
-    ================ ==================================================================
+    =================== ==================================================================
+    ``melanin``         melanin volume fraction C_m, float64 in [0, 0.5]
+    ``eumelanin``       eumelanin blend β_m (the same for every texel), float64 in [0, 1]
+    ``hemoglobin``      hemoglobin volume fraction C_h, float64 in [0.001, 0.1]
+    ``delta_e``         CIEDE2000 between the texel and the fitted skin, float64 (0 off the mask)
+    ``in_gamut``        bool: fitted and reproduced within ΔE2000 ≤ 1
+    ``fitted``          bool: inside the mask
+    ``thin_epidermis``  bool: fitted under the thin epidermis (C_m, C_h are that skin's)
+    =================== ==================================================================
+
+    With ``eumelanin_regions`` the ``eumelanin`` array holds each texel's region's β_m (and the
+    summary's ``eumelanin`` their median).
 
     and ``summary``, a dict: ``eumelanin`` (β_m), ``eumelanin_fitted`` (bool),
     ``eumelanin_min``/``eumelanin_max`` (the β_m range the texels allow: candidates whose RMS
     ΔE2000, capped at 3 per texel, is within ``eumelanin_tolerance_de`` of the best,
     ``eumelanin_rms_de``; both ends equal β_m and the two ΔE None when β_m was given),
     ``texels``, ``fitted``, ``in_gamut``, ``invalid`` (counts), ``median_delta_e``,
-    ``p95_delta_e``, ``max_delta_e`` (over the fitted texels) and ``in_gamut_delta_e`` (1.0).
+    ``p95_delta_e``, ``max_delta_e`` (over the fitted texels), ``in_gamut_delta_e`` (1.0),
+    ``exposure`` (the R, G, B gains applied), ``exposure_range`` (for ``"auto"``: ``min``, ``max``,
+    ``tolerance_de``, ``rms_de`` of the gains the texels allow; else None), ``regions`` (with
+    ``eumelanin_regions``: ``block``, ``regions``, ``min``, ``median``, ``max`` β_m and
+    ``median_allowed_width``; else None), ``model``, ``thin_epidermis`` (the count of such texels) and ``extended`` (for ``"full"``/``"auto"``:
+    ``seed_rms_de``, ``rms_de`` and ``values``, per parameter name its ``value``, ``kept`` and
+    ``range``; else None).
 
     Example:
         >>> wl = np.arange(400.0, 701.0, 10.0)
@@ -594,15 +624,59 @@ def maps(
             eumelanin = float(eumelanin)
         except (TypeError, ValueError):
             raise SkinError(f"eumelanin: {eumelanin!r} is not a number in [0, 1] (or None: fitted)") from None
-    d = _native.maps(a.reshape(-1, 3), m, eumelanin, bool(cache), threads)
+    if eumelanin_regions is not None and (
+        isinstance(eumelanin_regions, bool) or not isinstance(eumelanin_regions, (int, np.integer)) or eumelanin_regions < 0
+    ):
+        raise SkinError(f"eumelanin_regions: {eumelanin_regions!r} is not a block size in [4, 4096] texels (or None)")
+    gains = (1.0, 1.0, 1.0)
+    if isinstance(exposure, str):
+        kind = exposure.strip().lower()
+        if kind not in ("auto", "auto-rgb"):
+            raise SkinError(f"exposure: {exposure!r} is not a gain in [0.125, 2], three gains, 'auto' or 'auto-rgb'")
+    else:
+        try:
+            g = np.asarray(exposure, dtype=np.float64).reshape(-1)
+        except (TypeError, ValueError):
+            raise SkinError(f"exposure: {exposure!r} is not a gain in [0.125, 2], three gains, 'auto' or 'auto-rgb'") from None
+        if g.size not in (1, 3):
+            raise SkinError(f"exposure: {g.size} gains given; one (R = G = B) or three (R, G, B), each in [0.125, 2]")
+        gains = tuple(float(x) for x in np.broadcast_to(g, (3,)))
+        kind = "gains"
+    if not isinstance(model, str):
+        raise SkinError(f"model: {model!r} is not one of 'seed', 'full', 'auto'")
+    if isinstance(parameters, str):
+        parameters = [parameters]
+    if parameters is not None:
+        parameters = [str(p) for p in parameters]
+    d = _native.maps(
+        a.reshape(-1, 3),
+        shape[1],
+        m,
+        eumelanin,
+        None if eumelanin_regions is None else int(eumelanin_regions),
+        kind,
+        gains,
+        model,
+        parameters,
+        bool(thin_epidermis),
+        None if thin_epidermis_mm is None else float(thin_epidermis_mm),
+        bool(cache),
+        threads,
+    )
     summary = dict(d["summary"])
+    beta = (
+        d["eumelanin_map"].reshape(shape)
+        if "eumelanin_map" in d
+        else np.full(shape, summary["eumelanin"], dtype=np.float64)
+    )
     out: dict[str, Any] = {
         "melanin": d["melanin"].reshape(shape),
-        "eumelanin": np.full(shape, summary["eumelanin"], dtype=np.float64),
+        "eumelanin": beta,
         "hemoglobin": d["hemoglobin"].reshape(shape),
         "delta_e": d["delta_e"].reshape(shape),
         "in_gamut": np.asarray(d["in_gamut"], dtype=bool).reshape(shape),
         "fitted": np.asarray(d["fitted"], dtype=bool).reshape(shape),
+        "thin_epidermis": np.asarray(d["thin_epidermis"], dtype=bool).reshape(shape),
         "summary": summary,
     }
     return out

@@ -104,7 +104,23 @@ def export(
     """The file text of a format for one skin, and its notes."""
 
 def maps(
-    texels: _In, mask: _In | None, eumelanin: float | None, cache: bool, threads: int | None = None
+    texels: _In,
+    width: int,
+    mask: _In | None,
+    eumelanin: float | None,
+    eumelanin_regions: int | None,
+    exposure: str,
+    gains: tuple[float, float, float],
+    model: str,
+    parameters: list[str] | None,
+    thin_epidermis: bool,
+    thin_epidermis_mm: float | None,
+    cache: bool,
+    threads: int | None = None,
 ) -> dict[str, Any]:
-    """(N, 3) linear Rec.709 albedo and (N,) flags → melanin, hemoglobin, delta_e (N,) float64,
-    in_gamut, fitted (N,) bool and a summary dict (β_m and its allowed range, counts, ΔE2000)."""
+    """(N, 3) linear Rec.709 albedo in rows of ``width`` texels and (N,) flags, with β_m given,
+    fitted or per region of ``eumelanin_regions`` texels, exposure ``"gains"`` (``gains``),
+    ``"auto"`` or ``"auto-rgb"``, model ``"seed"``/``"full"``/``"auto"`` over the extended
+    ``parameters`` (None: all) → melanin, hemoglobin,
+    delta_e (N,) float64 (and eumelanin_map with regions), in_gamut, fitted (N,) bool and a summary
+    dict (β_m and its allowed range, counts, ΔE2000, exposure, regions, extended parameters)."""

@@ -40,6 +40,7 @@ mod regions;
 mod table;
 #[cfg(test)]
 mod tests;
+mod thin_epidermis;
 
 pub use delta_e::delta_e_2000_fast;
 pub use edit::{EDIT_SYNTAX, Edit, apply as apply_edits};
@@ -50,6 +51,7 @@ pub use table::{
     ForwardTable, MELANIN_KNEE, STEP_NM, Slice, TableSize, cache_key, hemoglobin_of_v,
     melanin_of_u, u_of_melanin, v_of_hemoglobin,
 };
+pub use thin_epidermis::{THIN_EPIDERMIS_MM, THIN_MIN_GAIN_DE, ThinEpidermis};
 
 use crate::FitError;
 use rayon::prelude::*;
@@ -169,6 +171,10 @@ pub struct MapsOptions {
     pub lookup: Lookup,
     /// The gain on every texel, given or fitted (default 1: the texels as given).
     pub exposure: Exposure,
+    /// Epidermis thickness, mm, of the second skin that texels out of gamut are fitted again
+    /// under (lip vermilion; module `thin_epidermis`), in [0.04, 0.3]; `None`: one skin for
+    /// every texel (default [`THIN_EPIDERMIS_MM`]).
+    pub thin_epidermis_mm: Option<f64>,
 }
 
 impl Default for MapsOptions {
@@ -184,6 +190,7 @@ impl Default for MapsOptions {
             beta_tolerance_de: 0.25,
             lookup: Lookup::Auto,
             exposure: Exposure::Fixed([1.0; 3]),
+            thin_epidermis_mm: Some(THIN_EPIDERMIS_MM),
         }
     }
 }
@@ -219,6 +226,15 @@ impl MapsOptions {
                 r.smoothness,
                 r.smoothness >= 0.0,
                 "[0, ∞) ΔE² per unit β_m²",
+            )?;
+        }
+        if let Some(t) = self.thin_epidermis_mm {
+            let [lo, hi] = crate::Parameter::EpidermisThickness.range();
+            check(
+                "thin_epidermis_mm",
+                t,
+                (lo..=hi).contains(&t),
+                "[0.04, 0.3] mm",
             )?;
         }
         if let Exposure::Fixed(gains) = self.exposure {
@@ -296,6 +312,8 @@ pub struct MapsSummary {
     pub exposure_spread: Option<FittedRange>,
     /// β_m over the regions (`None` unless [`Eumelanin::PerRegion`]).
     pub regions: Option<RegionSummary>,
+    /// Fitted texels whose skin has the thin epidermis ([`MapsOptions::thin_epidermis_mm`]).
+    pub thin_epidermis: usize,
 }
 
 /// The maps of a texture, one value per texel (row-major, as the texels given).
@@ -315,6 +333,8 @@ pub struct Maps {
     pub in_gamut: Vec<bool>,
     /// Whether the texel was fitted (inside the mask).
     pub fitted: Vec<bool>,
+    /// The texels fitted under the thin epidermis (`None` when none were).
+    pub thin_epidermis: Option<ThinEpidermis>,
     /// Counts and residual statistics.
     pub summary: MapsSummary,
 }
@@ -324,6 +344,8 @@ pub struct Maps {
 pub struct MapsModel {
     table: ForwardTable,
     outcome: CacheOutcome,
+    /// Thin-epidermis tables loaded so far, by cache key (shared by clones).
+    thin_tables: thin_epidermis::Tables,
 }
 
 /// Slots of the per-worker memo of recent texel values.
@@ -417,12 +439,17 @@ impl MapsModel {
             build,
         )?;
         if table.is_whole() && table.size() == opts.table {
-            return Ok(Self { table, outcome });
+            return Ok(Self {
+                table,
+                outcome,
+                thin_tables: thin_epidermis::Tables::default(),
+            });
         }
         // A readable entry of the wrong shape: rebuilt, not trusted.
         Ok(Self {
             table: build()?,
             outcome: CacheOutcome::Off,
+            thin_tables: thin_epidermis::Tables::default(),
         })
     }
 
@@ -432,6 +459,7 @@ impl MapsModel {
         Self {
             table,
             outcome: CacheOutcome::Off,
+            thin_tables: thin_epidermis::Tables::default(),
         }
     }
 
@@ -579,6 +607,46 @@ impl MapsModel {
                 invalid
             })
             .sum();
+        // Texels out of gamut, fitted again under the thin epidermis (module `thin_epidermis`).
+        let thin = match opts.thin_epidermis_mm {
+            Some(mm) => {
+                let candidates: Vec<usize> = (0..n)
+                    .filter(|&k| fitted[k] && !in_gamut[k] && !texel_lab(texels[k]).1)
+                    .collect();
+                if candidates.is_empty() {
+                    None
+                } else {
+                    let betas = regions
+                        .as_ref()
+                        .map_or_else(|| vec![beta], |r| r.betas.clone());
+                    let (table, refits) = thin_epidermis::refit(
+                        &self.thin_tables,
+                        opts,
+                        mm,
+                        texels,
+                        &candidates,
+                        labels,
+                        &betas,
+                        gain,
+                        &delta_e,
+                    )?;
+                    let mut flags = vec![false; n];
+                    for &(k, m, h, de) in &refits {
+                        melanin[k] = m;
+                        hemoglobin[k] = h;
+                        delta_e[k] = de;
+                        in_gamut[k] = thin_epidermis::in_gamut(de);
+                        flags[k] = true;
+                    }
+                    (!refits.is_empty()).then_some(ThinEpidermis {
+                        epidermis_mm: mm,
+                        texels: flags,
+                        table,
+                    })
+                }
+            }
+            None => None,
+        };
         let mut residuals: Vec<f32> = delta_e
             .iter()
             .zip(&fitted)
@@ -626,6 +694,9 @@ impl MapsModel {
             exposure: gain,
             exposure_spread: shared.gain_spread,
             regions: regions.as_ref().map(|r| r.summary),
+            thin_epidermis: thin
+                .as_ref()
+                .map_or(0, |t| t.texels.iter().filter(|f| **f).count()),
         };
         let eumelanin_map = regions.as_ref().map(|r| {
             r.label_of_texel
@@ -641,6 +712,7 @@ impl MapsModel {
             delta_e,
             in_gamut,
             fitted,
+            thin_epidermis: thin,
             summary,
         })
     }
@@ -765,8 +837,44 @@ impl MapsModel {
 
 impl MapsModel {
     /// The albedo of `maps` as [`MapsModel::albedo`], with β_m per texel where the maps have it
-    /// (each distinct β_m value gets its slice).
+    /// (each distinct β_m value gets its slice) and the thin-epidermis skin's where a texel has
+    /// it.
     pub fn albedo_of(&self, maps: &Maps) -> Result<Vec<[f32; 3]>, MapsError> {
+        let mut out = self.albedo_per_beta(maps)?;
+        if let Some(thin) = &maps.thin_epidermis {
+            let n = maps.melanin.len();
+            if thin.texels.len() != n {
+                return Err(MapsError::Length {
+                    what: "thin-epidermis flags",
+                    found: thin.texels.len(),
+                    expected: n,
+                });
+            }
+            let pick: Vec<usize> = (0..n).filter(|&k| thin.texels[k]).collect();
+            let sub = Maps {
+                melanin: pick.iter().map(|&k| maps.melanin[k]).collect(),
+                hemoglobin: pick.iter().map(|&k| maps.hemoglobin[k]).collect(),
+                eumelanin: maps.eumelanin,
+                eumelanin_map: maps
+                    .eumelanin_map
+                    .as_ref()
+                    .map(|b| pick.iter().map(|&k| b[k]).collect()),
+                delta_e: Vec::new(),
+                in_gamut: Vec::new(),
+                fitted: Vec::new(),
+                thin_epidermis: None,
+                summary: maps.summary.clone(),
+            };
+            let thin_model = MapsModel::from_table(thin.table.clone());
+            for (k, a) in pick.iter().zip(thin_model.albedo_per_beta(&sub)?) {
+                out[*k] = a;
+            }
+        }
+        Ok(out)
+    }
+
+    /// [`MapsModel::albedo_of`] on this model's table alone.
+    fn albedo_per_beta(&self, maps: &Maps) -> Result<Vec<[f32; 3]>, MapsError> {
         let Some(betas) = &maps.eumelanin_map else {
             return self.albedo(&maps.melanin, maps.eumelanin, &maps.hemoglobin);
         };

@@ -650,3 +650,77 @@ fn eumelanin_per_region_follows_the_texture() {
         "maps option eumelanin regions width = 5 outside a divisor of the texel count"
     );
 }
+
+/// Red texels made by the exact model under a 0.05 mm epidermis (C_m 0.01–0.04, C_h 0.05–0.09,
+/// as lip vermilion) beside skin of the default epidermis: the default skin cannot reach them
+/// (ΔE2000 > 1 without the second skin), the thin-epidermis skin reproduces them within 1
+/// ΔE2000 and returns C_m within 5 % and C_h within 10 % (the table's error near its C_h edge),
+/// while every default-epidermis texel keeps the texture's skin and its in-gamut fit.
+#[test]
+fn thin_epidermis_texels_are_fitted_under_it() {
+    use crate::Parameter;
+    let base = MapsOptions::default().base;
+    let thin_base = Parameter::EpidermisThickness
+        .set(base, THIN_EPIDERMIS_MM)
+        .unwrap();
+    let thin_exact = ColourModel::new(STEP_NM, Method::Exact, thin_base).expect("model");
+    let m = exact();
+    let lips: Vec<[f64; 3]> = (0..8)
+        .map(|k| {
+            let t = k as f64 / 7.0;
+            [0.01 * 4f64.powf(t), 0.6, 0.05 + 0.04 * (1.0 - t)]
+        })
+        .collect();
+    let skin: Vec<[f64; 3]> = synthetic(3, 0.6);
+    let texels: Vec<[f32; 3]> = lips
+        .iter()
+        .map(|p| exact_texel(&thin_exact, *p))
+        .chain(skin.iter().map(|p| exact_texel(&m, *p)))
+        .collect();
+    let opts = MapsOptions {
+        eumelanin: Eumelanin::Fixed(0.6),
+        ..MapsOptions::default()
+    };
+    let one_skin = model()
+        .fit(
+            &texels,
+            None,
+            &MapsOptions {
+                thin_epidermis_mm: None,
+                ..opts.clone()
+            },
+            &|_| {},
+        )
+        .unwrap();
+    let maps = model().fit(&texels, None, &opts, &|_| {}).unwrap();
+    let thin = maps.thin_epidermis.as_ref().expect("thin texels");
+    for (k, p) in lips.iter().enumerate() {
+        assert!(one_skin.delta_e[k] > 1.0, "{k}: {}", one_skin.delta_e[k]);
+        assert!(
+            thin.texels[k] && maps.in_gamut[k],
+            "{k}: {}",
+            maps.delta_e[k]
+        );
+        let (c_m, c_h) = (f64::from(maps.melanin[k]), f64::from(maps.hemoglobin[k]));
+        assert!(
+            (c_m / p[0] - 1.0).abs() <= 0.05,
+            "{k}: C_m {c_m} vs {}",
+            p[0]
+        );
+        assert!(
+            (c_h / p[2] - 1.0).abs() <= 0.1,
+            "{k}: C_h {c_h} vs {}",
+            p[2]
+        );
+    }
+    for k in lips.len()..texels.len() {
+        assert!(!thin.texels[k] && maps.in_gamut[k], "{k}");
+        assert_eq!(maps.melanin[k], one_skin.melanin[k]);
+    }
+    assert_eq!(maps.summary.thin_epidermis, lips.len());
+    let albedo = model().albedo_of(&maps).unwrap();
+    for (k, a) in albedo.iter().enumerate() {
+        let de = delta_e_2000_fast(&texel_lab(*a).0, &texel_lab(texels[k]).0);
+        assert!(de <= 1.0, "{k}: albedo ΔE2000 {de}");
+    }
+}
