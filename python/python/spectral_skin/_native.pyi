@@ -90,7 +90,7 @@ def ita(lab: _In) -> _F:
     """(N, 3) CIELAB → (N,) ITA°, degrees."""
 
 def export(
-    format: str,  # a `Format` name: "openpbr" … "mcx", "blender", "blender-json"
+    format: str,
     params: _In,
     from_nm: float,
     to_nm: float,
