@@ -1,0 +1,107 @@
+//! Our reference for the Cycles sphere: the same sphere of skin rendered by our volumetric walk
+//! (`render::volumetric`, docs/physics.md §15) under the same uniform white sky, its subsurface
+//! part read out over the same disc.
+//!
+//! A sphere under a uniform sky is not a flat slab seen at normal incidence: by reciprocity a pixel
+//! is the sphere's albedo for light arriving from the camera at the pixel's incidence cosine μ, and
+//! light that enters a finite convex body may leave it anywhere, so both the spread of μ over the
+//! disc and the sphere's size (against the skin's diffusion length, millimetres in red) change the
+//! mean. The walk through our two layers on the same sphere holds both.
+//!
+//! The surface is the smooth dielectric (η of the skin), so the specular part of a pixel is the
+//! Fresnel reflectance F(μ) exactly (the sky is uniform and the sphere convex) and the subsurface
+//! part is the pixel minus F(μ).
+
+use brdf::fresnel::dielectric_reflectance;
+use render::integrator::{BodyIntegrator, IntegratorKind};
+use render::material::SkinKnobs;
+use render::renderer::{RenderOptions, render_with};
+use render::scene::Scene;
+use skin_optics::{Preset, SkinParams};
+
+/// Camera distance from the sphere's centre, in sphere radii: far enough that the perspective
+/// view is orthographic within 0.06° at the disc's edge.
+const CAMERA_DISTANCE_RADII: f64 = 500.0;
+
+/// The sphere, its read-out and the render's size.
+#[derive(Debug, Clone, Copy)]
+pub struct SphereView {
+    /// Sphere radius, mm.
+    pub radius_mm: f64,
+    /// Pixels averaged: those whose centre lies within this fraction of the projected radius.
+    pub mask: f64,
+    /// Film side, pixels (the frame is the sphere's bounding square).
+    pub pixels: usize,
+    /// Samples per pixel.
+    pub spp: u32,
+}
+
+/// Mean subsurface part (pixel − F(μ)) over the disc per linear Rec.709 channel and its standard
+/// error over pixels, of the skin preset `preset` (light, medium, dark) as a smooth-faced sphere under a uniform D65 sky of luminance 1
+/// (a white reflector renders as 1 in every channel), rendered by our volumetric walk.
+pub fn volumetric_sphere(
+    preset: &str,
+    view: SphereView,
+    threads: Option<usize>,
+) -> anyhow::Result<([f64; 3], [f64; 3])> {
+    let distance = CAMERA_DISTANCE_RADII * view.radius_mm;
+    let fov_deg = 2.0 * (view.radius_mm / distance).atan().to_degrees();
+    let toml = format!(
+        "[camera]\nposition_mm = [0, 0, {distance}]\nlook_at_mm = [0, 0, 0]\nfov_deg = {fov_deg}\n\
+         [environment]\nspectrum = \"d65\"\nintensity = 1\n\
+         [materials.skin]\ntype = \"skin\"\npreset = \"{preset}\"\nsurface = \"smooth\"\n\
+         [[meshes]]\nshape = \"sphere\"\nmaterial = \"skin\"\nunits_mm = {}\n",
+        view.radius_mm
+    );
+    let scene = Scene::from_toml(&toml, "sphere.toml", None, &SkinKnobs::default())?;
+    let body = BodyIntegrator::build(&scene, IntegratorKind::Volumetric)?;
+    let settings = RenderOptions {
+        width: view.pixels,
+        height: view.pixels,
+        spp: view.spp,
+        seed: 7,
+        threads,
+        integrator: IntegratorKind::Volumetric,
+        ..Default::default()
+    }
+    .validate()?;
+    let (film, _) = render_with(&scene, &body, &settings, None)?;
+    let eta = scene_eta(preset)?;
+    let n = view.pixels;
+    let mut parts: Vec<[f64; 3]> = Vec::new();
+    for y in 0..n {
+        for x in 0..n {
+            let u = (x as f64 + 0.5) / n as f64 * 2.0 - 1.0;
+            let v = (y as f64 + 0.5) / n as f64 * 2.0 - 1.0;
+            let r2 = u * u + v * v;
+            if r2 >= view.mask * view.mask {
+                continue;
+            }
+            let f = dielectric_reflectance((1.0 - r2).sqrt(), eta);
+            let rgb = film.linear_srgb(x, y);
+            parts.push(rgb.map(|c| f64::from(c) - f));
+        }
+    }
+    anyhow::ensure!(
+        parts.len() > 1,
+        "sphere: no pixel within the mask {}",
+        view.mask
+    );
+    let k = parts.len() as f64;
+    let mut mean = [0.0; 3];
+    let mut se = [0.0; 3];
+    for c in 0..3 {
+        mean[c] = parts.iter().map(|p| p[c]).sum::<f64>() / k;
+        let var = parts.iter().map(|p| (p[c] - mean[c]).powi(2)).sum::<f64>() / (k - 1.0);
+        se[c] = (var / k).sqrt();
+    }
+    Ok((mean, se))
+}
+
+/// Index of refraction of the preset's skin (the smooth face's η).
+fn scene_eta(preset: &str) -> anyhow::Result<f64> {
+    let p: Preset = preset
+        .parse()
+        .map_err(|e| anyhow::anyhow!("sphere preset {preset}: {e}"))?;
+    Ok(SkinParams::preset(p).eta())
+}
