@@ -74,7 +74,7 @@ struct EnginesArgs {
     cycles_spp: u32,
     /// Samples per pixel of our volumetric sphere (48 × 48 pixels), the Cycles sphere's
     /// reference, [1, 65536].
-    #[arg(long = "sphere-spp", value_name = "N", default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=65_536))]
+    #[arg(long = "sphere-spp", value_name = "N", default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=65_536))]
     sphere_spp: u32,
     /// Photons of each MCX run, [1000, 1e9].
     #[arg(long = "mcx-photons", value_name = "N", default_value_t = 100_000, value_parser = clap::value_parser!(u64).range(1_000..=1_000_000_000))]

@@ -13,8 +13,9 @@
 //! - **Blender Cycles** (bpy): the `blender` script's Principled BSDF (Random Walk and Random Walk
 //!   (Skin)) on the flat slab at normal view and over a sphere, both under a uniform white sky, its
 //!   subsurface part (the render minus the same render with Base Color 0) against the RGB of
-//!   `skin spectrum`'s diffuse reflectance; and its volumetric slab (`volume_slab()`) against F(0)
-//!   + that reflectance.
+//!   `skin spectrum`'s diffuse reflectance, and the sphere's also against our volumetric walk on the
+//!   same sphere (`sphere`), the reference a sphere under a sky has; and its volumetric slab
+//!   (`volume_slab()`) against F(0) + that reflectance.
 
 pub mod sphere;
 

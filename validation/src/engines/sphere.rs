@@ -13,6 +13,7 @@
 //! part is the pixel minus F(μ).
 
 use brdf::fresnel::dielectric_reflectance;
+use render::fidelity::FidelityKnobs;
 use render::integrator::{BodyIntegrator, IntegratorKind};
 use render::material::SkinKnobs;
 use render::renderer::{RenderOptions, render_with};
@@ -20,7 +21,7 @@ use render::scene::Scene;
 use skin_optics::{Preset, SkinParams};
 
 /// Camera distance from the sphere's centre, in sphere radii: far enough that the perspective
-/// view is orthographic within 0.06° at the disc's edge.
+/// rays are parallel within 0.12° (the pixel's μ is taken as the orthographic one).
 const CAMERA_DISTANCE_RADII: f64 = 500.0;
 
 /// The sphere, its read-out and the render's size.
@@ -53,9 +54,17 @@ pub fn volumetric_sphere(
          [[meshes]]\nshape = \"sphere\"\nmaterial = \"skin\"\nunits_mm = {}\n",
         view.radius_mm
     );
-    let scene = Scene::from_toml(&toml, "sphere.toml", None, &SkinKnobs::default())?;
+    // The fidelity the command line resolves for this film (`skin render --height`).
+    let knobs = SkinKnobs {
+        fidelity: FidelityKnobs {
+            image_height: Some(u32::try_from(view.pixels)?),
+            ..FidelityKnobs::default()
+        },
+        ..SkinKnobs::default()
+    };
+    let scene = Scene::from_toml(&toml, "sphere.toml", None, &knobs)?;
     let body = BodyIntegrator::build(&scene, IntegratorKind::Volumetric)?;
-    let settings = RenderOptions {
+    let mut options = RenderOptions {
         width: view.pixels,
         height: view.pixels,
         spp: view.spp,
@@ -63,8 +72,10 @@ pub fn volumetric_sphere(
         threads,
         integrator: IntegratorKind::Volumetric,
         ..Default::default()
-    }
-    .validate()?;
+    };
+    // As `skin render` does: the level of detail follows the camera's pixel footprint.
+    options.path.pixel_angle_rad = scene.camera.pixel_angle_rad(view.pixels);
+    let settings = options.validate()?;
     let (film, _) = render_with(&scene, &body, &settings, None)?;
     let eta = scene_eta(preset)?;
     let n = view.pixels;
