@@ -125,7 +125,7 @@ mod tests {
     /// larger, returns the same disc mean at any radius (a half-space's reflectance has no length
     /// scale): 20 and 40 mm agree within 4σ. A camera, field of view or mask that did not follow
     /// the radius would pair pixels with the wrong F(μ) (F is 0.04–0.2 over the disc against a
-    /// subsurface part of 0.009–0.018) and fail this.
+    /// subsurface part of 0.010–0.020) and fail this.
     #[test]
     fn dark_sphere_subsurface_part_does_not_depend_on_the_radius() {
         let view = |radius_mm| SphereView {
