@@ -23,6 +23,7 @@ SLAB_HALF_WIDTH_MM = 50.0
 SLAB_THICKNESS_MM = 50.0
 SPHERE_RADIUS_MM = 20.0
 SPHERE_MASK = 0.95
+SPHERE_SIDE_PX = 48
 
 
 def reset(spp, px, seed=1, threads=2):

@@ -27,7 +27,7 @@ import cycles_common as cc  # noqa: E402
 
 
 def principled(skin, scene_name, method, spp, base_zero, seed):
-    px = 16 if scene_name == "slab" else 48
+    px = 16 if scene_name == "slab" else cc.SPHERE_SIDE_PX
     scene = cc.reset(spp, px, seed=seed)
     cc.light_paths(scene, 16)
     mat = skin["subsurface_material"](method)
@@ -99,6 +99,9 @@ def main():
         "stderr": [float(x) for x in se],
         "specular": [float(x) for x in spec],
         "pixels": n,
+        "radius_mm": cc.SPHERE_RADIUS_MM,
+        "mask": cc.SPHERE_MASK,
+        "side": cc.SPHERE_SIDE_PX,
     }))
 
 

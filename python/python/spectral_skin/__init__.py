@@ -489,7 +489,18 @@ def fit_colour(
 
 def export(
     format: Literal[
-        "openpbr", "standard-surface", "unreal", "hdrp", "gaussians", "burley", "pbrt", "mitsuba", "mcml", "mcx"
+        "openpbr",
+        "standard-surface",
+        "unreal",
+        "hdrp",
+        "gaussians",
+        "burley",
+        "pbrt",
+        "mitsuba",
+        "mcml",
+        "mcx",
+        "blender",
+        "blender-json",
     ],
     *,
     preset: str | None = None,

@@ -72,6 +72,10 @@ struct EnginesArgs {
     /// Samples per pixel of the Cycles renders, [1, 65536].
     #[arg(long = "cycles-spp", value_name = "N", default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=65_536))]
     cycles_spp: u32,
+    /// Samples per pixel of our volumetric sphere (48 × 48 pixels), the Cycles sphere's
+    /// reference, [1, 65536].
+    #[arg(long = "sphere-spp", value_name = "N", default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=65_536))]
+    sphere_spp: u32,
     /// Photons of each MCX run, [1000, 1e9].
     #[arg(long = "mcx-photons", value_name = "N", default_value_t = 100_000, value_parser = clap::value_parser!(u64).range(1_000..=1_000_000_000))]
     mcx_photons: u64,
@@ -99,6 +103,7 @@ fn run_engines(args: &EnginesArgs) -> anyhow::Result<()> {
         out: args.out.clone(),
         spp: args.spp,
         cycles_spp: args.cycles_spp,
+        sphere_spp: args.sphere_spp,
         mcx_photons: args.mcx_photons,
         mcx_preload: args.mcx_ld_preload.clone(),
         only: args.engine.clone(),

@@ -13,8 +13,11 @@
 //! - **Blender Cycles** (bpy): the `blender` script's Principled BSDF (Random Walk and Random Walk
 //!   (Skin)) on the flat slab at normal view and over a sphere, both under a uniform white sky, its
 //!   subsurface part (the render minus the same render with Base Color 0) against the RGB of
-//!   `skin spectrum`'s diffuse reflectance; and its volumetric slab (`volume_slab()`) against F(0)
-//!   + that reflectance.
+//!   `skin spectrum`'s diffuse reflectance, and the sphere's also against our volumetric walk on the
+//!   same sphere (`sphere`), the reference a sphere under a sky has; and its volumetric slab
+//!   (`volume_slab()`) against F(0) + that reflectance.
+
+pub mod sphere;
 
 use anyhow::{Context, bail};
 use skin_export::mitsuba::Variant;
@@ -41,6 +44,8 @@ pub struct EngineOptions {
     pub spp: u32,
     /// Samples per pixel of the Cycles renders.
     pub cycles_spp: u32,
+    /// Samples per pixel of our volumetric sphere, the Cycles sphere's reference.
+    pub sphere_spp: u32,
     /// Photons of each MCX run.
     pub mcx_photons: u64,
     /// Run only the engines whose Python module is listed (empty: every engine).
@@ -340,6 +345,7 @@ fn cycles(opts: &EngineOptions, rows: &mut Vec<Row>) -> anyhow::Result<()> {
         // exactly by the volumetric slab at four view angles.
         let white = driver(opts, "cycles_render.py", &[file, "volume_white", "-", &spp])?;
         let (white_mean, white_se) = (numbers(&white["mean"]), numbers(&white["stderr"]));
+        let mut ours_sphere: Option<([f64; 3], [f64; 3])> = None;
         for (scene, method) in cases {
             let v = driver(opts, "cycles_render.py", &[file, scene, method, &spp])?;
             let engine = format!("Cycles {}", v["version"].as_str().unwrap_or("?"));
@@ -374,6 +380,30 @@ fn cycles(opts: &EngineOptions, rows: &mut Vec<Row>) -> anyhow::Result<()> {
                 });
             }
             if scene == "sphere" {
+                let view = sphere::SphereView {
+                    radius_mm: v["radius_mm"].as_f64().context("sphere radius_mm")?,
+                    mask: v["mask"].as_f64().context("sphere mask")?,
+                    pixels: v["side"].as_u64().context("sphere side")? as usize,
+                    spp: opts.sphere_spp,
+                };
+                let (walk_mean, walk_se) = match ours_sphere {
+                    Some(x) => x,
+                    None => *ours_sphere.insert(sphere::volumetric_sphere(name, view, None)?),
+                };
+                for c in 0..3 {
+                    rows.push(Row {
+                        engine: engine.clone(),
+                        preset: name,
+                        quantity: format!(
+                            "Principled {method}, sphere under white sky ({spp} spp): subsurface part against our volumetric walk on the same sphere ({} spp; its stderr added)",
+                            opts.sphere_spp
+                        ),
+                        channel: ["R", "G", "B"][c].into(),
+                        ours: walk_mean[c],
+                        engine_value: mean[c],
+                        engine_stderr: se[c].hypot(walk_se[c]),
+                    });
+                }
                 for c in 0..3 {
                     rows.push(Row {
                         engine: engine.clone(),
