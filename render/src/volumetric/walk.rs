@@ -27,6 +27,7 @@
 //! smooth normal there would refract into directions the flat face does not allow.
 
 use super::SkinVolume;
+use super::distance::SurfaceDistance;
 use crate::accel::BVH_MIN_T_MM;
 use crate::bssrdf::Directional;
 use crate::geometry::{Geometry, SurfaceHit};
@@ -133,47 +134,22 @@ pub fn walk<R: RngCore>(
         } else {
             f64::INFINITY
         };
-        let delta = anchor.x0.distance(x);
-        if ahead.is_none() && s >= anchor.lo - delta {
-            // D(x) ≤ hi + δ: when the flight is longer, fresh bounds could not clear it.
-            let lo = if s < anchor.hi + delta {
-                anchor = Anchor::at(region, x);
-                anchor.lo
-            } else {
-                anchor.lo - delta
-            };
-            if s >= lo {
-                // Only as far as the flight goes: a short ray visits few BVH nodes.
-                *rays += 1;
-                match surface_ahead(geometry, material, x, d, s, on_face) {
-                    Ahead::Surface(b) => ahead = Some(b),
-                    Ahead::Clear if region.encloses(x + d * s) => {}
-                    // Not a closed mesh around x: the light is lost.
-                    Ahead::Clear | Ahead::Lost => return out,
-                }
+        if ahead.is_none() {
+            let flight = Flight { x, d, s, on_face };
+            match look_ahead(geometry, material, region, &mut anchor, flight, rays) {
+                Ahead::Surface(b) => ahead = Some(b),
+                Ahead::Clear => {}
+                Ahead::Lost => return out,
             }
         }
         if let Some(b) = ahead.filter(|b| s >= b.t) {
-            // At the surface, from inside.
-            let dir32 = d.as_vec3();
-            let n_out = if b.hit.ng.dot(dir32) > 0.0 {
-                b.hit.ng
-            } else {
-                -b.hit.ng
-            };
-            if let Some(t) = refract(dir32, -n_out, vol.eta)
-                && rng.random::<f32>() < directional.transmittance(t.dot(n_out))
-            {
-                out.exit = Some(Exit {
-                    p: b.p.as_vec3(),
-                    ng: n_out,
-                    dir: t,
-                    weight: w as f32,
-                });
-                return out;
+            match meet_surface(&b, d, vol, directional, w, rng) {
+                Ok(exit) => {
+                    out.exit = Some(exit);
+                    return out;
+                }
+                Err(reflected) => d = reflected,
             }
-            let n = n_out.as_dvec3();
-            d = (d - n * (2.0 * d.dot(n))).normalize();
             x = b.p;
             on_face = Some(b.hit.triangle);
             anchor = Anchor::surface(x);
@@ -188,36 +164,125 @@ pub fn walk<R: RngCore>(
         out.tentative += 1;
         let (sa, ss) = if one_layer {
             dermis
+        } else if in_epidermis(region, &mut anchor, x, d_epi) {
+            epidermis
         } else {
-            let delta = anchor.x0.distance(x);
-            let in_epidermis = if anchor.lo - delta > d_epi {
-                false
-            } else if anchor.hi + delta <= d_epi {
-                true
-            } else {
-                anchor = Anchor::at(region, x);
-                anchor.hi <= d_epi
-            };
-            if in_epidermis { epidermis } else { dermis }
+            dermis
         };
         if rng.random::<f32>() * majorant >= sa + ss {
             continue; // null collision
         }
         out.collisions += 1;
-        w *= f64::from(ss / (sa + ss));
-        if w == 0.0 {
-            return out;
-        }
-        if w < ROULETTE_BELOW {
-            if rng.random::<f64>() * ROULETTE_BELOW >= w {
-                return out;
-            }
-            w = ROULETTE_BELOW;
+        match after_collision(w, sa, ss, rng) {
+            Some(kept) => w = kept,
+            None => return out,
         }
         d = DVec3::from_array(scatter_direction(d.to_array(), &vol.hg, rng)).normalize();
         ahead = None;
     }
     out
+}
+
+/// A free flight: from `x` along unit `d` for `s` mm, starting on face `on_face` if any.
+#[derive(Debug, Clone, Copy)]
+struct Flight {
+    x: DVec3,
+    d: DVec3,
+    s: f64,
+    on_face: Option<u32>,
+}
+
+/// The surface the flight could reach, found only when the anchor's bounds (refreshed when they
+/// could decide) do not clear the whole flight: `Clear` when the flight stays inside the body,
+/// `Lost` when the mesh is not closed around the point.
+fn look_ahead(
+    geometry: &Geometry,
+    material: u32,
+    region: &SurfaceDistance,
+    anchor: &mut Anchor,
+    f: Flight,
+    rays: &mut u64,
+) -> Ahead {
+    let delta = anchor.x0.distance(f.x);
+    if f.s < anchor.lo - delta {
+        return Ahead::Clear;
+    }
+    // D(x) ≤ hi + δ: when the flight is longer, fresh bounds could not clear it.
+    let lo = if f.s < anchor.hi + delta {
+        *anchor = Anchor::at(region, f.x);
+        anchor.lo
+    } else {
+        anchor.lo - delta
+    };
+    if f.s < lo {
+        return Ahead::Clear;
+    }
+    // Only as far as the flight goes: a short ray visits few BVH nodes.
+    *rays += 1;
+    match surface_ahead(geometry, material, f.x, f.d, f.s, f.on_face) {
+        Ahead::Clear if !region.encloses(f.x + f.d * f.s) => Ahead::Lost,
+        found => found,
+    }
+}
+
+/// At the surface `b` from inside along `d`: the light leaves with probability T of its refracted
+/// direction (the exit, carrying weight `w`), or is reflected (the new direction).
+fn meet_surface<R: RngCore>(
+    b: &Boundary,
+    d: DVec3,
+    vol: &SkinVolume,
+    directional: &Directional,
+    w: f64,
+    rng: &mut R,
+) -> Result<Exit, DVec3> {
+    let dir32 = d.as_vec3();
+    let n_out = if b.hit.ng.dot(dir32) > 0.0 {
+        b.hit.ng
+    } else {
+        -b.hit.ng
+    };
+    if let Some(t) = refract(dir32, -n_out, vol.eta)
+        && rng.random::<f32>() < directional.transmittance(t.dot(n_out))
+    {
+        return Ok(Exit {
+            p: b.p.as_vec3(),
+            ng: n_out,
+            dir: t,
+            weight: w as f32,
+        });
+    }
+    let n = n_out.as_dvec3();
+    Err((d - n * (2.0 * d.dot(n))).normalize())
+}
+
+/// Whether `x` lies within `d_epi` of the surface (the epidermis), from the anchor's bounds where
+/// they decide and from fresh bounds at `x` (which become the anchor) where they do not.
+fn in_epidermis(region: &SurfaceDistance, anchor: &mut Anchor, x: DVec3, d_epi: f64) -> bool {
+    let delta = anchor.x0.distance(x);
+    if anchor.lo - delta > d_epi {
+        false
+    } else if anchor.hi + delta <= d_epi {
+        true
+    } else {
+        *anchor = Anchor::at(region, x);
+        anchor.hi <= d_epi
+    }
+}
+
+/// The path's weight after a real collision of single-scattering albedo σs/(σa + σs), with Russian
+/// roulette below [`ROULETTE_BELOW`] ([AK90]); `None` when the path ends.
+fn after_collision<R: RngCore>(w: f64, sa: f32, ss: f32, rng: &mut R) -> Option<f64> {
+    let w = w * f64::from(ss / (sa + ss));
+    if w == 0.0 {
+        return None;
+    }
+    if w < ROULETTE_BELOW {
+        if rng.random::<f64>() * ROULETTE_BELOW >= w {
+            return None;
+        }
+        return Some(ROULETTE_BELOW);
+    }
+    Some(w)
 }
 
 /// A point and bounds lo ≤ D ≤ hi on its distance D to the surface, mm.
@@ -239,7 +304,7 @@ impl Anchor {
     }
 
     /// The bounds at `x0`.
-    fn at(region: &super::distance::SurfaceDistance, x0: DVec3) -> Self {
+    fn at(region: &SurfaceDistance, x0: DVec3) -> Self {
         let (lo, hi) = region.bounds(x0);
         Self { x0, lo, hi }
     }
