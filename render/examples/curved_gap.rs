@@ -70,7 +70,7 @@ fn vol(scene: &Scene, side: usize, spp: u32, nm: f32, key: &str) -> Film {
 }
 
 fn run(scene: &Scene, kind: IntegratorKind, side: usize, spp: u32, nm: f32) -> Film {
-    let body = BodyIntegrator::build(scene, kind).unwrap();
+    let body = BodyIntegrator::build(scene, kind);
     let opts = RenderOptions {
         width: side,
         height: side,

@@ -63,7 +63,7 @@ fn main() -> anyhow::Result<()> {
             let alone = load(Some(0.0))?;
             let reference = run(
                 &default,
-                &BodyIntegrator::build(&default, IntegratorKind::Volumetric)?,
+                &BodyIntegrator::build(&default, IntegratorKind::Volumetric),
                 ThinExit::Refracted,
                 side,
                 ref_spp,
@@ -100,7 +100,7 @@ fn main() -> anyhow::Result<()> {
                 ),
             ];
             for (label, scene, kind, exit, n) in rows {
-                let body = BodyIntegrator::build(scene, kind)?;
+                let body = BodyIntegrator::build(scene, kind);
                 let r = if kind == IntegratorKind::Volumetric {
                     reference
                 } else {
@@ -162,7 +162,7 @@ fn ear(side: usize, spp: u32, ref_spp: u32) -> anyhow::Result<()> {
     // exits) needs thousands of samples per pixel; the walk everywhere (k = 10) is the low-noise
     // comparison, checked against it within its noise.
     if ref_spp > 0 {
-        let vol = BodyIntegrator::build(&default, IntegratorKind::Volumetric)?;
+        let vol = BodyIntegrator::build(&default, IntegratorKind::Volumetric);
         let r = run(&default, &vol, ThinExit::Refracted, side, ref_spp, 2)?;
         println!(
             "volumetric reference,{ref_spp},{:.5},{:.5},{:.2},{:.5},0",
@@ -185,7 +185,7 @@ fn ear(side: usize, spp: u32, ref_spp: u32) -> anyhow::Result<()> {
         ("k 10 (walk everywhere)", Some(10.0), ThinExit::LightSampled),
     ] {
         let scene = load(k)?;
-        let body = BodyIntegrator::build(&scene, IntegratorKind::Bssrdf)?;
+        let body = BodyIntegrator::build(&scene, IntegratorKind::Bssrdf);
         let r = run(&scene, &body, exit, side, spp, 1)?;
         let walked = body
             .thin_parts()

@@ -31,7 +31,7 @@ fn main() -> anyhow::Result<()> {
         .replace("fov_deg = 20", "fov_deg = 24");
     let skin_scene = Scene::from_toml(&skin_sphere, "skin.toml", None, &SkinKnobs::default())?;
     {
-        let body = BodyIntegrator::build(&skin_scene, IntegratorKind::Volumetric)?;
+        let body = BodyIntegrator::build(&skin_scene, IntegratorKind::Volumetric);
         let only: Option<u32> = std::env::args().nth(1).map(|s| s.parse()).transpose()?;
         let opts = RenderOptions {
             width: 64,
@@ -57,7 +57,7 @@ fn main() -> anyhow::Result<()> {
             return Ok(());
         }
     }
-    let two_layer = Volumetric::build(&scene)?;
+    let two_layer = Volumetric::build(&scene);
     // Homogeneous: both layers the dermis.
     let mut homogeneous = two_layer.clone();
     if let Some(Some(m)) = homogeneous.media.first_mut() {
@@ -98,7 +98,7 @@ fn main() -> anyhow::Result<()> {
 fn distance_cost() -> anyhow::Result<()> {
     let head = Scene::load("builtin:ear", &SkinKnobs::default())?;
     let BodyIntegrator::Volumetric(Volumetric { media }) =
-        BodyIntegrator::build(&head, IntegratorKind::Volumetric)?
+        BodyIntegrator::build(&head, IntegratorKind::Volumetric)
     else {
         anyhow::bail!("no media");
     };

@@ -76,9 +76,6 @@ pub enum RenderError {
     /// A render option outside its range (see [`crate::renderer::RenderOptions::validate`]).
     #[error(transparent)]
     Settings(#[from] SettingError),
-    /// The volumetric media of a skin material could not be built.
-    #[error(transparent)]
-    Volumetric(#[from] VolumetricError),
     /// The render's worker threads could not be started.
     #[error("cannot start {threads:?} render threads: {message}")]
     Threads {
@@ -110,21 +107,6 @@ pub struct SettingError {
     pub value: String,
     /// The valid range.
     pub range: &'static str,
-}
-
-/// Why the volumetric media could not be built.
-#[derive(Debug, Error)]
-pub enum VolumetricError {
-    /// A skin's layers at one wavelength were refused by the layered-medium description.
-    #[error("material {material}: layers at {nm} nm: {source}")]
-    Layers {
-        /// The material's name.
-        material: String,
-        /// The wavelength, nm.
-        nm: f64,
-        /// What `multipole::layered` reported.
-        source: multipole::MultipoleError,
-    },
 }
 
 impl From<skin_io::input::InputError> for RenderError {

@@ -226,7 +226,7 @@ pub fn render(
     scene: &Scene,
     settings: &RenderSettings,
 ) -> Result<(Film, RenderStats), RenderError> {
-    let body = BodyIntegrator::build(scene, settings.integrator)?;
+    let body = BodyIntegrator::build(scene, settings.integrator);
     render_with(scene, &body, settings, None)
 }
 

@@ -290,7 +290,7 @@ fn auto_slab(thickness_mm: f32, backlit: bool, side: usize, spp: u32, seed: u64)
     let dir = tempfile::tempdir().unwrap();
     let toml = slab_scene(dir.path(), thickness_mm, backlit);
     let scene = load_slab(&toml, Some(render::fidelity::DEFAULT_THIN_WALK_R99));
-    let body = BodyIntegrator::build(&scene, IntegratorKind::Bssrdf).unwrap();
+    let body = BodyIntegrator::build(&scene, IntegratorKind::Bssrdf);
     let (_, _, film) = mean_y(&scene, &body, side, spp, seed);
     let counts = body.thin_parts().unwrap().part(0).unwrap().counts();
     AutoSlab {
@@ -315,14 +315,14 @@ fn default_backlit_slabs_match_the_volumetric_reference() {
         let dir = tempfile::tempdir().unwrap();
         let toml = slab_scene(dir.path(), mm, true);
         let scene = load_slab(&toml, None);
-        let body = BodyIntegrator::build(&scene, IntegratorKind::Bssrdf).unwrap();
+        let body = BodyIntegrator::build(&scene, IntegratorKind::Bssrdf);
         let (y, err, _) = mean_y(&scene, &body, side, spp, 1);
         let (tested, walked) = body.thin_parts().unwrap().part(0).unwrap().counts();
         assert!(
             tested > 0 && walked as f64 >= 0.95 * tested as f64,
             "{mm} mm: {walked}/{tested} walked"
         );
-        let volumetric = BodyIntegrator::build(&scene, IntegratorKind::Volumetric).unwrap();
+        let volumetric = BodyIntegrator::build(&scene, IntegratorKind::Volumetric);
         let (y_ref, e_ref, _) = mean_y(&scene, &volumetric, side, spp, 2);
         let sigma = err.hypot(e_ref);
         assert!(
@@ -330,7 +330,7 @@ fn default_backlit_slabs_match_the_volumetric_reference() {
             "{mm} mm: default {y} ± {err} against the reference {y_ref} ± {e_ref}"
         );
         let alone = load_slab(&toml, Some(0.0));
-        let bssrdf = BodyIntegrator::build(&alone, IntegratorKind::Bssrdf).unwrap();
+        let bssrdf = BodyIntegrator::build(&alone, IntegratorKind::Bssrdf);
         assert!(bssrdf.thin_parts().is_none());
         let (y_bssrdf, e_bssrdf, _) = mean_y(&alone, &bssrdf, side, spp, 3);
         assert!(
@@ -348,7 +348,7 @@ fn the_thin_walk_keeps_the_bssrdf_on_a_thick_slab() {
     let (tested, walked) = auto.counts;
     assert!(tested > 0 && walked == 0, "{walked}/{tested} walked");
     let thick = load_slab(&auto.toml, Some(0.0));
-    let bssrdf = BodyIntegrator::build(&thick, IntegratorKind::Bssrdf).unwrap();
+    let bssrdf = BodyIntegrator::build(&thick, IntegratorKind::Bssrdf);
     let (_, _, b) = mean_y(&thick, &bssrdf, 8, 4, 7);
     assert_eq!(auto.film, b);
 }
@@ -363,12 +363,12 @@ fn a_thin_slab_lit_only_from_the_front_keeps_the_bssrdf() {
         .replace("[environment]\nspectrum = \"d65\"\nintensity = 0.02\n", "");
     assert!(!toml.contains("[environment]"));
     let scene = load_slab(&toml, None);
-    let body = BodyIntegrator::build(&scene, IntegratorKind::Bssrdf).unwrap();
+    let body = BodyIntegrator::build(&scene, IntegratorKind::Bssrdf);
     let (_, _, film) = mean_y(&scene, &body, 8, 4, 7);
     let (tested, walked) = body.thin_parts().unwrap().part(0).unwrap().counts();
     assert!(tested > 0 && walked == 0, "{walked}/{tested} walked");
     let alone = load_slab(&toml, Some(0.0));
-    let bssrdf = BodyIntegrator::build(&alone, IntegratorKind::Bssrdf).unwrap();
+    let bssrdf = BodyIntegrator::build(&alone, IntegratorKind::Bssrdf);
     let (_, _, b) = mean_y(&alone, &bssrdf, 8, 4, 7);
     assert_eq!(film, b);
 }

@@ -350,7 +350,7 @@ mod against_the_walk {
         "melanin = 0.05\neumelanin = 0.7\nhemoglobin = 0.02\nsurface = \"smooth\"\nphase_g = 0";
 
     fn render(scene: &Scene, kind: IntegratorKind, side: usize, spp: u32, nm: f32) -> Film {
-        let body = BodyIntegrator::build(scene, kind).unwrap();
+        let body = BodyIntegrator::build(scene, kind);
         let opts = RenderOptions {
             width: side,
             height: side,

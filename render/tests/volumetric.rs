@@ -88,7 +88,7 @@ fn slab_matches_adding_doubling_and_monte_carlo() {
     for (g, spp) in [(0.9, 1500), (0.0, 1500)] {
         let keys = format!("preset = \"light\"\nsurface = \"smooth\"\nphase_g = {g}");
         let scene = box_scene(dir.path(), [200.0, 200.0, 20.0], 0.0, &keys);
-        let body = BodyIntegrator::build(&scene, IntegratorKind::Volumetric).unwrap();
+        let body = BodyIntegrator::build(&scene, IntegratorKind::Volumetric);
         let film = render_mono(&scene, &body, 4, spp, 11);
         let (l, sigma) = mean_and_sigma(&film);
         let ad = skin_totals(
@@ -208,7 +208,7 @@ fn one_wavelength_black_absorber_is_exactly_fresnel() {
         )
         .with_surface_kind(SurfaceKind::Smooth);
         scene.materials[0] = Material::Skin(black);
-        let body = BodyIntegrator::build(&scene, IntegratorKind::Bssrdf).unwrap();
+        let body = BodyIntegrator::build(&scene, IntegratorKind::Bssrdf);
         let film = render_mono(&scene, &body, 4, 16, 9);
         let (l, _) = mean_and_sigma(&film);
         let (lo, hi) = fresnel_bounds(theta);
@@ -259,7 +259,7 @@ fn the_walk_is_independent_of_the_mesh_scale() {
         );
         let scene =
             Scene::from_toml(&text, "cube.toml", Some(dir.path()), &SkinKnobs::default()).unwrap();
-        let body = BodyIntegrator::build(&scene, IntegratorKind::Volumetric).unwrap();
+        let body = BodyIntegrator::build(&scene, IntegratorKind::Volumetric);
         let opts = RenderOptions {
             width: 4,
             height: 4,
@@ -309,7 +309,7 @@ fn the_walk_is_independent_of_the_tessellation() {
             scene.geometry.triangle_count(),
             20 * 4usize.pow(subdivisions)
         );
-        let body = BodyIntegrator::build(&scene, IntegratorKind::Volumetric).unwrap();
+        let body = BodyIntegrator::build(&scene, IntegratorKind::Volumetric);
         let film = render_mono(&scene, &body, 4, 2000, 3);
         let (l, sigma) = mean_and_sigma(&film);
         eprintln!(

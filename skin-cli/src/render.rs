@@ -213,7 +213,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
             ..SkinKnobs::default()
         },
     )?;
-    let body = BodyIntegrator::build(&scene, options.integrator)?;
+    let body = BodyIntegrator::build(&scene, options.integrator);
     let load = t0.elapsed();
     let skins = scene.skin_choices();
     if args.explain {

@@ -102,7 +102,7 @@ fn our_scene(dir: &Path, body: Body) -> anyhow::Result<((Scene, BodyIntegrator),
             g: 0.0,
             eta: skin.params.eta(),
         };
-        let integrator = BodyIntegrator::build(&scene, IntegratorKind::Volumetric)?;
+        let integrator = BodyIntegrator::build(&scene, IntegratorKind::Volumetric);
         return Ok(((scene, integrator), media));
     }
     let volume = SkinVolume::new(

@@ -32,7 +32,7 @@ use crate::material::{Bsdf, Material};
 use crate::sampler::{PathSampler, SamplerKind};
 use crate::scene::{Hit, Scene};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths, WavelengthSampling};
-use crate::volumetric::{SkinVolume, ThinParts, Volumetric, VolumetricError};
+use crate::volumetric::{SkinVolume, ThinParts, Volumetric};
 use glam::Vec3;
 use lights::{PrevVertex, Receiver, direct_light, light_probabilities};
 
@@ -148,11 +148,12 @@ pub enum BodyIntegrator {
 
 impl BodyIntegrator {
     /// The `kind` integrator's state for `scene`.
-    pub fn build(scene: &Scene, kind: IntegratorKind) -> Result<Self, VolumetricError> {
-        Ok(match kind {
-            IntegratorKind::Bssrdf => Self::Bssrdf(ThinParts::build(scene)?),
-            IntegratorKind::Volumetric => Self::Volumetric(Volumetric::build(scene)?),
-        })
+    #[must_use]
+    pub fn build(scene: &Scene, kind: IntegratorKind) -> Self {
+        match kind {
+            IntegratorKind::Bssrdf => Self::Bssrdf(ThinParts::build(scene)),
+            IntegratorKind::Volumetric => Self::Volumetric(Volumetric::build(scene)),
+        }
     }
 
     /// The thin-part walks, if any skin takes them.

@@ -18,7 +18,6 @@ use crate::spectrum::{N_WAVELENGTHS, SampledSpectrum};
 use distance::SurfaceDistance;
 use multipole::exact::montecarlo::HgSampler;
 
-pub use crate::error::VolumetricError;
 pub use crate::media::LayerTables;
 pub use thin::{ThinPart, ThinParts};
 pub use walk::{Exit, Walk, walk};
@@ -68,8 +67,9 @@ pub struct Volumetric {
 }
 
 impl Volumetric {
-    /// The media of every skin material of `scene`, from its parameters and `phase_g`.
-    pub fn build(scene: &Scene) -> Result<Self, VolumetricError> {
+    /// The media of every skin material of `scene`: its layers (`SkinMedia`) inside its meshes.
+    #[must_use]
+    pub fn build(scene: &Scene) -> Self {
         let mut media = Vec::with_capacity(scene.materials.len());
         for (index, m) in scene.materials.iter().enumerate() {
             let Material::Skin(skin) = m else {
@@ -86,7 +86,7 @@ impl Volumetric {
                 triangles,
             )));
         }
-        Ok(Self { media })
+        Self { media }
     }
 
     /// The medium of material `material`, if it is skin.

@@ -23,7 +23,7 @@
 //! paths. There the hit keeps the BSSRDF and no probe ray is traced, as the level of detail
 //! (`crate::fidelity::lod`) keeps no profile the footprint cannot resolve.
 
-use super::{LayerTables, SkinVolume, VolumetricError};
+use super::{LayerTables, SkinVolume};
 use crate::geometry::{SurfaceHit, offset_origin};
 use crate::light::Light;
 use crate::material::Material;
@@ -59,7 +59,8 @@ pub struct ThinParts {
 impl ThinParts {
     /// The thin-part walks of every skin material of `scene` whose choices ask for one; `None`
     /// when none does.
-    pub fn build(scene: &Scene) -> Result<Option<Self>, VolumetricError> {
+    #[must_use]
+    pub fn build(scene: &Scene) -> Option<Self> {
         let mut parts = Vec::with_capacity(scene.materials.len());
         for m in &scene.materials {
             let below = match m {
@@ -85,7 +86,7 @@ impl ThinParts {
                 front_lit: AtomicU64::new(0),
             }));
         }
-        Ok(parts.iter().any(Option::is_some).then_some(Self { parts }))
+        parts.iter().any(Option::is_some).then_some(Self { parts })
     }
 
     /// The thin-part walk of material `material`, if it has one.

@@ -433,7 +433,7 @@ fn load_as(toml: &str, config: Config) -> anyhow::Result<Loaded> {
     } else {
         IntegratorKind::Bssrdf
     };
-    let body = BodyIntegrator::build(&scene, kind)?;
+    let body = BodyIntegrator::build(&scene, kind);
     Ok(Loaded { scene, body })
 }
 

@@ -63,7 +63,7 @@ pub fn volumetric_sphere(
         ..SkinKnobs::default()
     };
     let scene = Scene::from_toml(&toml, "sphere.toml", None, &knobs)?;
-    let body = BodyIntegrator::build(&scene, IntegratorKind::Volumetric)?;
+    let body = BodyIntegrator::build(&scene, IntegratorKind::Volumetric);
     let mut options = RenderOptions {
         width: view.pixels,
         height: view.pixels,
