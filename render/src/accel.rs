@@ -22,7 +22,7 @@ use std::time::Duration;
 /// The CWBVH build: obvhs's `very_slow_build` (reinsertion over every node) without its spatial
 /// pre-splits, so each triangle is in exactly one leaf (the all-hits query reports it once). Its
 /// traversal costs fewer instructions per path than `medium_build`'s for a slower build
-/// (docs/benchmarks-archive.md, "Image noise: session 7").
+/// (docs/benchmarks-archive.md, "Image noise: traversal, allocation and profile lookups").
 pub const BVH_BUILD: BvhBuildParams = BvhBuildParams {
     pre_split: false,
     ..BvhBuildParams::very_slow_build()
