@@ -21,6 +21,14 @@ fn block<'py>(py: Python<'py>, v: Vec<f64>, cols: usize) -> PyResult<Bound<'py, 
     out2(py, v, cols)
 }
 
+/// The fitted skins as rows of the parameter block (`params.WIDTH` columns).
+fn params_block<'py, 'a>(
+    py: Python<'py>,
+    skins: impl Iterator<Item = &'a skin_optics::SkinParams>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    block(py, skins.flat_map(row_of).collect(), WIDTH)
+}
+
 /// Fit each row of `reflectance` (N × M, on `lambda_nm`) with `skin_fit::fit_measured`: the seed
 /// model under SCE is `fit_spectrum` bit for bit. Returns the fitted parameter rows (N × 10), the
 /// weighted RMS residuals, the model spectra (N × M) and the instrument's surface term.
@@ -82,14 +90,7 @@ pub fn fit_spectrum<'py>(
         })
     })??;
     let d = PyDict::new(py);
-    d.set_item(
-        "params",
-        block(
-            py,
-            fits.iter().flat_map(|f| row_of(&f.skin)).collect(),
-            WIDTH,
-        )?,
-    )?;
+    d.set_item("params", params_block(py, fits.iter().map(|f| &f.skin))?)?;
     d.set_item("rms", out1(py, fits.iter().map(|f| f.rms).collect()))?;
     d.set_item(
         "model",
@@ -137,14 +138,7 @@ pub fn fit_colour<'py>(
         })
     })??;
     let d = PyDict::new(py);
-    d.set_item(
-        "params",
-        block(
-            py,
-            fits.iter().flat_map(|f| row_of(&f.skin)).collect(),
-            WIDTH,
-        )?,
-    )?;
+    d.set_item("params", params_block(py, fits.iter().map(|f| &f.skin))?)?;
     d.set_item(
         "lab",
         block(

@@ -75,6 +75,28 @@ pub struct Row {
 }
 
 impl Row {
+    /// One row per RGB channel: `ours[c]` against the engine's `value[c]` ± `stderr[c]`.
+    fn rgb(
+        engine: &str,
+        preset: &'static str,
+        quantity: &str,
+        ours: [f64; 3],
+        value: &[f64],
+        stderr: [f64; 3],
+    ) -> impl Iterator<Item = Row> {
+        (0..3).map(move |c| Row {
+            engine: engine.to_string(),
+            preset,
+            quantity: quantity.to_string(),
+            channel: ["R", "G", "B"][c].into(),
+            ours: ours[c],
+            engine_value: value[c],
+            engine_stderr: stderr[c],
+        })
+    }
+}
+
+impl Row {
     /// (engine − ours) / ours.
     #[must_use]
     pub fn rel_error(&self) -> f64 {
@@ -271,17 +293,14 @@ fn mitsuba(opts: &EngineOptions, rows: &mut Vec<Row>) -> anyhow::Result<()> {
                     });
                 }
                 _ => {
-                    for c in 0..3 {
-                        rows.push(Row {
-                            engine: engine.clone(),
-                            preset: name,
-                            quantity: quantity.clone(),
-                            channel: ["R", "G", "B"][c].into(),
-                            ours: f0 + rgb[c],
-                            engine_value: mean[c],
-                            engine_stderr: se[c],
-                        });
-                    }
+                    rows.extend(Row::rgb(
+                        &engine,
+                        name,
+                        &quantity,
+                        std::array::from_fn(|c| f0 + rgb[c]),
+                        &mean,
+                        std::array::from_fn(|c| se[c]),
+                    ));
                 }
             }
         }
@@ -368,17 +387,14 @@ fn cycles(opts: &EngineOptions, rows: &mut Vec<Row>) -> anyhow::Result<()> {
                     0.0,
                 ),
             };
-            for c in 0..3 {
-                rows.push(Row {
-                    engine: engine.clone(),
-                    preset: name,
-                    quantity: quantity.clone(),
-                    channel: ["R", "G", "B"][c].into(),
-                    ours: offset + rgb[c],
-                    engine_value: mean[c],
-                    engine_stderr: se[c],
-                });
-            }
+            rows.extend(Row::rgb(
+                &engine,
+                name,
+                &quantity,
+                std::array::from_fn(|c| offset + rgb[c]),
+                &mean,
+                std::array::from_fn(|c| se[c]),
+            ));
             if scene == "sphere" {
                 let view = sphere::SphereView {
                     radius_mm: v["radius_mm"].as_f64().context("sphere radius_mm")?,
@@ -390,33 +406,27 @@ fn cycles(opts: &EngineOptions, rows: &mut Vec<Row>) -> anyhow::Result<()> {
                     Some(x) => x,
                     None => *ours_sphere.insert(sphere::volumetric_sphere(name, view, None)?),
                 };
-                for c in 0..3 {
-                    rows.push(Row {
-                        engine: engine.clone(),
-                        preset: name,
-                        quantity: format!(
-                            "Principled {method}, sphere under white sky ({spp} spp): subsurface part against our volumetric walk on the same sphere ({} spp; its stderr added)",
-                            opts.sphere_spp
-                        ),
-                        channel: ["R", "G", "B"][c].into(),
-                        ours: walk_mean[c],
-                        engine_value: mean[c],
-                        engine_stderr: se[c].hypot(walk_se[c]),
-                    });
-                }
-                for c in 0..3 {
-                    rows.push(Row {
-                        engine: engine.clone(),
-                        preset: name,
-                        quantity: format!(
-                            "Principled {method}, sphere under white sky ({spp} spp): subsurface part against our layers over the same view angles (volume_slab() at 4 angles; its stderr added)"
-                        ),
-                        channel: ["R", "G", "B"][c].into(),
-                        ours: white_mean[c],
-                        engine_value: mean[c],
-                        engine_stderr: se[c].hypot(white_se[c]),
-                    });
-                }
+                rows.extend(Row::rgb(
+                    &engine,
+                    name,
+                    &format!(
+                        "Principled {method}, sphere under white sky ({spp} spp): subsurface part against our volumetric walk on the same sphere ({} spp; its stderr added)",
+                        opts.sphere_spp
+                    ),
+                    std::array::from_fn(|c| walk_mean[c]),
+                    &mean,
+                    std::array::from_fn(|c| se[c].hypot(walk_se[c])),
+                ));
+                rows.extend(Row::rgb(
+                    &engine,
+                    name,
+                    &format!(
+                        "Principled {method}, sphere under white sky ({spp} spp): subsurface part against our layers over the same view angles (volume_slab() at 4 angles; its stderr added)"
+                    ),
+                    std::array::from_fn(|c| white_mean[c]),
+                    &mean,
+                    std::array::from_fn(|c| se[c].hypot(white_se[c])),
+                ));
             }
         }
     }
