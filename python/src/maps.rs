@@ -61,10 +61,10 @@ fn exposure_of(kind: &str, gains: [f64; 3]) -> Result<Exposure, Bad> {
 /// with `gains`, `"auto"`, `"auto-rgb"`) and the skin model `model` (`seed`, `full`, `auto`)
 /// over the extended `parameters` (their `skin fit --json` names; `None`: all of them); texels
 /// out of gamut fitted again under a thin epidermis if `thin_epidermis` (`thin_epidermis_mm`,
-/// `None`: the default).
+/// `None`: the default), whose C_h reaches `thin_hemoglobin_max` (`None`: the default 0.25).
 /// Returns flat (N,) maps and the summary.
 #[pyfunction]
-#[pyo3(signature = (texels, width, mask, eumelanin, eumelanin_regions, exposure, gains, model, parameters, thin_epidermis, thin_epidermis_mm, cache, threads=None))]
+#[pyo3(signature = (texels, width, mask, eumelanin, eumelanin_regions, exposure, gains, model, parameters, thin_epidermis, thin_epidermis_mm, thin_hemoglobin_max, cache, threads=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn maps<'py>(
     py: Python<'py>,
@@ -79,6 +79,7 @@ pub fn maps<'py>(
     parameters: Option<Vec<String>>,
     thin_epidermis: bool,
     thin_epidermis_mm: Option<f64>,
+    thin_hemoglobin_max: Option<f64>,
     cache: bool,
     threads: Option<usize>,
 ) -> PyResult<Bound<'py, PyDict>> {
@@ -136,6 +137,8 @@ pub fn maps<'py>(
         exposure: exposure_of(exposure, gains)?,
         thin_epidermis_mm: thin_epidermis
             .then_some(thin_epidermis_mm.unwrap_or(skin_fit::maps::THIN_EPIDERMIS_MM)),
+        thin_hemoglobin_max: thin_hemoglobin_max
+            .unwrap_or(skin_fit::maps::THIN_HEMOGLOBIN_RANGE[1]),
         cache_dir: if cache {
             skin_io::cache::cache_dir()
         } else {

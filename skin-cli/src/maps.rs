@@ -67,12 +67,22 @@ pub struct MapsArgs {
     /// kept one adds a channel to maps.exr named as in `skin fit --json`.
     #[arg(long, value_name = "MODEL", default_value = "seed", value_parser = crate::args::Checked(parse_model))]
     pub model: ModelChoice,
+    /// The extended parameters `--model full|auto` tries, comma-separated, named as in `skin fit
+    /// --json` (epidermis_blood, epidermis_thickness_mm, oxygenation, mie_scale, rayleigh_scale,
+    /// dermis_scattering_scale, bilirubin_g_per_l); default all of them.
+    #[arg(long, value_name = "NAMES", value_delimiter = ',', value_parser = crate::args::Checked(parse_parameter))]
+    pub parameters: Vec<skin_fit::Parameter>,
     /// Texels out of gamut are fitted again under a thin epidermis of this thickness, mm, in
     /// [0.04, 0.3] (lip vermilion), and keep that skin where it reproduces them at least 1
     /// ΔE2000 closer; `off`: one skin for every texel. maps.exr gets a channel
     /// `thin_epidermis` (1 where a texel has it).
     #[arg(long, value_name = "MM|off", default_value = "0.05", value_parser = crate::args::Checked(parse_thin_epidermis))]
     pub thin_epidermis: ThinEpidermisArg,
+    /// The top of the thin-epidermis skin's blood fraction C_h, in (0.001, 1]: the default 0.25 is
+    /// the plausible range of Aliaga et al. 2023's skin model (the vermilion's capillaries lie
+    /// dense under its thin epithelium); 0.1 gives it the range of the texture's skin.
+    #[arg(long, value_name = "C", default_value = "0.25", value_parser = crate::args::Checked(parse_thin_hemoglobin_max))]
+    pub thin_hemoglobin_max: f64,
     /// Edit the maps before writing them, in order (repeatable): melanin*S, melanin+D,
     /// melanin-D (tanning, pallor), hemoglobin*S, hemoglobin+D, hemoglobin-D (flush; under
     /// --edit-mask if given), eumelanin=B. albedo.png is then the forward model of the edited maps.
@@ -96,6 +106,33 @@ pub fn parse_edit(s: &str) -> Result<Edit, String> {
 /// Parse `--model` (clap value parser).
 pub fn parse_model(s: &str) -> Result<ModelChoice, String> {
     s.parse().map_err(|e: skin_fit::FitError| e.to_string())
+}
+
+/// Parse one name of `--parameters` (clap value parser).
+pub fn parse_parameter(s: &str) -> Result<skin_fit::Parameter, String> {
+    let candidates = skin_fit::Parameter::CANDIDATES;
+    candidates
+        .iter()
+        .copied()
+        .find(|p| p.name() == s.trim())
+        .ok_or_else(|| {
+            let known: Vec<&str> = candidates.iter().map(|p| p.name()).collect();
+            format!(
+                "'{}' is not an extended parameter (one of {})",
+                skin_optics::echo::Text(s),
+                known.join(", ")
+            )
+        })
+}
+
+/// Parse `--thin-hemoglobin-max` (clap value parser).
+pub fn parse_thin_hemoglobin_max(s: &str) -> Result<f64, String> {
+    let c = crate::args::parse_number(s, "(0.001, 1]")?;
+    if c > skin_fit::maps::THIN_HEMOGLOBIN_RANGE[0] && c <= 1.0 {
+        Ok(c)
+    } else {
+        Err(format!("{} outside (0.001, 1]", skin_optics::echo::Num(c)))
+    }
 }
 
 /// `--thin-epidermis`: the thickness, mm, or `None` for `off`.
@@ -205,6 +242,7 @@ pub fn run(args: &MapsArgs) -> anyhow::Result<()> {
         },
         exposure: args.exposure,
         thin_epidermis_mm: args.thin_epidermis.0,
+        thin_hemoglobin_max: args.thin_hemoglobin_max,
         cache_dir: if args.no_cache {
             None
         } else {
@@ -226,7 +264,11 @@ pub fn run(args: &MapsArgs) -> anyhow::Result<()> {
             mask.as_deref(),
             &opts,
             args.model,
-            &skin_fit::Parameter::CANDIDATES,
+            if args.parameters.is_empty() {
+                &skin_fit::Parameter::CANDIDATES
+            } else {
+                &args.parameters
+            },
             &|name| spinner.set_message(format!("fitting {name} over the texture")),
         )?;
         spinner.finish_and_clear();

@@ -301,11 +301,57 @@ fn bad_exposure_and_model_are_usage_errors() {
         ("--eumelanin-regions", "2", "4..=4096"),
         ("--thin-epidermis", "0.5", "outside [0.04, 0.3] mm"),
         ("--thin-epidermis", "thin", "[0.04, 0.3] mm"),
+        ("--thin-hemoglobin-max", "1.5", "outside (0.001, 1]"),
+        ("--parameters", "gloss", "one of epidermis_blood"),
     ] {
         let o = skin_maps(&["--albedo", "x.png", flag, value]);
         assert_eq!(o.status.code(), Some(2), "{flag} {value}: {}", stderr(&o));
         assert!(stderr(&o).contains(want), "{flag} {value}: {}", stderr(&o));
     }
+}
+
+/// `--model full` over one extended parameter: skins made with a Mie scale of 1.5 get it back
+/// within 5 % (candidates 0.375 apart and a parabola between them, the library test's bound),
+/// written as its own maps.exr channel named as in `skin fit --json`, and the maps of that skin
+/// reproduce every texel in gamut.
+#[test]
+fn an_extended_parameter_becomes_its_own_channel() {
+    let mie = skin_fit::Parameter::CANDIDATES
+        .into_iter()
+        .find(|p| p.name() == "mie_scale")
+        .unwrap();
+    let base = mie.set(skin_fit::FitOptions::default().base, 1.5).unwrap();
+    let m = ColourModel::new(10.0, multipole::Method::Exact, base).unwrap();
+    let texels: Vec<[f32; 3]> = (0..16)
+        .map(|k| {
+            let (x, y) = ((k % 4) as f64, (k / 4) as f64);
+            let skin = m
+                .skin(0.01 * 3f64.powf(x), 0.6, 0.005 * 2f64.powf(y))
+                .unwrap();
+            m.xyz(&skin).unwrap().to_linear_srgb().0.map(|c| c as f32)
+        })
+        .collect();
+    let (tmp, out) = out_dir("extended");
+    let exr = tmp.path().join("albedo.exr");
+    write_exr(&exr, 4, 4, &texels);
+    let o = skin_maps(&[
+        "--albedo",
+        exr.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--eumelanin",
+        "0.6",
+        "--model",
+        "full",
+        "--parameters",
+        "mie_scale",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let maps = read_maps(&out);
+    let mie = maps.get("mie_scale").expect("a mie_scale channel");
+    assert!(mie.iter().all(|v| (v / 1.5 - 1.0).abs() <= 0.05), "{mie:?}");
+    assert!(maps["in_gamut"].iter().all(|g| *g == 1.0), "{}", stderr(&o));
+    assert!(!maps.contains_key("bilirubin_g_per_l"));
 }
 
 /// NaN and negative texels of an EXR are fitted as replaced values and flagged, not an error.

@@ -549,6 +549,7 @@ def maps(
     parameters: Sequence[str] | None = None,
     thin_epidermis: bool = True,
     thin_epidermis_mm: float | None = None,
+    thin_hemoglobin_max: float | None = None,
     cache: bool = True,
     threads: int | None = None,
 ) -> dict[str, Any]:
@@ -574,7 +575,8 @@ def maps(
     ``thin_epidermis``: fit texels out of gamut again under a thin epidermis of
     ``thin_epidermis_mm`` (in [0.04, 0.3] mm; None: 0.05 mm, the lip vermilion's; ``skin maps
     --thin-epidermis``) and keep that skin where it reproduces the texel at least 1 ΔE2000 closer
-    (docs/physics.md §18). ``cache``: keep the forward table (built once, a few CPU-seconds) in the disk cache
+    (docs/physics.md §18); that skin's C_h reaches ``thin_hemoglobin_max`` (in (0.001, 1]; None:
+    0.25, ``--thin-hemoglobin-max``). ``cache``: keep the forward table (built once, a few CPU-seconds) in the disk cache
     (``$SKIN_CACHE_DIR``, else ``$XDG_CACHE_HOME/skin``, else ``~/.cache/skin``).
 
     Non-finite, negative or huge (> 16) components are replaced (NaN by 0, then clamped), fitted
@@ -671,6 +673,7 @@ def maps(
         parameters,
         bool(thin_epidermis),
         None if thin_epidermis_mm is None else float(thin_epidermis_mm),
+        None if thin_hemoglobin_max is None else float(thin_hemoglobin_max),
         bool(cache),
         threads,
     )

@@ -115,6 +115,7 @@ def maps(
     parameters: list[str] | None,
     thin_epidermis: bool,
     thin_epidermis_mm: float | None,
+    thin_hemoglobin_max: float | None,
     cache: bool,
     threads: int | None = None,
 ) -> dict[str, Any]:

@@ -7,7 +7,7 @@ use std::fmt;
 use std::str::FromStr;
 
 /// One edit of the maps. Results are clamped to the model's ranges (C_m ∈ [0, 0.5],
-/// C_h ∈ [0.001, 0.1]).
+/// C_h ∈ [0.001, 0.1], or the thin-epidermis skin's C_h range where a texel has that skin).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Edit {
     /// C_m ← C_m · s (`melanin*S`), s ≥ 0.
@@ -119,7 +119,15 @@ pub fn apply(
         })
     };
     let [m_lo, m_hi] = MELANIN_RANGE;
-    let [h_lo, h_hi] = HEMOGLOBIN_RANGE;
+    // A texel keeps the C_h range of the skin it was fitted under.
+    let thin = maps
+        .thin_epidermis
+        .as_ref()
+        .map(|t| (t.texels.clone(), t.table.hemoglobin_range()));
+    let hemoglobin_range = |k: usize| match &thin {
+        Some((texels, range)) if texels.get(k) == Some(&true) => *range,
+        _ => HEMOGLOBIN_RANGE,
+    };
     for e in edits {
         e.validate()?;
         match *e {
@@ -141,7 +149,7 @@ pub fn apply(
                         Edit::HemoglobinOffset(d) => old + d,
                         _ => old,
                     }
-                    .clamp(h_lo, h_hi);
+                    .clamp(hemoglobin_range(k)[0], hemoglobin_range(k)[1]);
                     *c = (old + weight(k) * (new - old)) as f32;
                 }
             }

@@ -51,7 +51,9 @@ pub use table::{
     ForwardTable, MELANIN_KNEE, STEP_NM, Slice, TableSize, cache_key, hemoglobin_of_v,
     melanin_of_u, u_of_melanin, v_of_hemoglobin,
 };
-pub use thin_epidermis::{THIN_EPIDERMIS_MM, THIN_MIN_GAIN_DE, ThinEpidermis};
+pub use thin_epidermis::{
+    THIN_EPIDERMIS_MM, THIN_HEMOGLOBIN_RANGE, THIN_MIN_GAIN_DE, ThinEpidermis,
+};
 
 use crate::FitError;
 use rayon::prelude::*;
@@ -175,6 +177,9 @@ pub struct MapsOptions {
     /// under (lip vermilion; module `thin_epidermis`), in [0.04, 0.3]; `None`: one skin for
     /// every texel (default [`THIN_EPIDERMIS_MM`]).
     pub thin_epidermis_mm: Option<f64>,
+    /// The top of the C_h range of the thin-epidermis skin, in (0.001, 1] (default
+    /// [`THIN_HEMOGLOBIN_RANGE`]'s 0.25; 0.1 gives it the texture's skin's range).
+    pub thin_hemoglobin_max: f64,
 }
 
 impl Default for MapsOptions {
@@ -191,6 +196,7 @@ impl Default for MapsOptions {
             lookup: Lookup::Auto,
             exposure: Exposure::Fixed([1.0; 3]),
             thin_epidermis_mm: Some(THIN_EPIDERMIS_MM),
+            thin_hemoglobin_max: THIN_HEMOGLOBIN_RANGE[1],
         }
     }
 }
@@ -237,6 +243,12 @@ impl MapsOptions {
                 "[0.04, 0.3] mm",
             )?;
         }
+        check(
+            "thin_hemoglobin_max",
+            self.thin_hemoglobin_max,
+            self.thin_hemoglobin_max > THIN_HEMOGLOBIN_RANGE[0] && self.thin_hemoglobin_max <= 1.0,
+            "(0.001, 1]",
+        )?;
         if let Exposure::Fixed(gains) = self.exposure {
             let [lo, hi] = EXPOSURE_RANGE;
             for g in gains {
@@ -430,7 +442,7 @@ impl MapsModel {
     /// The table of `opts` from the cache, or built (about 5000 exact colours) and stored.
     pub fn load(opts: &MapsOptions) -> Result<Self, MapsError> {
         opts.validate()?;
-        let key = cache_key(opts.table, &opts.base);
+        let key = cache_key(opts.table, &opts.base, crate::HEMOGLOBIN_RANGE);
         let build = || ForwardTable::build(opts.table, opts.base);
         let (table, outcome) = skin_io::cache::load_or_build(
             opts.cache_dir.as_deref(),
@@ -438,7 +450,10 @@ impl MapsModel {
             &key,
             build,
         )?;
-        if table.is_whole() && table.size() == opts.table {
+        if table.is_whole()
+            && table.size() == opts.table
+            && table.hemoglobin_range() == crate::HEMOGLOBIN_RANGE
+        {
             return Ok(Self {
                 table,
                 outcome,
@@ -580,7 +595,8 @@ impl MapsModel {
                         Some((b, l, out)) if b == bits && l == label => out,
                         _ => {
                             let (lab, bad) = texel_lab(scaled(t[k], gain32));
-                            let r = inverters[usize::from(label)].invert_fast(&lab);
+                            let inv = &inverters[usize::from(label)];
+                            let r = inv.invert_fast(&lab);
                             // The residual at the texture's own exposure (module doc).
                             let (seen, fit) = if unit_gain {
                                 (lab, r.lab)
@@ -589,7 +605,7 @@ impl MapsModel {
                             };
                             let out = (
                                 melanin_of_u(r.u) as f32,
-                                hemoglobin_of_v(r.v) as f32,
+                                inv.slice().hemoglobin_of_v(r.v) as f32,
                                 delta_e_2000_fast(&seen, &fit) as f32,
                                 bad,
                             );
@@ -828,7 +844,10 @@ impl MapsModel {
             .zip(hemoglobin.par_iter())
             .with_min_len(CHUNK)
             .map(|(&m, &h)| {
-                let lab = slice.lab(u_of_melanin(f64::from(m)), v_of_hemoglobin(f64::from(h)));
+                let lab = slice.lab(
+                    u_of_melanin(f64::from(m)),
+                    slice.v_of_hemoglobin(f64::from(h)),
+                );
                 lab_of(lab).to_xyz().to_linear_srgb().0.map(|c| c as f32)
             })
             .collect())

@@ -4,7 +4,8 @@
 //!
 //! Nodes are spaced evenly in two unit coordinates where colour changes roughly evenly:
 //! u = ln(1 + C_m / c₀) / ln(1 + C_max / c₀) with the knee c₀ = [`MELANIN_KNEE`] (logarithmic
-//! above the knee, linear through C_m = 0), and v = log₁₀(C_h / 0.001) / 2 over C_h ∈ [0.001, 0.1].
+//! above the knee, linear through C_m = 0), and v = log(C_h / C_lo) / log(C_hi / C_lo) over the
+//! table's C_h range [C_lo, C_hi] ([`HEMOGLOBIN_RANGE`], [0.001, 0.1], unless built over another).
 //! Every node is one call of the exact forward model, the same path as `skin spectrum` and
 //! `skin fit` ([`crate::ColourModel`]: adding-doubling diffuse reflectance over 400–700 nm every
 //! 10 nm, CIE 1931 2°, D65).
@@ -37,17 +38,29 @@ pub fn u_of_melanin(c_m: f64) -> f64 {
     ((c_m.max(0.0) / MELANIN_KNEE).ln_1p() / span).clamp(0.0, 1.0)
 }
 
-/// C_h of the unit coordinate v ∈ [0, 1].
+/// C_h of the unit coordinate v ∈ [0, 1] on the default axis over [`HEMOGLOBIN_RANGE`].
 #[must_use]
 pub fn hemoglobin_of_v(v: f64) -> f64 {
-    let [lo, hi] = HEMOGLOBIN_RANGE;
+    hemoglobin_of_v_over(v, HEMOGLOBIN_RANGE)
+}
+
+/// The unit coordinate v of C_h on the default axis (inverse of [`hemoglobin_of_v`]).
+#[must_use]
+pub fn v_of_hemoglobin(c_h: f64) -> f64 {
+    v_of_hemoglobin_over(c_h, HEMOGLOBIN_RANGE)
+}
+
+/// C_h of the unit coordinate v ∈ [0, 1] on the logarithmic axis over `range` = [C_lo, C_hi].
+#[must_use]
+pub fn hemoglobin_of_v_over(v: f64, range: [f64; 2]) -> f64 {
+    let [lo, hi] = range;
     (lo * (hi / lo).powf(v)).clamp(lo, hi)
 }
 
-/// The unit coordinate v of C_h (inverse of [`hemoglobin_of_v`]).
+/// The unit coordinate v of C_h on the axis over `range` (inverse of [`hemoglobin_of_v_over`]).
 #[must_use]
-pub fn v_of_hemoglobin(c_h: f64) -> f64 {
-    let [lo, hi] = HEMOGLOBIN_RANGE;
+pub fn v_of_hemoglobin_over(c_h: f64, range: [f64; 2]) -> f64 {
+    let [lo, hi] = range;
     ((c_h.max(lo) / lo).ln() / (hi / lo).ln()).clamp(0.0, 1.0)
 }
 
@@ -85,15 +98,18 @@ impl TableSize {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ForwardTable {
     size: TableSize,
+    /// The C_h range [C_lo, C_hi] of the v axis.
+    hemoglobin_range: [f64; 2],
     lab_bits: Vec<[u64; 3]>,
 }
 
-/// The cache key of a table: everything its nodes depend on, as text with every float's bits.
+/// The cache key of a table over the C_h range `hemoglobin_range`: everything its nodes depend
+/// on, as text with every float's bits.
 #[must_use]
-pub fn cache_key(size: TableSize, base: &SkinParams) -> String {
+pub fn cache_key(size: TableSize, base: &SkinParams, hemoglobin_range: [f64; 2]) -> String {
     let ad = AddingDoublingOptions::default();
     format!(
-        "maps-forward-table v1; nodes u{} b{} v{}; knee {:016x}; melanin {:016x}..{:016x}; \
+        "maps-forward-table v2; nodes u{} b{} v{}; knee {:016x}; melanin {:016x}..{:016x}; \
          hemoglobin {:016x}..{:016x}; step {:016x} nm; exact quadrature {} g {:016x}; base {base:?}",
         size.melanin,
         size.eumelanin,
@@ -101,8 +117,8 @@ pub fn cache_key(size: TableSize, base: &SkinParams) -> String {
         MELANIN_KNEE.to_bits(),
         MELANIN_RANGE[0].to_bits(),
         MELANIN_RANGE[1].to_bits(),
-        HEMOGLOBIN_RANGE[0].to_bits(),
-        HEMOGLOBIN_RANGE[1].to_bits(),
+        hemoglobin_range[0].to_bits(),
+        hemoglobin_range[1].to_bits(),
         STEP_NM.to_bits(),
         ad.quadrature_points(),
         ad.g().to_bits(),
@@ -110,8 +126,18 @@ pub fn cache_key(size: TableSize, base: &SkinParams) -> String {
 }
 
 impl ForwardTable {
-    /// Build the table with the exact model (rayon over nodes), skins built on `base`.
+    /// Build the table over [`HEMOGLOBIN_RANGE`] with the exact model, skins built on `base`.
     pub fn build(size: TableSize, base: SkinParams) -> Result<Self, FitError> {
+        Self::build_over(size, base, HEMOGLOBIN_RANGE)
+    }
+
+    /// Build the table with its C_h axis over `hemoglobin_range` (0 < C_lo < C_hi ≤ 1) with the
+    /// exact model (rayon over nodes), skins built on `base`.
+    pub fn build_over(
+        size: TableSize,
+        base: SkinParams,
+        hemoglobin_range: [f64; 2],
+    ) -> Result<Self, FitError> {
         // The layer cache reuses each layer's operators across nodes that share it (the dermis
         // depends on C_h only, the epidermis on C_m and β_m only); a cached solve equals an
         // uncached one bit for bit.
@@ -127,7 +153,7 @@ impl ForwardTable {
                 let skin = model.skin(
                     melanin_of_u(i as f64 / (size.melanin - 1) as f64),
                     b as f64 / (size.eumelanin - 1) as f64,
-                    hemoglobin_of_v(j as f64 / (size.hemoglobin - 1) as f64),
+                    hemoglobin_of_v_over(j as f64 / (size.hemoglobin - 1) as f64, hemoglobin_range),
                 )?;
                 let lab = model.lab(&skin)?;
                 Ok([lab.l, lab.a, lab.b].map(f64::to_bits))
@@ -135,6 +161,7 @@ impl ForwardTable {
             .collect::<Result<Vec<_>, FitError>>()?;
         Ok(Self {
             size,
+            hemoglobin_range,
             lab_bits: lab,
         })
     }
@@ -163,7 +190,7 @@ impl ForwardTable {
                 Ok([lab.l, lab.a, lab.b])
             })
             .collect::<Result<Vec<_>, FitError>>()?;
-        Ok(Slice::new(nu, nv, &nodes, beta))
+        Ok(Slice::new(nu, nv, &nodes, beta, HEMOGLOBIN_RANGE))
     }
 
     /// The node counts.
@@ -172,11 +199,21 @@ impl ForwardTable {
         self.size
     }
 
+    /// The C_h range [C_lo, C_hi] of the table's v axis.
+    #[must_use]
+    pub fn hemoglobin_range(&self) -> [f64; 2] {
+        self.hemoglobin_range
+    }
+
     /// Whether a table read back from the cache has the shape its size says.
     #[must_use]
     pub fn is_whole(&self) -> bool {
         let s = self.size;
+        let [lo, hi] = self.hemoglobin_range;
         s.melanin >= 4
+            && 0.0 < lo
+            && lo < hi
+            && hi <= 1.0
             && s.eumelanin >= 4
             && s.hemoglobin >= 4
             && self.lab_bits.len() == s.nodes()
@@ -215,7 +252,7 @@ impl ForwardTable {
                 lab
             })
             .collect();
-        Slice::new(s.melanin, s.hemoglobin, &nodes, beta)
+        Slice::new(s.melanin, s.hemoglobin, &nodes, beta, self.hemoglobin_range)
     }
 }
 
@@ -230,6 +267,7 @@ pub struct Slice {
     /// Per cell (row-major in v), coefficient of tu^k tv^l at `[l * 4 + k]`.
     cells: Vec<[Lanes; 16]>,
     beta: f64,
+    hemoglobin_range: [f64; 2],
 }
 
 /// L*, a*, b* and a zero: four lanes that vectorise.
@@ -263,7 +301,13 @@ fn cell(x: f64, n: usize) -> (usize, f64) {
 }
 
 impl Slice {
-    fn new(nu: usize, nv: usize, nodes: &[[f64; 3]], beta: f64) -> Self {
+    fn new(
+        nu: usize,
+        nv: usize,
+        nodes: &[[f64; 3]],
+        beta: f64,
+        hemoglobin_range: [f64; 2],
+    ) -> Self {
         let (pu, pv) = (nu + 2, nv + 2);
         let mut padded = vec![[0.0; 3]; pu * pv];
         let at = |i: isize, j: isize| -> [f64; 3] {
@@ -318,6 +362,7 @@ impl Slice {
             nv,
             cells,
             beta,
+            hemoglobin_range,
         }
     }
 
@@ -325,6 +370,18 @@ impl Slice {
     #[must_use]
     pub fn eumelanin(&self) -> f64 {
         self.beta
+    }
+
+    /// C_h of the unit coordinate v on the slice's axis.
+    #[must_use]
+    pub fn hemoglobin_of_v(&self, v: f64) -> f64 {
+        hemoglobin_of_v_over(v, self.hemoglobin_range)
+    }
+
+    /// The unit coordinate v of C_h on the slice's axis.
+    #[must_use]
+    pub fn v_of_hemoglobin(&self, c_h: f64) -> f64 {
+        v_of_hemoglobin_over(c_h, self.hemoglobin_range)
     }
 
     #[inline(always)]

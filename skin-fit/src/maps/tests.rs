@@ -2,7 +2,7 @@
 //! synthetic textures with known maps, out-of-gamut and bad texels, edits and the cache.
 
 use super::*;
-use crate::ColourModel;
+use crate::{ColourModel, HEMOGLOBIN_RANGE};
 use multipole::Method;
 use skin_optics::SkinParams;
 use skin_optics::lab::delta_e_2000;
@@ -248,8 +248,14 @@ fn non_skin_and_bad_texels_are_flagged_and_finite() {
             "{k}: {}",
             maps.melanin[k]
         );
+        let thin = maps.thin_epidermis.as_ref().is_some_and(|t| t.texels[k]);
+        let top = if thin {
+            THIN_HEMOGLOBIN_RANGE[1]
+        } else {
+            HEMOGLOBIN_RANGE[1]
+        };
         assert!(
-            (0.001..=0.1).contains(&maps.hemoglobin[k]),
+            (0.001..=top as f32).contains(&maps.hemoglobin[k]),
             "{k}: {}",
             maps.hemoglobin[k]
         );
@@ -665,11 +671,13 @@ fn thin_epidermis_texels_are_fitted_under_it() {
         .unwrap();
     let thin_exact = ColourModel::new(STEP_NM, Method::Exact, thin_base).expect("model");
     let m = exact();
+    // Blood fractions up to 0.2: within the thin skin's range, beyond the default skin's 0.1.
     let lips: Vec<[f64; 3]> = (0..8)
         .map(|k| {
             let t = k as f64 / 7.0;
             [0.01 * 4f64.powf(t), 0.6, 0.05 + 0.04 * (1.0 - t)]
         })
+        .chain([[0.01, 0.6, 0.12], [0.02, 0.6, 0.16], [0.015, 0.6, 0.2]])
         .collect();
     let skin: Vec<[f64; 3]> = synthetic(3, 0.6);
     let texels: Vec<[f32; 3]> = lips

@@ -2,7 +2,7 @@
 //! under a thin epidermis, as on the lip vermilion (docs/physics.md §18, "Thin epidermis").
 
 use super::invert::Inverter;
-use super::table::{ForwardTable, cache_key, hemoglobin_of_v, melanin_of_u};
+use super::table::{ForwardTable, cache_key, melanin_of_u};
 use super::{
     CHUNK, IN_GAMUT_DE, LOOKUP_NODES, Lookup, MEMO_SLOTS, MapsError, MapsOptions,
     delta_e_2000_fast, memo_slot, scaled, texel_lab, unscaled,
@@ -14,6 +14,13 @@ use std::sync::{Arc, Mutex};
 /// Default epidermis thickness of the second skin, mm: the thin end of the viable epidermis
 /// (0.05–0.1 mm, [SM03]), within the range of `skin fit`'s epidermis thickness.
 pub const THIN_EPIDERMIS_MM: f64 = 0.05;
+
+/// The default C_h range of the second skin's table (its top is the knob
+/// [`super::MapsOptions::thin_hemoglobin_max`]): the plausible range of Aliaga et al.'s biophysical
+/// skin model ([ALI23], hemoglobin fraction 0.001–0.25), which fits whole faces including the
+/// lips, wider than [DJ06]'s 0.1 because the vermilion's capillaries lie dense under its thin
+/// epithelium (docs/physics.md §18, "Thin epidermis").
+pub const THIN_HEMOGLOBIN_RANGE: [f64; 2] = [0.001, 0.25];
 
 /// ΔE2000 by which the thin-epidermis skin must reproduce a texel better to replace the
 /// texture's skin there: one just-noticeable difference, so that texels the texture's skin
@@ -49,25 +56,27 @@ fn load_table(
     let base = Parameter::EpidermisThickness
         .set(opts.base, epidermis_mm)
         .map_err(crate::FitError::from)?;
-    let key = cache_key(opts.table, &base);
+    let range = [THIN_HEMOGLOBIN_RANGE[0], opts.thin_hemoglobin_max];
+    let key = cache_key(opts.table, &base, range);
     let mut held = tables
         .lock()
         .unwrap_or_else(std::sync::PoisonError::into_inner);
     if let Some((_, t)) = held.iter().find(|(k, _)| *k == key) {
         return Ok(t.clone());
     }
-    let build = || ForwardTable::build(opts.table, base);
+    let build = || ForwardTable::build_over(opts.table, base, range);
     let (table, _) = skin_io::cache::load_or_build(
         opts.cache_dir.as_deref(),
         opts.cache_max_bytes,
         &key,
         build,
     )?;
-    let table = if table.is_whole() && table.size() == opts.table {
-        table
-    } else {
-        build()?
-    };
+    let table =
+        if table.is_whole() && table.size() == opts.table && table.hemoglobin_range() == range {
+            table
+        } else {
+            build()?
+        };
     held.push((key, table.clone()));
     Ok(table)
 }
@@ -137,7 +146,7 @@ pub(super) fn refit(
                         };
                         let out = (
                             melanin_of_u(r.u) as f32,
-                            hemoglobin_of_v(r.v) as f32,
+                            inv.slice().hemoglobin_of_v(r.v) as f32,
                             delta_e_2000_fast(&seen, &fit) as f32,
                         );
                         memo[slot] = Some((bits, label, out));
