@@ -4,6 +4,7 @@
 use crate::args::SkinArgs;
 use anyhow::Context;
 use clap::Args;
+use skin_export::textured::{ChromophoreTexture, TexturedOptions, export_textured};
 use skin_export::{ColourSpace, ExportOptions, Format, export};
 use skin_io::atomic::write_bytes;
 use skin_optics::{Wavelength, WavelengthGrid};
@@ -81,6 +82,15 @@ pub struct ExportArgs {
     /// Finite dermis thickness for MCML, MCX, Mitsuba and Blender's volume, mm, [1, 1000].
     #[arg(long = "dermis-mm", value_name = "MM", default_value_t = ExportOptions::default().dermis_thickness_mm)]
     pub dermis_mm: f64,
+    /// Chromophore maps (maps.exr of `skin maps`: channels melanin, eumelanin, hemoglobin): write
+    /// openpbr, standard-surface, unreal or hdrp with texture images, fitted per texel, beside
+    /// --out (required); the other parameters come from the skin options.
+    #[arg(long, value_name = "FILE", requires = "out")]
+    pub maps: Option<PathBuf>,
+    /// Grid nodes along C_m and C_h for the per-texel fit of --maps, [2, 33] (the interpolation
+    /// error is measured and printed with the export).
+    #[arg(long = "texture-nodes", value_name = "N", default_value_t = TexturedOptions::default().nodes)]
+    pub texture_nodes: usize,
 }
 
 impl ExportArgs {
@@ -137,6 +147,9 @@ pub fn run(args: &ExportArgs) -> anyhow::Result<()> {
             );
         }
     }
+    if let (Some(maps), Some(out)) = (&args.maps, &args.out) {
+        return run_textured(format, &skin, &opts, args, maps, out);
+    }
     let exported = export(&skin, format, &opts)?;
     for note in &exported.notes {
         eprintln!("{note}");
@@ -153,5 +166,73 @@ pub fn run(args: &ExportArgs) -> anyhow::Result<()> {
             out.flush()?;
         }
     }
+    Ok(())
+}
+
+/// `skin export FORMAT --maps FILE --out FILE`: the material and its texture images beside it,
+/// written as one group (all or none).
+fn run_textured(
+    format: Format,
+    skin: &skin_optics::SkinParams,
+    opts: &ExportOptions,
+    args: &ExportArgs,
+    maps: &std::path::Path,
+    out: &std::path::Path,
+) -> anyhow::Result<()> {
+    use crate::maps::image_file::{exr_bytes, read_channels};
+    let (width, height, mut channels) =
+        read_channels(maps, &["melanin", "eumelanin", "hemoglobin"]).context("--maps")?;
+    let texture = ChromophoreTexture {
+        width,
+        height,
+        hemoglobin: channels.pop().unwrap_or_default(),
+        eumelanin: channels.pop().unwrap_or_default(),
+        melanin: channels.pop().unwrap_or_default(),
+    };
+    let topts = TexturedOptions {
+        nodes: args.texture_nodes,
+        ..TexturedOptions::default()
+    };
+    let bar = indicatif::ProgressBar::new(0);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{elapsed_precise} [{bar:30}] {pos}/{len} {msg}")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar())
+            .progress_chars("=> "),
+    );
+    bar.set_message("skins fitted on the texture's grid");
+    let exported = export_textured(format, skin, &texture, opts, &topts, &|done, total| {
+        bar.set_length(total as u64);
+        bar.set_position(done as u64);
+    })
+    .with_context(|| format!("--maps {}", maps.display()))?;
+    bar.finish_and_clear();
+    for note in &exported.notes {
+        eprintln!("{note}");
+    }
+    let dir = out
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(std::path::Path::new("."));
+    let mut staged = vec![skin_io::atomic::stage_bytes(out, exported.text.as_bytes())?];
+    for image in &exported.images {
+        let channel = |c: usize| image.rgb.iter().map(|t| t[c]).collect::<Vec<f32>>();
+        let bytes = exr_bytes(
+            width,
+            height,
+            vec![("R", channel(0)), ("G", channel(1)), ("B", channel(2))],
+        )?;
+        staged.push(skin_io::atomic::stage_bytes(
+            &dir.join(image.file_name),
+            &bytes,
+        )?);
+    }
+    skin_io::atomic::commit(staged)?;
+    let names: Vec<&str> = exported.images.iter().map(|i| i.file_name).collect();
+    eprintln!(
+        "wrote {} and {} in {}",
+        out.display(),
+        names.join(", "),
+        dir.display()
+    );
     Ok(())
 }

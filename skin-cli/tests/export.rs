@@ -855,3 +855,116 @@ fn materialx_documents_pass_materialx_own_checks_where_it_is_installed() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The channels of a maps.exr: melanin, eumelanin, hemoglobin per texel (row-major).
+fn write_maps_exr(path: &std::path::Path, w: usize, h: usize, texels: &[[f32; 3]], skip: &str) {
+    use exr::prelude::*;
+    let list: Vec<AnyChannel<FlatSamples>> = ["melanin", "eumelanin", "hemoglobin"]
+        .iter()
+        .enumerate()
+        .filter(|(_, name)| **name != skip)
+        .map(|(c, name)| {
+            let data = texels.iter().map(|t| t[c]).collect();
+            AnyChannel::new(*name, FlatSamples::F32(data))
+        })
+        .collect();
+    let layer = Layer::new(
+        (w, h),
+        LayerAttributes::default(),
+        Encoding::FAST_LOSSLESS,
+        AnyChannels::sort(list.into()),
+    );
+    Image::from_layer(layer).write().to_file(path).unwrap();
+}
+
+/// `skin export openpbr --maps`: the document and its two images are written together, the
+/// document references them, each image has the maps' size, and the texels of each of the two
+/// skins hold that skin's colour from the scalar export (within the grid's interpolation, here
+/// exact: the two skins are the grid's corner nodes). A missing channel is a one-line error that
+/// writes nothing.
+#[test]
+fn maps_become_texture_images_beside_the_document() {
+    let tmp = tempfile::tempdir().unwrap();
+    let maps = tmp.path().join("maps.exr");
+    let (a, b) = ([0.02f32, 0.6, 0.01], [0.2f32, 0.6, 0.05]);
+    let texels: Vec<[f32; 3]> = (0..8).map(|k| if k % 2 == 0 { a } else { b }).collect();
+    write_maps_exr(&maps, 4, 2, &texels, "");
+    let out = tmp.path().join("mat").join("skin.mtlx");
+    let quick = [
+        "--escapes",
+        "500",
+        "--volume-photons",
+        "2000",
+        "--step",
+        "20",
+        "--texture-nodes",
+        "3",
+    ];
+    let mut args = vec!["export", "openpbr", "--maps", maps.to_str().unwrap()];
+    args.extend(["--out", out.to_str().unwrap()]);
+    args.extend(quick);
+    let (ok, stderr) = skin_cmd(&args);
+    assert!(ok, "{stderr}");
+    let text = std::fs::read_to_string(&out).unwrap();
+    let doc = roxmltree::Document::parse(&text).unwrap();
+    let files: Vec<&str> = doc
+        .descendants()
+        .filter(|n| n.attribute("type") == Some("filename"))
+        .filter_map(|n| n.attribute("value"))
+        .collect();
+    assert_eq!(
+        files,
+        ["subsurface_color.exr", "subsurface_radius_scale.exr"]
+    );
+    let colour = exr::prelude::read_first_rgba_layer_from_file(
+        out.with_file_name(files[0]),
+        |size, _| (size.0, vec![[0.0f32; 3]; size.0 * size.1]),
+        |t: &mut (usize, Vec<[f32; 3]>), pos, (r, g, b, _): (f32, f32, f32, f32)| {
+            t.1[pos.1 * t.0 + pos.0] = [r, g, b];
+        },
+    )
+    .unwrap();
+    let (width, pixels) = &colour.layer_data.channel_data.pixels;
+    assert_eq!((*width, pixels.len()), (4, 8));
+    let o = ExportOptions {
+        grid: WavelengthGrid::new(400.0, 700.0, 20.0).unwrap(),
+        escapes: 500,
+        volume_photons: 2000,
+        ..ExportOptions::default()
+    };
+    for (k, p) in texels.iter().enumerate() {
+        let skin = SkinParams::preset(Preset::Light)
+            .with_melanin(f64::from(p[0]))
+            .unwrap()
+            .with_eumelanin_blend(f64::from(p[1]))
+            .unwrap()
+            .with_hemoglobin(f64::from(p[2]))
+            .unwrap();
+        let fit = VolumeFit::fit(
+            &rgb_profile(&skin, &o).unwrap(),
+            multipole::DEFAULT_G,
+            1.4,
+            2000,
+        )
+        .unwrap();
+        for c in 0..3 {
+            assert!(
+                close(f64::from(pixels[k][c]), fit.colour[c], 1e-5),
+                "texel {k} channel {c}: {:?} vs {:?}",
+                pixels[k],
+                fit.colour
+            );
+        }
+    }
+    let missing = tmp.path().join("no_blood.exr");
+    write_maps_exr(&missing, 4, 2, &texels, "hemoglobin");
+    let out2 = tmp.path().join("other").join("skin.mtlx");
+    let mut args = vec!["export", "unreal", "--maps", missing.to_str().unwrap()];
+    args.extend(["--out", out2.to_str().unwrap()]);
+    let (ok, stderr) = skin_cmd(&args);
+    assert!(
+        !ok && stderr.contains("no channel 'hemoglobin'"),
+        "{stderr}"
+    );
+    assert!(!out2.exists() && !out2.with_file_name("base_color.exr").exists());
+}

@@ -55,6 +55,14 @@ pub enum ExportError {
         /// What was wrong.
         message: String,
     },
+    /// A chromophore texture that cannot be exported: the channel or option, and what is wrong.
+    #[error("{key}: {message}")]
+    Texture {
+        /// The channel (melanin, eumelanin, hemoglobin), `size` or `format`.
+        key: &'static str,
+        /// What was wrong, with the valid range.
+        message: String,
+    },
     /// A fit that found no admissible value.
     #[error("{0}")]
     Fit(String),

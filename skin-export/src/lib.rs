@@ -13,6 +13,7 @@ pub mod mitsuba;
 pub mod pbrt;
 pub mod rgb;
 pub mod spectral;
+pub mod textured;
 pub mod volume;
 
 pub use colour::ColourSpace;
@@ -355,20 +356,7 @@ pub fn export(
 ) -> Result<Export, ExportError> {
     opts.validate()?;
     let surface = Surface::of(skin);
-    let mut header = vec![format!(
-        "skin export {format}: C_m = {}, β_m = {}, C_h = {}, ρ_s = {}, η = {}, epidermis {} mm; reference: exact profiles over {}–{} nm step {} nm (adding-doubling totals, Monte Carlo shapes of {} escapes every {} nm), docs/physics.md §14",
-        skin.melanin(),
-        skin.eumelanin_blend(),
-        skin.hemoglobin(),
-        skin.oiliness(),
-        skin.eta(),
-        skin.epidermis_thickness_mm(),
-        opts.grid.start_nm(),
-        opts.grid.nm(opts.grid.len() - 1),
-        opts.grid.step_nm(),
-        opts.escapes,
-        opts.shape_step_nm,
-    )];
+    let mut header = vec![header_note(skin, format, opts)];
     opts.check_format(format)?;
     let mut out = if format.is_rgb() {
         // MaterialX documents are fitted in linear Rec.709 and carry their colour space themselves.
@@ -504,8 +492,26 @@ pub fn export_spectral(
     })
 }
 
+/// The first note of every export: the skin, and the reference its fit was made against.
+pub(crate) fn header_note(skin: &SkinParams, format: Format, opts: &ExportOptions) -> String {
+    format!(
+        "skin export {format}: C_m = {}, β_m = {}, C_h = {}, ρ_s = {}, η = {}, epidermis {} mm; reference: exact profiles over {}–{} nm step {} nm (adding-doubling totals, Monte Carlo shapes of {} escapes every {} nm), docs/physics.md §14",
+        skin.melanin(),
+        skin.eumelanin_blend(),
+        skin.hemoglobin(),
+        skin.oiliness(),
+        skin.eta(),
+        skin.epidermis_thickness_mm(),
+        opts.grid.start_nm(),
+        opts.grid.nm(opts.grid.len() - 1),
+        opts.grid.step_nm(),
+        opts.escapes,
+        opts.shape_step_nm,
+    )
+}
+
 /// Put the notes into the file as comments (XML, pbrt, MCML) or a `notes` array (JSON).
-fn materialise_notes(format: Format, notes: &[String], text: &str) -> String {
+pub(crate) fn materialise_notes(format: Format, notes: &[String], text: &str) -> String {
     match format {
         Format::OpenPbr | Format::StandardSurface | Format::Mitsuba => {
             let (decl, rest) = text.split_once('\n').unwrap_or((text, ""));

@@ -123,3 +123,87 @@ pub fn write(
     ];
     (x, notes)
 }
+
+/// The document for `format` (OpenPBR or Standard Surface) whose subsurface colour and radius
+/// colour come from the images `colour_file` and `radius_file` (declared in `space`), with the
+/// scalar `radius` in scene units; the surface is `surface`'s.
+#[must_use]
+pub fn write_textured(
+    format: Format,
+    surface: Surface,
+    space: &str,
+    radius: f64,
+    colour_file: &str,
+    radius_file: &str,
+) -> String {
+    let mut x = String::new();
+    let _ = writeln!(x, r#"<?xml version="1.0" encoding="UTF-8"?>"#);
+    let _ = writeln!(x, r#"<materialx version="1.39" colorspace="{space}">"#);
+    for (name, file) in [
+        ("subsurface_color_image", colour_file),
+        ("radius_image", radius_file),
+    ] {
+        let _ = writeln!(
+            x,
+            r#"  <image name="{name}" type="color3">
+    <input name="file" type="filename" value="{file}" colorspace="{space}" />
+  </image>"#
+        );
+    }
+    let value = |x: &mut String, name: &str, ty: &str, value: String| {
+        let _ = writeln!(
+            x,
+            r#"    <input name="{name}" type="{ty}" value="{value}" />"#
+        );
+    };
+    let image = |x: &mut String, name: &str, node: &str| {
+        let _ = writeln!(
+            x,
+            r#"    <input name="{name}" type="color3" nodename="{node}" />"#
+        );
+    };
+    let (node, shader) = match format {
+        Format::OpenPbr => ("open_pbr_surface", "skin_openpbr"),
+        _ => ("standard_surface", "skin_standard_surface"),
+    };
+    let _ = writeln!(x, r#"  <{node} name="{shader}" type="surfaceshader">"#);
+    let roughness = format!("{:.6}", surface.ggx_roughness());
+    let ior = format!("{:.6}", surface.eta);
+    let weight = format!("{:.6}", surface.oiliness);
+    let g = format!("{:.6}", multipole::DEFAULT_G);
+    match format {
+        Format::OpenPbr => {
+            value(&mut x, "base_weight", "float", "1".into());
+            image(&mut x, "base_color", "subsurface_color_image");
+            value(&mut x, "subsurface_weight", "float", "1".into());
+            image(&mut x, "subsurface_color", "subsurface_color_image");
+            value(&mut x, "subsurface_radius", "float", format!("{radius:.6}"));
+            image(&mut x, "subsurface_radius_scale", "radius_image");
+            value(&mut x, "subsurface_scatter_anisotropy", "float", g);
+            value(&mut x, "specular_weight", "float", weight);
+            value(&mut x, "specular_roughness", "float", roughness);
+            value(&mut x, "specular_ior", "float", ior);
+        }
+        _ => {
+            value(&mut x, "base", "float", "1".into());
+            image(&mut x, "base_color", "subsurface_color_image");
+            value(&mut x, "subsurface", "float", "1".into());
+            image(&mut x, "subsurface_color", "subsurface_color_image");
+            image(&mut x, "subsurface_radius", "radius_image");
+            value(&mut x, "subsurface_scale", "float", format!("{radius:.6}"));
+            value(&mut x, "subsurface_anisotropy", "float", g);
+            value(&mut x, "specular", "float", weight);
+            value(&mut x, "specular_roughness", "float", roughness);
+            value(&mut x, "specular_IOR", "float", ior);
+        }
+    }
+    let _ = writeln!(x, "  </{node}>");
+    let _ = writeln!(
+        x,
+        r#"  <surfacematerial name="skin" type="material">
+    <input name="surfaceshader" type="surfaceshader" nodename="{shader}" />
+  </surfacematerial>
+</materialx>"#
+    );
+    x
+}
