@@ -686,8 +686,12 @@ def volume_material(layer, name, glass_above=None):
 
 
 def _box(name, half, z_bottom, z_top, material):
-    xs, zs = (-half, half), (z_bottom, z_top)
-    verts = [(x, y, z) for z in zs for y in xs for x in xs]
+    """A box of half-width `half` between `z_bottom` and `z_top`, shifted by half/2 along x so that
+    no triangle edge passes under the origin: Cycles lets light through a volume's boundary at the
+    shared edge of its triangles (a camera looking down at the centre of a centred box measured
+    a 2.5-fold pixel value along the top face's diagonal, +0.002 on the mean)."""
+    ys, xs, zs = (-half, half), (-half / 2, 1.5 * half), (z_bottom, z_top)
+    verts = [(x, y, z) for z in zs for y in ys for x in xs]
     faces = [(0, 2, 3, 1), (4, 5, 7, 6), (0, 1, 5, 4), (2, 6, 7, 3), (0, 4, 6, 2), (1, 3, 7, 5)]
     mesh = bpy.data.meshes.new(name)
     mesh.from_pydata(verts, [], faces)

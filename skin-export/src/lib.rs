@@ -112,7 +112,7 @@ impl Format {
                 "MCML 1.2 (the exported runs): within 1.8 binomial σ of skin spectrum's diffuse_reflectance"
             }
             Format::Blender | Format::BlenderJson => {
-                "Blender 5.0.1 Cycles (CPU, 256 spp), light, medium and dark skin: Principled BSDF subsurface part on a slab at normal view within 2.2% of our diffuse reflectance (both methods); over a 20 mm sphere under a white sky, against our volumetric walk on the same sphere, Random Walk (Skin) within 2.7% for light skin, +5.6 to −4.7% for medium and −9 to −15% for dark, as Cycles' homogeneous walk does not follow layered skin's angular response (the 3% target is not met for medium and dark); volume_slab() within 2.5% of F(0) + our diffuse reflectance for light and medium skin (light red −2.5%: Cycles' 1,024-bounce limit), dark skin +4.6–6.5%"
+                "Blender 5.0.1 Cycles (CPU, 256 spp), light, medium and dark skin: Principled BSDF subsurface part on a slab at normal view within 2.2% of our diffuse reflectance (both methods); over a 20 mm sphere under a white sky, against our volumetric walk on the same sphere, Random Walk (Skin) within 2.7% for light skin, +5.6 to −4.7% for medium and −9 to −15% for dark, as Cycles' homogeneous walk does not follow layered skin's angular response (the 3% target is not met for medium and dark); volume_slab() within 1.0% of F(0) + our diffuse reflectance (1,024 spp) for every skin and channel but light skin's red, −3.0% (Cycles' 1,024-bounce limit)"
             }
             Format::Unreal | Format::Hdrp => {
                 "cannot run here (no Unreal or Unity on this machine): the errors above are model-side, Burley's profile against ours"
