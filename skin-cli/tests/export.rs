@@ -852,6 +852,47 @@ fn materialx_documents_pass_materialx_own_checks_where_it_is_installed() {
             );
             assert_eq!(v["colorspace"], space.materialx_name());
         }
+        // The textured document: its inputs bound to image nodes pass the same checks.
+        let texture = skin_export::textured::ChromophoreTexture {
+            width: 2,
+            height: 1,
+            melanin: vec![0.01, 0.1],
+            eumelanin: vec![0.6, 0.6],
+            hemoglobin: vec![0.01, 0.05],
+        };
+        let topts = skin_export::textured::TexturedOptions {
+            nodes: 2,
+            checks: 0,
+        };
+        let textured = skin_export::textured::export_textured(
+            format,
+            &skin(),
+            &texture,
+            &opts(),
+            &topts,
+            &|_, _| {},
+        )
+        .unwrap();
+        let path = dir.join(format!("{format}_textured.mtlx"));
+        std::fs::write(&path, textured.text).unwrap();
+        let out = std::process::Command::new(&python)
+            .arg(script)
+            .arg(&path)
+            .output()
+            .unwrap();
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        let v = json(stdout.lines().last().unwrap());
+        assert_eq!(
+            v["valid"],
+            Value::Bool(true),
+            "{format} textured: {}",
+            v["message"]
+        );
+        assert_eq!(
+            v["unknown_inputs"],
+            serde_json::json!([]),
+            "{format} textured"
+        );
     }
     let _ = std::fs::remove_dir_all(&dir);
 }

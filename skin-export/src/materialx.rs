@@ -30,58 +30,14 @@ pub fn write(
     let radius = mfp_units.iter().copied().fold(0.0, f64::max);
     let scale = mfp_units.map(|l| l / radius);
     let space = opts.colour_space.materialx_name();
-    let mut x = String::new();
-    let _ = writeln!(x, r#"<?xml version="1.0" encoding="UTF-8"?>"#);
-    let _ = writeln!(x, r#"<materialx version="1.39" colorspace="{space}">"#);
-    let input = |x: &mut String, name: &str, ty: &str, value: String| {
-        let _ = writeln!(
-            x,
-            r#"    <input name="{name}" type="{ty}" value="{value}" />"#
-        );
-    };
-    let (node, shader) = match format {
-        Format::OpenPbr => ("open_pbr_surface", "skin_openpbr"),
-        _ => ("standard_surface", "skin_standard_surface"),
-    };
-    let _ = writeln!(x, r#"  <{node} name="{shader}" type="surfaceshader">"#);
-    let colour = triple(to_space(fit.colour));
-    let roughness = format!("{:.6}", surface.ggx_roughness());
-    let ior = format!("{:.6}", surface.eta);
-    let weight = format!("{:.6}", surface.oiliness);
-    let g = format!("{:.6}", fit.g);
-    match format {
-        Format::OpenPbr => {
-            input(&mut x, "base_weight", "float", "1".into());
-            input(&mut x, "base_color", "color3", colour.clone());
-            input(&mut x, "subsurface_weight", "float", "1".into());
-            input(&mut x, "subsurface_color", "color3", colour);
-            input(&mut x, "subsurface_radius", "float", format!("{radius:.6}"));
-            input(&mut x, "subsurface_radius_scale", "color3", triple(scale));
-            input(&mut x, "subsurface_scatter_anisotropy", "float", g);
-            input(&mut x, "specular_weight", "float", weight);
-            input(&mut x, "specular_roughness", "float", roughness);
-            input(&mut x, "specular_ior", "float", ior);
-        }
-        _ => {
-            input(&mut x, "base", "float", "1".into());
-            input(&mut x, "base_color", "color3", colour.clone());
-            input(&mut x, "subsurface", "float", "1".into());
-            input(&mut x, "subsurface_color", "color3", colour);
-            input(&mut x, "subsurface_radius", "color3", triple(scale));
-            input(&mut x, "subsurface_scale", "float", format!("{radius:.6}"));
-            input(&mut x, "subsurface_anisotropy", "float", g);
-            input(&mut x, "specular", "float", weight);
-            input(&mut x, "specular_roughness", "float", roughness);
-            input(&mut x, "specular_IOR", "float", ior);
-        }
-    }
-    let _ = writeln!(x, "  </{node}>");
-    let _ = writeln!(
-        x,
-        r#"  <surfacematerial name="skin" type="material">
-    <input name="surfaceshader" type="surfaceshader" nodename="{shader}" />
-  </surfacematerial>
-</materialx>"#
+    let x = document(
+        format,
+        surface,
+        space,
+        fit.g,
+        radius,
+        &Colour3::Value(to_space(fit.colour)),
+        &Colour3::Value(scale),
     );
     let notes = vec![
         format!(
@@ -124,6 +80,15 @@ pub fn write(
     (x, notes)
 }
 
+/// A `color3` input: a value, or an image file declared in the document's colour space.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Colour3 {
+    /// The same value at every point.
+    Value([f64; 3]),
+    /// An image file, read through an `image` node.
+    Image(String),
+}
+
 /// The document for `format` (OpenPBR or Standard Surface) whose subsurface colour and radius
 /// colour come from the images `colour_file` and `radius_file` (declared in `space`), with the
 /// scalar `radius` in scene units; the surface is `surface`'s.
@@ -136,31 +101,65 @@ pub fn write_textured(
     colour_file: &str,
     radius_file: &str,
 ) -> String {
+    document(
+        format,
+        surface,
+        space,
+        multipole::DEFAULT_G,
+        radius,
+        &Colour3::Image(colour_file.to_string()),
+        &Colour3::Image(radius_file.to_string()),
+    )
+}
+
+/// The MaterialX document of `format` in colour space `space`: the surface shader with the
+/// subsurface colour `colour` (also the base colour), the radius `radius` (scene units) times the
+/// radius colour `radius_colour`, anisotropy `g`, and `surface`'s specular face.
+fn document(
+    format: Format,
+    surface: Surface,
+    space: &str,
+    g: f64,
+    radius: f64,
+    colour: &Colour3,
+    radius_colour: &Colour3,
+) -> String {
     let mut x = String::new();
     let _ = writeln!(x, r#"<?xml version="1.0" encoding="UTF-8"?>"#);
     let _ = writeln!(x, r#"<materialx version="1.39" colorspace="{space}">"#);
-    for (name, file) in [
-        ("subsurface_color_image", colour_file),
-        ("radius_image", radius_file),
-    ] {
-        let _ = writeln!(
-            x,
-            r#"  <image name="{name}" type="color3">
+    let images = [
+        ("subsurface_color_image", colour),
+        ("radius_image", radius_colour),
+    ];
+    for (node, c) in &images {
+        if let Colour3::Image(file) = c {
+            let _ = writeln!(
+                x,
+                r#"  <image name="{node}" type="color3">
     <input name="file" type="filename" value="{file}" colorspace="{space}" />
   </image>"#
-        );
+            );
+        }
     }
-    let value = |x: &mut String, name: &str, ty: &str, value: String| {
+    let scalar = |x: &mut String, name: &str, value: String| {
         let _ = writeln!(
             x,
-            r#"    <input name="{name}" type="{ty}" value="{value}" />"#
+            r#"    <input name="{name}" type="float" value="{value}" />"#
         );
     };
-    let image = |x: &mut String, name: &str, node: &str| {
-        let _ = writeln!(
-            x,
-            r#"    <input name="{name}" type="color3" nodename="{node}" />"#
-        );
+    let colour3 = |x: &mut String, name: &str, which: usize| {
+        let (node, c) = images[which];
+        let _ = match c {
+            Colour3::Value(v) => writeln!(
+                x,
+                r#"    <input name="{name}" type="color3" value="{}" />"#,
+                triple(*v)
+            ),
+            Colour3::Image(_) => writeln!(
+                x,
+                r#"    <input name="{name}" type="color3" nodename="{node}" />"#
+            ),
+        };
     };
     let (node, shader) = match format {
         Format::OpenPbr => ("open_pbr_surface", "skin_openpbr"),
@@ -170,31 +169,31 @@ pub fn write_textured(
     let roughness = format!("{:.6}", surface.ggx_roughness());
     let ior = format!("{:.6}", surface.eta);
     let weight = format!("{:.6}", surface.oiliness);
-    let g = format!("{:.6}", multipole::DEFAULT_G);
+    let g = format!("{g:.6}");
     match format {
         Format::OpenPbr => {
-            value(&mut x, "base_weight", "float", "1".into());
-            image(&mut x, "base_color", "subsurface_color_image");
-            value(&mut x, "subsurface_weight", "float", "1".into());
-            image(&mut x, "subsurface_color", "subsurface_color_image");
-            value(&mut x, "subsurface_radius", "float", format!("{radius:.6}"));
-            image(&mut x, "subsurface_radius_scale", "radius_image");
-            value(&mut x, "subsurface_scatter_anisotropy", "float", g);
-            value(&mut x, "specular_weight", "float", weight);
-            value(&mut x, "specular_roughness", "float", roughness);
-            value(&mut x, "specular_ior", "float", ior);
+            scalar(&mut x, "base_weight", "1".into());
+            colour3(&mut x, "base_color", 0);
+            scalar(&mut x, "subsurface_weight", "1".into());
+            colour3(&mut x, "subsurface_color", 0);
+            scalar(&mut x, "subsurface_radius", format!("{radius:.6}"));
+            colour3(&mut x, "subsurface_radius_scale", 1);
+            scalar(&mut x, "subsurface_scatter_anisotropy", g);
+            scalar(&mut x, "specular_weight", weight);
+            scalar(&mut x, "specular_roughness", roughness);
+            scalar(&mut x, "specular_ior", ior);
         }
         _ => {
-            value(&mut x, "base", "float", "1".into());
-            image(&mut x, "base_color", "subsurface_color_image");
-            value(&mut x, "subsurface", "float", "1".into());
-            image(&mut x, "subsurface_color", "subsurface_color_image");
-            image(&mut x, "subsurface_radius", "radius_image");
-            value(&mut x, "subsurface_scale", "float", format!("{radius:.6}"));
-            value(&mut x, "subsurface_anisotropy", "float", g);
-            value(&mut x, "specular", "float", weight);
-            value(&mut x, "specular_roughness", "float", roughness);
-            value(&mut x, "specular_IOR", "float", ior);
+            scalar(&mut x, "base", "1".into());
+            colour3(&mut x, "base_color", 0);
+            scalar(&mut x, "subsurface", "1".into());
+            colour3(&mut x, "subsurface_color", 0);
+            colour3(&mut x, "subsurface_radius", 1);
+            scalar(&mut x, "subsurface_scale", format!("{radius:.6}"));
+            scalar(&mut x, "subsurface_anisotropy", g);
+            scalar(&mut x, "specular", weight);
+            scalar(&mut x, "specular_roughness", roughness);
+            scalar(&mut x, "specular_IOR", ior);
         }
     }
     let _ = writeln!(x, "  </{node}>");

@@ -32,7 +32,7 @@ def main() -> None:
             spec = nodedef.getActiveInput(inp.getName()) if nodedef else None
             if spec is None or spec.getType() != inp.getType():
                 unknown.append(inp.getName())
-            if inp.getType() == "color3":
+            if inp.getType() == "color3" and inp.getValue() is not None:
                 values[inp.getName()] = list(inp.getValue().asTuple())
     # MaterialX's default CMS: which inputs it would transform, and with which matrix.
     gen = mx_gen_glsl.GlslShaderGenerator.create()
