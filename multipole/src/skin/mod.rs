@@ -19,6 +19,7 @@ mod explain;
 mod options;
 mod shape;
 mod shape_table;
+pub mod thin_slab;
 pub use explain::{DIFFUSION_OK, Explanation, explain};
 pub use options::ProfileOptions;
 pub use shape::{
