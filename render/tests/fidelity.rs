@@ -208,11 +208,11 @@ fn scene_keys_set_the_fidelity_and_bad_ones_are_named() {
     }
 }
 
-/// A closed box of light skin (smooth surface) `thickness_mm` thick and 60 mm across, seen
+/// A closed box of skin (`preset`, smooth surface) `thickness_mm` thick and 60 mm across, seen
 /// head-on from 300 mm; lit from behind by a 200-mm quad (`backlit`) or from the front by a
 /// sphere, with a weak sky. The backlit slabs are the cases where the BSSRDF fails (BENCHMARKS.md,
 /// "BSSRDF against the volumetric reference").
-fn slab_scene(dir: &std::path::Path, thickness_mm: f32, backlit: bool) -> String {
+fn slab_scene(dir: &std::path::Path, preset: &str, thickness_mm: f32, backlit: bool) -> String {
     let obj = dir.join(format!("slab{thickness_mm}.obj"));
     std::fs::write(
         &obj,
@@ -227,7 +227,7 @@ fn slab_scene(dir: &std::path::Path, thickness_mm: f32, backlit: bool) -> String
     format!(
         "[camera]\nposition_mm = [0, 0, 300]\nlook_at_mm = [0, 0, 0]\nfov_deg = 5.7\n\
          [environment]\nspectrum = \"d65\"\nintensity = 0.02\n\
-         [materials.skin]\ntype = \"skin\"\npreset = \"light\"\nsurface = \"smooth\"\n\
+         [materials.skin]\ntype = \"skin\"\npreset = \"{preset}\"\nsurface = \"smooth\"\n\
          [[meshes]]\nfile = \"{}\"\nmaterial = \"skin\"\n[[lights]]\n{light}\n",
         obj.display()
     )
@@ -288,7 +288,7 @@ struct AutoSlab {
 
 fn auto_slab(thickness_mm: f32, backlit: bool, side: usize, spp: u32, seed: u64) -> AutoSlab {
     let dir = tempfile::tempdir().unwrap();
-    let toml = slab_scene(dir.path(), thickness_mm, backlit);
+    let toml = slab_scene(dir.path(), "light", thickness_mm, backlit);
     let scene = load_slab(&toml, Some(render::fidelity::DEFAULT_THIN_WALK_R99));
     let body = BodyIntegrator::build(&scene, IntegratorKind::Bssrdf);
     let (_, _, film) = mean_y(&scene, &body, side, spp, seed);
@@ -301,33 +301,40 @@ fn auto_slab(thickness_mm: f32, backlit: bool, side: usize, spp: u32, seed: u64)
     }
 }
 
-/// Backlit slabs of light skin 1, 2 and 4 mm thick, all thinner than its r99 (4.95 mm), in the
+/// Backlit slabs of light skin 1, 2 and 4 mm thick and of medium skin 4 mm thick (thicker than
+/// its r₉₉, 4.0 mm, yet transmitting: T(4 mm) E_far is about 0.4 of R∞ E_near there), in the
 /// default configuration (no fidelity knob set): every hit the camera sees takes the walk, and the
 /// image agrees with the volumetric reference (`--integrator volumetric`, another seed) within 4
-/// standard errors of the difference, two-sided (each mean's error from its variance pass, 3–5%
-/// at 12² pixels × 48 paths; a false alarm at 4σ is 6·10⁻⁵ per slab). The BSSRDF alone
-/// (`thin_walk` 0) returns 50–60% less (BENCHMARKS.md, "BSSRDF against the volumetric
-/// reference"), more than 4σ below the reference at each thickness, so the check can fail.
+/// standard errors of the difference, two-sided (each mean's error from its variance pass, 3–8%
+/// at 12² pixels × 48 paths, 128 for medium skin; a false alarm at 4σ is 6·10⁻⁵ per slab). The BSSRDF alone
+/// (`thin_walk` 0) returns 27–60% less (docs/accuracy_evidence.md §4), more than 4σ below the
+/// reference at each slab, so the check can fail.
 #[test]
 fn default_backlit_slabs_match_the_volumetric_reference() {
-    let (side, spp) = (12, 48);
-    for mm in [1.0, 2.0, 4.0] {
+    let side = 12;
+    // Medium skin's BSSRDF misses by 27%, not 50–60%: 128 paths keep that gap beyond 4σ.
+    for (preset, mm, spp) in [
+        ("light", 1.0, 48),
+        ("light", 2.0, 48),
+        ("light", 4.0, 48),
+        ("medium", 4.0, 128),
+    ] {
         let dir = tempfile::tempdir().unwrap();
-        let toml = slab_scene(dir.path(), mm, true);
+        let toml = slab_scene(dir.path(), preset, mm, true);
         let scene = load_slab(&toml, None);
         let body = BodyIntegrator::build(&scene, IntegratorKind::Bssrdf);
         let (y, err, _) = mean_y(&scene, &body, side, spp, 1);
         let (tested, walked) = body.thin_parts().unwrap().part(0).unwrap().counts();
         assert!(
             tested > 0 && walked as f64 >= 0.95 * tested as f64,
-            "{mm} mm: {walked}/{tested} walked"
+            "{preset} {mm} mm: {walked}/{tested} walked"
         );
         let volumetric = BodyIntegrator::build(&scene, IntegratorKind::Volumetric);
         let (y_ref, e_ref, _) = mean_y(&scene, &volumetric, side, spp, 2);
         let sigma = err.hypot(e_ref);
         assert!(
             (y - y_ref).abs() <= 4.0 * sigma,
-            "{mm} mm: default {y} ± {err} against the reference {y_ref} ± {e_ref}"
+            "{preset} {mm} mm: default {y} ± {err} against the reference {y_ref} ± {e_ref}"
         );
         let alone = load_slab(&toml, Some(0.0));
         let bssrdf = BodyIntegrator::build(&alone, IntegratorKind::Bssrdf);
@@ -335,7 +342,7 @@ fn default_backlit_slabs_match_the_volumetric_reference() {
         let (y_bssrdf, e_bssrdf, _) = mean_y(&alone, &bssrdf, side, spp, 3);
         assert!(
             y_ref - y_bssrdf > 4.0 * e_bssrdf.hypot(e_ref),
-            "{mm} mm: the BSSRDF alone ({y_bssrdf}) should miss the reference ({y_ref})"
+            "{preset} {mm} mm: the BSSRDF alone ({y_bssrdf}) should miss the reference ({y_ref})"
         );
     }
 }
@@ -359,7 +366,7 @@ fn the_thin_walk_keeps_the_bssrdf_on_a_thick_slab() {
 #[test]
 fn a_thin_slab_lit_only_from_the_front_keeps_the_bssrdf() {
     let dir = tempfile::tempdir().unwrap();
-    let toml = slab_scene(dir.path(), 2.0, false)
+    let toml = slab_scene(dir.path(), "light", 2.0, false)
         .replace("[environment]\nspectrum = \"d65\"\nintensity = 0.02\n", "");
     assert!(!toml.contains("[environment]"));
     let scene = load_slab(&toml, None);

@@ -105,8 +105,9 @@ pub struct RenderArgs {
     /// radius: BSSRDF below LO, diffuse above HI, blended between; auto: 1,4).
     #[arg(long, value_name = "off|LO,HI", value_parser = Checked(parse_lod))]
     pub lod: Option<LodSetting>,
-    /// Volumetric walk instead of the BSSRDF where the body under a skin hit is thinner than this
-    /// many of the skin's largest 99% energy radii and its far face is lit, in [0, 10] (0: never;
+    /// Volumetric walk instead of the BSSRDF at thin parts (where the BSSRDF would omit a share
+    /// `render::fidelity::THIN_OMISSION_SHARE` of the light, judged from the slab's exact transmission and both faces' light) seen at pixel
+    /// footprints below this many of the skin's largest 99% energy radii, in [0, 10] (0: never;
     /// auto: 1, full: 0).
     #[arg(long, value_name = "R99S", value_parser = Checked(parse_thin_walk), allow_hyphen_values = true)]
     pub thin_walk: Option<f64>,

@@ -13,13 +13,13 @@ use std::fmt::Write;
 /// How a skin's body is shaded.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum TransportChoice {
-    /// The separable BSSRDF, and the volumetric walk where the body under a hit is thinner than
-    /// `walk_below_mm` (`crate::volumetric::thin`); `transport_mfp_mm` is the dermis' largest transport
-    /// mean free path 1/(σa + σs') over 380–780 nm, for scale.
+    /// The separable BSSRDF, and the volumetric walk at thin parts where the pixel footprint is
+    /// below `walk_below_mm` (`crate::volumetric::thin`); `transport_mfp_mm` is the dermis'
+    /// largest transport mean free path 1/(σa + σs') over 380–780 nm, for scale.
     Bssrdf {
         /// Largest transport mean free path, mm.
         transport_mfp_mm: f64,
-        /// Local thickness below which a hit takes the walk, mm (`None`: never).
+        /// Pixel footprint below which a thin part takes the walk, mm (`None`: never).
         walk_below_mm: Option<f32>,
     },
     /// The Lambertian stand-in (`--no-subsurface`).
@@ -27,7 +27,7 @@ pub enum TransportChoice {
 }
 
 impl TransportChoice {
-    /// The local thickness below which a hit takes the walk, mm, if it ever does.
+    /// The pixel footprint below which a thin part takes the walk, mm, if it ever does.
     #[must_use]
     pub fn walk_below_mm(&self) -> Option<f32> {
         match self {
@@ -204,10 +204,12 @@ pub fn explain_table(skins: &[(&str, &SkinChoices)]) -> String {
                 transport_mfp_mm,
                 walk_below_mm: Some(t),
             } => format!(
-                "BSSRDF; the volumetric walk where the body under a hit is thinner than {t:.2} mm \
-                 along the inward normal and its far face is lit ({:.1} × r99; dermis transport \
-                 mean free path {transport_mfp_mm:.3} mm); share of hits walked printed after the \
-                 render",
+                "BSSRDF; the volumetric walk where the BSSRDF would omit ≥ {:.0}% of the light, from \
+                 the slab's exact transmission at the thickness along the inward normal and both \
+                 faces' direct light, at pixel footprints below {t:.2} mm ({:.1} × r99; dermis \
+                 transport mean free path {transport_mfp_mm:.3} mm); share of hits walked printed \
+                 after the render",
+                100.0 * super::THIN_OMISSION_SHARE,
                 t / c.r99_mm.max(f32::MIN_POSITIVE)
             ),
             TransportChoice::Bssrdf {

@@ -38,10 +38,17 @@ use std::fmt;
 use std::str::FromStr;
 use thiserror::Error;
 
-/// Factor of r₉₉ below which a hit's local thickness takes the volumetric walk
-/// (`crate::volumetric::thin`) under `Fidelity::Auto`, as measured on the backlit slabs (`--thin-walk
-/// K` sets another, 0 turns the walk off; `Fidelity::Full` never walks).
+/// Factor of r₉₉: the pixel footprint below which a thin part (where the BSSRDF would omit at least
+/// [`THIN_OMISSION_SHARE`] of the light, judged from the slab's exact transmission)
+/// takes the volumetric walk under `Fidelity::Auto` (`--thin-walk K` sets another, 0 turns the walk
+/// off; `Fidelity::Full` never walks).
 pub const DEFAULT_THIN_WALK_R99: f64 = 1.0;
+
+/// Share of the light the BSSRDF returns at a hit, R∞ E_near, that it may omit there (light
+/// crossing from a lit far face, reflection a thin part lacks) before the hit takes the volumetric
+/// walk (`crate::volumetric::thin`, docs/physics.md §16.7). The approximation's knob: its error on
+/// backlit and front-lit slabs and on the ear is measured in docs/accuracy_evidence.md §4.
+pub const THIN_OMISSION_SHARE: f32 = 0.05;
 /// Wavelength step of the skin reflectance tables in `Fidelity::Full` and without a BSSRDF, nm
 /// (interpolated to 5 nm).
 pub const SKIN_TABLE_STEP_NM: f64 = 10.0;
@@ -118,7 +125,7 @@ pub struct FidelityKnobs {
     pub wavelength_step_nm: Option<f64>,
     /// Level of detail by pixel footprint.
     pub lod: LodSetting,
-    /// Local thickness, in units of the skin's largest r₉₉, below which a hit takes the
+    /// Pixel footprint, in units of the skin's largest r₉₉, below which a thin part takes the
     /// volumetric walk, in [0, 10] (0: never).
     pub thin_walk_r99: Option<f64>,
     /// Photons of the universal shape table, in [1e4, 1e9] (auto: from the pixel footprint,
@@ -187,7 +194,7 @@ pub struct Resolved {
     pub step: StepChoice,
     /// The level-of-detail band, if on.
     pub lod: Option<LodBand>,
-    /// The thin-part walk's threshold in r₉₉, if on.
+    /// The thin-part walk's largest pixel footprint in r₉₉, if on.
     pub thin_walk_r99: Option<f64>,
     /// How the shape photons are chosen.
     pub photons: PhotonPolicy,

@@ -9,6 +9,7 @@
 
 pub mod distance;
 pub mod shapes;
+pub mod slab_table;
 pub mod thin;
 pub mod walk;
 

@@ -1,28 +1,32 @@
-//! BSSRDF or volumetric walk, per hit (docs/physics.md §16.6). The separable BSSRDF takes the skin
-//! under a hit for a half-space (§8); where the body is thinner than the distance its light
-//! travels, light that the half-space would send back instead crosses to the far face, and light
-//! entering the far face crosses to the viewer: the BSSRDF returns 50–60% too little of a backlit
-//! slab 1–4 mm thick (BENCHMARKS.md, "BSSRDF against the volumetric reference"). The criterion: a
-//! probe ray from the hit along the inward normal; when it meets the same material's surface
-//! within `walk_below_mm` — the skin's largest 99% energy radius r₉₉ (over the table's
-//! wavelengths) times a factor (`crate::fidelity::DEFAULT_THIN_WALK_R99`, `--thin-walk`) — and
-//! that far face receives direct light ([`FAR_LIGHT_SHARE`]), the hit is thin and the path takes
-//! the volumetric walk (`crate::volumetric`, §15) through the mesh instead of the BSSRDF. r₉₉ is
-//! the profile's own reach: a slab thicker than it holds 99% of the half-space's light within its
-//! depth, so the BSSRDF's answer stands. A thin part lit only from the front (an eyelid over the
-//! eye's cavity) keeps the BSSRDF: there the walk would add a heavy-tailed estimate for light the
-//! BSSRDF misses by little.
+//! BSSRDF or volumetric walk, per hit (docs/physics.md §16.6–16.7). The separable BSSRDF takes the
+//! skin under a hit for a half-space (§8); where the body is thin, light that the half-space would
+//! send back instead crosses to the far face, and light entering the far face crosses to the
+//! viewer: the BSSRDF returns 50–60% too little of a backlit slab 1–4 mm thick
+//! (docs/accuracy_evidence.md §4). The criterion: a probe ray from the hit along the inward normal
+//! meets the same material's surface at a distance d; the light the BSSRDF omits there is, from
+//! the slab's exact totals ([`SlabTable`]: R(d), T(d), R∞ by adding-doubling),
+//!
+//! omitted / returned = (T(d) E_far + (R∞ − R(d)) E_near) / (R∞ E_near),
+//!
+//! with E_near and E_far the direct light of the two faces (the path tracer's light-selection
+//! proxies where a shadow ray to each light's centre is clear). Where that share reaches
+//! [`OMISSION_SHARE`] the path takes the volumetric walk (`crate::volumetric`, §15) through the
+//! mesh instead of the BSSRDF. The probe is as long as the thickest slab whose T could still
+//! matter under a far face [`MAX_FAR_TO_NEAR`] times brighter than the near one. A thin part lit
+//! only from the front (an eyelid over the eye's cavity) keeps the BSSRDF: there the walk would
+//! add a heavy-tailed estimate for light the BSSRDF misses by little.
 //!
 //! The walk needs each material's epidermis region, a distance grid over its triangles that takes
 //! seconds for a head: it is built at the first thin hit of that material (`OnceLock`), so a scene
 //! without thin parts pays one short probe ray per subsurface hit and nothing else.
 //!
-//! A pixel whose footprint exceeds `walk_below_mm` does not resolve the thin part: its light is
-//! summed with that of the thick skin around it, thin hits are a small share of the pixel
-//! (1.3% of light-skin hits in `builtin:three-heads-far`), and the walk costs about fifty BSSRDF
-//! paths. There the hit keeps the BSSRDF and no probe ray is traced, as the level of detail
-//! (`crate::fidelity::lod`) keeps no profile the footprint cannot resolve.
+//! A pixel whose footprint exceeds `walk_below_mm` (k r₉₉, `--thin-walk K`) does not resolve the
+//! thin part: its light is summed with that of the thick skin around it, thin hits are a small
+//! share of the pixel (1.3% of light-skin hits in `builtin:three-heads-far`), and the walk costs
+//! about fifty BSSRDF paths. There the hit keeps the BSSRDF and no probe ray is traced, as the
+//! level of detail (`crate::fidelity::lod`) keeps no profile the footprint cannot resolve.
 
+use super::slab_table::SlabTable;
 use super::{LayerTables, SkinVolume};
 use crate::geometry::{SurfaceHit, offset_origin};
 use crate::light::Light;
@@ -37,8 +41,10 @@ use std::sync::atomic::{AtomicU64, Ordering};
 /// counts of the hits tested and walked.
 #[derive(Debug)]
 pub struct ThinPart {
-    /// Local thickness below which a hit walks, mm.
+    /// Pixel footprint above which a hit keeps the BSSRDF, mm (k r₉₉).
     pub walk_below_mm: f32,
+    /// The slab's totals over its thickness; its range is the probe's length.
+    pub slab: SlabTable,
     epidermis: LayerTables,
     dermis: LayerTables,
     phase_g: f64,
@@ -73,8 +79,21 @@ impl ThinParts {
                 parts.push(None);
                 continue;
             };
+            let slab = match SlabTable::build(
+                &skin.media,
+                f64::from(OMISSION_SHARE / MAX_FAR_TO_NEAR),
+                MAX_PROBE_MM,
+            ) {
+                Ok(t) => t,
+                Err(e) => {
+                    log::warn!("thin parts keep the BSSRDF: the slab totals failed: {e}");
+                    parts.push(None);
+                    continue;
+                }
+            };
             parts.push(Some(ThinPart {
                 walk_below_mm,
+                slab,
                 epidermis: skin.media.epidermis.clone(),
                 dermis: skin.media.dermis.clone(),
                 phase_g: skin.media.phase_g,
@@ -95,10 +114,10 @@ impl ThinParts {
         self.parts.get(material as usize).and_then(Option::as_ref)
     }
 
-    /// The medium to walk at `si` (geometric normal `ng` facing the viewer) when the body under it
-    /// is thinner than its material's threshold, the pixel footprint `footprint_mm` (mm) resolves
-    /// it and its far face is lit (`far_face_lit`); `None` to keep the BSSRDF. Counts the rays in
-    /// `rays`.
+    /// The medium to walk at `si` (geometric normal `ng` facing the viewer) when the pixel
+    /// footprint `footprint_mm` (mm) resolves the part and the BSSRDF would omit at least
+    /// [`OMISSION_SHARE`] of the light there ([`omitted_share`]); `None` to keep the BSSRDF.
+    /// Counts the rays in `rays`.
     pub fn walk_at(
         &self,
         scene: &Scene,
@@ -119,7 +138,7 @@ impl ThinParts {
             offset_origin(si.p, ng, inward),
             inward,
             0.0,
-            part.walk_below_mm,
+            part.slab.max_mm(),
         )?;
         if far.material != si.material {
             return None;
@@ -129,7 +148,9 @@ impl ThinParts {
         } else {
             -far.ng
         };
-        if !far_face_lit(scene, (si.p, ng), (far.p, far_out), rays) {
+        let e_near = direct_proxy(scene, (si.p, ng), rays);
+        let e_far = direct_proxy(scene, (far.p, far_out), rays);
+        if omitted_share(&part.slab, far.t, e_near, e_far) < OMISSION_SHARE {
             part.front_lit.fetch_add(1, Ordering::Relaxed);
             return None;
         }
@@ -162,11 +183,13 @@ impl ThinParts {
             let share = |n: u64| 100.0 * n as f64 / tested.max(1) as f64;
             let _ = writeln!(
                 s,
-                "skin '{name}': volumetric walk at {:.2}% of {tested} subsurface hits (thinner than \
-                 {:.2} mm, far face lit), the BSSRDF at the rest ({:.2}% thin with an unlit far face)",
+                "skin '{name}': volumetric walk at {:.2}% of {tested} subsurface hits (the BSSRDF \
+                 would omit ≥ {:.0}% of their light), the BSSRDF at the rest ({:.2}% within {:.1} mm \
+                 of a far face but below that share)",
                 share(walked),
-                part.walk_below_mm,
-                share(front_lit)
+                100.0 * OMISSION_SHARE,
+                share(front_lit),
+                part.slab.max_mm()
             );
         }
         s
@@ -184,31 +207,38 @@ impl ThinPart {
     }
 }
 
-/// Share of the near face's direct light (irradiance proxy) below which a thin part's far face
-/// counts as unlit. The light the BSSRDF omits there is what crosses from the far face, T·E_far,
-/// against the R·E_near it returns: below this share the omission is under 5% of the pixel
-/// wherever the part transmits no more than it reflects (T ≤ R). The error of the choice, with
-/// the light lost through the far face, is measured on front-lit slabs (docs/accuracy_evidence.md
-/// §4).
-pub const FAR_LIGHT_SHARE: f32 = 0.05;
+pub use crate::fidelity::THIN_OMISSION_SHARE as OMISSION_SHARE;
 
-/// Whether the far face of a thin part (point and outward normal `far`) receives at least
-/// [`FAR_LIGHT_SHARE`] of the direct light of its near face (`near`): per light, the selection
-/// proxy (radiance × solid angle × widened cosine, `Light::selection_weight`) where a shadow ray
-/// to the light's centre (the environment: along the normal) is clear. A part lit only from the
-/// front (an eyelid over the eye's cavity) keeps the BSSRDF: what it misses there is the light
-/// that crosses the part instead of returning (docs/physics.md §16.6), while the walk would add a
-/// heavy-tailed estimate for little light. Deterministic in the hit, so the technique chosen at a
-/// point never depends on random numbers.
-fn far_face_lit(scene: &Scene, near: (Vec3, Vec3), far: (Vec3, Vec3), rays: &mut u64) -> bool {
-    let e_near = direct_proxy(scene, near, rays);
-    let e_far = direct_proxy(scene, far, rays);
-    e_far > 0.0 && e_far >= FAR_LIGHT_SHARE * e_near
+/// The brightest far face, against the near one, that the probe's length allows for: beyond the
+/// thickness where T(d) < [`OMISSION_SHARE`] R∞ / this, no lighting makes the part thin (the
+/// backlit ear's far face receives about 100 times its near face's light).
+pub const MAX_FAR_TO_NEAR: f32 = 1000.0;
+
+/// Longest probe, mm, whatever the skin's transmission.
+const MAX_PROBE_MM: f64 = 60.0;
+
+/// The share of the returned light R∞ E_near that the BSSRDF omits at a part `d_mm` thick whose
+/// faces receive `e_near` and `e_far` (any common unit): the light crossing from the far face,
+/// T(d) E_far, and the reflection the half-space adds over the slab's, (R∞ − R(d)) E_near
+/// (docs/physics.md §16.7). Infinite where only the far face is lit, 0 where neither is.
+#[must_use]
+pub fn omitted_share(slab: &SlabTable, d_mm: f32, e_near: f32, e_far: f32) -> f32 {
+    let (r, t) = slab.totals(d_mm);
+    let r_inf = slab.half_space_reflectance();
+    let omitted = t * e_far + (r_inf - r).max(0.0) * e_near;
+    let returned = r_inf * e_near;
+    if returned > 0.0 {
+        omitted / returned
+    } else if omitted > 0.0 {
+        f32::INFINITY
+    } else {
+        0.0
+    }
 }
 
 /// Sum over the lights (and the environment) visible from `p` along their centre ray of their
 /// selection proxies at `(p, n)`; counts the shadow rays in `rays`.
-fn direct_proxy(scene: &Scene, (p, n): (Vec3, Vec3), rays: &mut u64) -> f32 {
+pub fn direct_proxy(scene: &Scene, (p, n): (Vec3, Vec3), rays: &mut u64) -> f32 {
     let clear = |d: Vec3, t_max: f32, rays: &mut u64| {
         if d.dot(n) <= 0.0 {
             return false;
