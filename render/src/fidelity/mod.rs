@@ -46,7 +46,7 @@ pub const DEFAULT_THIN_WALK_R99: f64 = 1.0;
 
 /// Share of the light the BSSRDF returns at a hit, R∞ E_near, that it may omit there (light
 /// crossing from a lit far face, reflection a thin part lacks) before the hit takes the volumetric
-/// walk (`crate::volumetric::thin`, docs/physics.md §16.7). The approximation's knob: its error on
+/// walk (`crate::volumetric::thin`, docs/physics.md §16.6). The approximation's knob: its error on
 /// backlit and front-lit slabs and on the ear is measured in docs/accuracy_evidence.md §4.
 pub const THIN_OMISSION_SHARE: f32 = 0.05;
 /// Wavelength step of the skin reflectance tables in `Fidelity::Full` and without a BSSRDF, nm

@@ -1,4 +1,4 @@
-//! Monte Carlo shape photons from the pixel footprint (docs/physics.md §16.7). The exact profile's
+//! Monte Carlo shape photons from the pixel footprint (docs/physics.md §16.6). The exact profile's
 //! radial shape comes from photons (the universal white-Monte-Carlo table, or run-time escapes), and
 //! its error is Monte Carlo noise that falls as 1/√photons. A pixel of footprint F integrates the
 //! profile over itself: light that leaves within F/2 of where it entered lands, on average, in the

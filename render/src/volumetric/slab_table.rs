@@ -1,5 +1,5 @@
 //! A skin slab's exact totals over its thickness, as the image's luminance sees them (docs/physics.md
-//! §16.7): R(d) and T(d) of `multipole::skin::thin_slab` (adding-doubling, normal incidence) every
+//! §16.6): R(d) and T(d) of `multipole::skin::thin_slab` (adding-doubling, normal incidence) every
 //! 10 nm over 380–780 nm, weighted by ȳ(λ) D65(λ), on a uniform grid of thicknesses. Between nodes
 //! R is linear and ln T is linear in d (T falls nearly exponentially, e^(−d/δ) with δ the
 //! dermis' diffusion length), so the grid step is set by the measured interpolation error

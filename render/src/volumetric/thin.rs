@@ -1,4 +1,4 @@
-//! BSSRDF or volumetric walk, per hit (docs/physics.md §16.6–16.7). The separable BSSRDF takes the
+//! BSSRDF or volumetric walk, per hit (docs/physics.md §16.6). The separable BSSRDF takes the
 //! skin under a hit for a half-space (§8); where the body is thin, light that the half-space would
 //! send back instead crosses to the far face, and light entering the far face crosses to the
 //! viewer: the BSSRDF returns 50–60% too little of a backlit slab 1–4 mm thick
@@ -29,7 +29,7 @@
 use super::slab_table::SlabTable;
 use super::{LayerTables, SkinVolume};
 use crate::geometry::{SurfaceHit, offset_origin};
-use crate::light::Light;
+use crate::light::{Light, QuadLight};
 use crate::material::Material;
 use crate::scene::Scene;
 use glam::Vec3;
@@ -220,7 +220,7 @@ const MAX_PROBE_MM: f64 = 60.0;
 /// The share of the returned light R∞ E_near that the BSSRDF omits at a part `d_mm` thick whose
 /// faces receive `e_near` and `e_far` (any common unit): the light crossing from the far face,
 /// T(d) E_far, and the reflection the half-space adds over the slab's, (R∞ − R(d)) E_near
-/// (docs/physics.md §16.7). Infinite where only the far face is lit, 0 where neither is.
+/// (docs/physics.md §16.6). Infinite where only the far face is lit, 0 where neither is.
 #[must_use]
 pub fn omitted_share(slab: &SlabTable, d_mm: f32, e_near: f32, e_far: f32) -> f32 {
     let (r, t) = slab.totals(d_mm);
@@ -236,8 +236,35 @@ pub fn omitted_share(slab: &SlabTable, d_mm: f32, e_near: f32, e_far: f32) -> f3
     }
 }
 
+/// Irradiance at `p` (normal `n`) from quad light `q`, its mean radiance times the projected
+/// solid angle of the quad (Lambert's polygon formula, ½ Σ γ_i n · (r_i × r_(i+1))/|…|, the
+/// quad taken whole above the horizon). The light-selection proxy takes a near quad for a point
+/// source, which underestimates a 200-mm quad 60 mm behind a slab sevenfold; the criterion
+/// compares the two faces' light, so it needs the irradiance itself.
+fn quad_irradiance(q: &QuadLight, p: Vec3, n: Vec3) -> f32 {
+    let normal = q.edge_u_mm.cross(q.edge_v_mm);
+    if (p - q.corner_mm).dot(normal) <= 0.0 {
+        return 0.0;
+    }
+    let corners = [
+        q.corner_mm,
+        q.corner_mm + q.edge_u_mm,
+        q.corner_mm + q.edge_u_mm + q.edge_v_mm,
+        q.corner_mm + q.edge_v_mm,
+    ]
+    .map(|c| (c - p).normalize_or_zero());
+    let mut projected = 0.0f32;
+    for i in 0..4 {
+        let (a, b) = (corners[i], corners[(i + 1) % 4]);
+        let gamma = a.dot(b).clamp(-1.0, 1.0).acos();
+        projected += gamma * n.dot(a.cross(b).normalize_or_zero());
+    }
+    q.radiance.mean() * (0.5 * projected).abs()
+}
+
 /// Sum over the lights (and the environment) visible from `p` along their centre ray of their
-/// selection proxies at `(p, n)`; counts the shadow rays in `rays`.
+/// direct light at `(p, n)`: a quad's irradiance, the other lights' selection proxies (radiance ×
+/// solid angle × widened cosine); counts the shadow rays in `rays`.
 pub fn direct_proxy(scene: &Scene, (p, n): (Vec3, Vec3), rays: &mut u64) -> f32 {
     let clear = |d: Vec3, t_max: f32, rays: &mut u64| {
         if d.dot(n) <= 0.0 {
@@ -255,7 +282,10 @@ pub fn direct_proxy(scene: &Scene, (p, n): (Vec3, Vec3), rays: &mut u64) -> f32 
     };
     let mut e = 0.0;
     for light in &scene.lights {
-        let w = light.selection_weight(p, n);
+        let w = match light {
+            Light::Quad(q) => quad_irradiance(q, p, n),
+            _ => light.selection_weight(p, n),
+        };
         if w <= 0.0 {
             continue;
         }
