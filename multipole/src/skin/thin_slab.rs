@@ -1,5 +1,5 @@
 //! The skin as a finite slab: a body `d` thick with the epidermis on both faces and the dermis
-//! between, in air on both sides (docs/physics.md §16.7). This is what a thin part of a mesh (an
+//! between, in air on both sides (docs/physics.md §16.6). This is what a thin part of a mesh (an
 //! ear's rim, a backlit slab) is to the volumetric walk, whose epidermis is the shell within the
 //! epidermis' thickness of the surface. Adding-doubling ([Prahl95], physics §10) gives its exact
 //! totals at normal incidence: the diffuse reflectance R(d) and the transmittance T(d) per
