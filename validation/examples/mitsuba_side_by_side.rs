@@ -34,7 +34,9 @@ use render::material::Material;
 use render::material::SkinKnobs;
 use render::renderer::{RenderOptions, render_with};
 use render::scene::Scene;
+use render::volumetric::guide::DEFAULT_GUIDED_FRACTION;
 use render::volumetric::shapes::sphere_obj;
+use render::volumetric::walk::ROULETTE_BELOW;
 use render::volumetric::{LayerTables, SkinVolume, Volumetric};
 use skin_optics::Wavelength;
 use std::path::Path;
@@ -70,8 +72,26 @@ struct Media {
     eta: f64,
 }
 
+/// Our walk's knobs: the guided fraction and the roulette weight.
+#[derive(Debug, Clone, Copy)]
+struct Knobs {
+    guided: f64,
+    roulette: f64,
+}
+
+impl Knobs {
+    fn apply(self, v: SkinVolume) -> anyhow::Result<SkinVolume> {
+        Ok(v.with_guided_fraction(self.guided)?
+            .with_roulette_below(self.roulette)?)
+    }
+}
+
 /// Our scene: the OBJ under the constant sky with the body, and what Mitsuba is to be given.
-fn our_scene(dir: &Path, body: Body) -> anyhow::Result<((Scene, BodyIntegrator), Media)> {
+fn our_scene(
+    dir: &Path,
+    body: Body,
+    knobs: Knobs,
+) -> anyhow::Result<((Scene, BodyIntegrator), Media)> {
     let keys = match body {
         Body::Skin => format!(
             "melanin = {}\neumelanin = {}\nhemoglobin = {}\nphase_g = 0",
@@ -102,17 +122,26 @@ fn our_scene(dir: &Path, body: Body) -> anyhow::Result<((Scene, BodyIntegrator),
             g: 0.0,
             eta: skin.params.eta(),
         };
-        let integrator = BodyIntegrator::build(&scene, IntegratorKind::Volumetric);
-        return Ok(((scene, integrator), media));
+        let BodyIntegrator::Volumetric(mut walked) =
+            BodyIntegrator::build(&scene, IntegratorKind::Volumetric)
+        else {
+            anyhow::bail!("not the volumetric integrator");
+        };
+        for m in &mut walked.media {
+            if let Some(v) = m.take() {
+                *m = Some(knobs.apply(v)?);
+            }
+        }
+        return Ok(((scene, BodyIntegrator::Volumetric(walked)), media));
     }
-    let volume = SkinVolume::new(
+    let volume = knobs.apply(SkinVolume::new(
         LayerTables::constant(SIGMA_A, SIGMA_S),
         LayerTables::constant(SIGMA_A, SIGMA_S),
         G,
         ETA,
         0.1,
         scene.geometry.triangles_of(0),
-    );
+    ))?;
     let integrator = BodyIntegrator::Volumetric(Volumetric {
         media: vec![Some(volume)],
     });
@@ -251,7 +280,8 @@ fn mitsuba(
 fn main() -> anyhow::Result<()> {
     let args: Vec<String> = std::env::args().collect();
     let python = args.get(1).context(
-        "usage: mitsuba_side_by_side PYTHON [VARIANT] [RR_DEPTH] [ROUNDS] [SPP] [SIDE] [SCENE]",
+        "usage: mitsuba_side_by_side PYTHON|none [VARIANT] [RR_DEPTH] [ROUNDS] [SPP] [SIDE] [SCENE] \
+         [GUIDED] [ROULETTE]",
     )?;
     let variant = args.get(2).map_or("llvm_ad_mono", String::as_str);
     let num = |k: usize, d: u32| args.get(k).map_or(Ok(d), |s| s.parse::<u32>());
@@ -262,16 +292,21 @@ fn main() -> anyhow::Result<()> {
         "homogeneous" => Body::Homogeneous,
         other => anyhow::bail!("SCENE {other:?}: skin or homogeneous"),
     };
+    let real = |k: usize, d: f64| args.get(k).map_or(Ok(d), |s| s.parse::<f64>());
+    let knobs = Knobs {
+        guided: real(8, DEFAULT_GUIDED_FRACTION)?,
+        roulette: real(9, ROULETTE_BELOW)?,
+    };
     let dir = tempfile::tempdir()?;
     std::fs::write(dir.path().join("sphere.obj"), sphere_obj(4, RADIUS_MM))?;
-    let (scene, media) = our_scene(dir.path(), body)?;
+    let (scene, media) = our_scene(dir.path(), body, knobs)?;
     if let Some((_, d_epi)) = media.dermis {
         std::fs::write(
             dir.path().join("dermis.obj"),
             sphere_obj(4, RADIUS_MM - d_epi as f32),
         )?;
     }
-    println!("{body:?} sphere; Mitsuba's media {media:?}");
+    println!("{body:?} sphere; our walk {knobs:?}; Mitsuba's media {media:?}");
     let pixels = region(side);
     let paths = (side * side) as f64 * f64::from(spp);
     println!(
@@ -286,6 +321,16 @@ fn main() -> anyhow::Result<()> {
         let seeds = [2 * round + 1, 2 * round + 2];
         let (a, ta) = ours(&scene, side, spp, seeds[0])?;
         let (b, tb) = ours(&scene, side, spp, seeds[1])?;
+        if python == "none" {
+            let (mean, se, var1) = stats(&a, &b, &pixels, spp);
+            let rate = 2.0 * paths / (ta + tb);
+            println!(
+                "{round} | {mean:.5} ± {se:.5}, {rate:.0}, {:.3} | efficiency {:.0}",
+                var1.sqrt(),
+                rate / var1
+            );
+            continue;
+        }
         let m = mitsuba(
             python,
             variant,
@@ -322,6 +367,9 @@ fn main() -> anyhow::Result<()> {
             row[1].2,
             row[1].3.sqrt()
         );
+    }
+    if python == "none" {
+        return Ok(());
     }
     let r = f64::from(rounds);
     let [o, mi] = sums.map(|(m, se2, p, t)| (m / r, se2.sqrt() / r, p / t));

@@ -8,11 +8,13 @@
 //! the material is), tabulated every 5 nm and read at the path's hero wavelength.
 
 pub mod distance;
+pub mod guide;
 pub mod shapes;
 pub mod slab_table;
 pub mod thin;
 pub mod walk;
 
+use crate::error::SettingError;
 use crate::material::Material;
 use crate::scene::Scene;
 use crate::spectrum::{N_WAVELENGTHS, SampledSpectrum};
@@ -32,6 +34,12 @@ pub struct SkinVolume {
     pub dermis: LayerTables,
     /// Henyey–Greenstein sampler of both layers' g.
     pub hg: HgSampler,
+    /// Both layers' Henyey–Greenstein g.
+    pub g: f64,
+    /// Share of the walk's segments sampled towards the surface ([`guide`]; 0: classic only).
+    pub guided_fraction: f64,
+    /// Weight below which the walk plays Russian roulette (`walk::ROULETTE_BELOW` by default).
+    pub roulette_below: f64,
     /// Index of refraction of the skin (outside: air, n = 1).
     pub eta: f32,
     /// Which points lie in the epidermis (within d_epi of the surface).
@@ -54,9 +62,46 @@ impl SkinVolume {
             epidermis,
             dermis,
             hg: HgSampler::new(g),
+            g,
+            guided_fraction: guide::DEFAULT_GUIDED_FRACTION,
+            roulette_below: walk::ROULETTE_BELOW,
             eta,
             epidermis_region: SurfaceDistance::new(triangles, d_epi_mm),
         }
+    }
+
+    /// The same medium with `fraction` of the walk's segments guided towards the surface, in
+    /// [0, 1] (0: the classic walk; 1: guided only, its weights unbounded).
+    ///
+    /// # Errors
+    /// [`SettingError`] naming `guided_fraction` outside [0, 1].
+    pub fn with_guided_fraction(mut self, fraction: f64) -> Result<Self, SettingError> {
+        if !(0.0..=1.0).contains(&fraction) {
+            return Err(SettingError {
+                name: "guided_fraction",
+                value: fraction.to_string(),
+                range: "[0, 1]",
+            });
+        }
+        self.guided_fraction = fraction;
+        Ok(self)
+    }
+
+    /// The same medium with the walk's Russian roulette below weight `weight`, in (0, 1]: the walk
+    /// goes on with probability w/weight at that weight.
+    ///
+    /// # Errors
+    /// [`SettingError`] naming `roulette_below` outside (0, 1].
+    pub fn with_roulette_below(mut self, weight: f64) -> Result<Self, SettingError> {
+        if !(weight > 0.0 && weight <= 1.0) {
+            return Err(SettingError {
+                name: "roulette_below",
+                value: weight.to_string(),
+                range: "(0, 1]",
+            });
+        }
+        self.roulette_below = weight;
+        Ok(self)
     }
 }
 

@@ -28,6 +28,7 @@
 
 use super::SkinVolume;
 use super::distance::SurfaceDistance;
+use super::guide::{Guide, Segment};
 use crate::accel::BVH_MIN_T_MM;
 use crate::bssrdf::Directional;
 use crate::geometry::{Geometry, SurfaceHit};
@@ -127,10 +128,23 @@ pub fn walk<R: RngCore>(
     let mut anchor = Anchor::surface(x);
     let mut ahead: Option<Boundary> = None;
     let mut w = 1.0f64;
+    let majorant = f64::from(majorant);
+    let guide = Guide::new(
+        majorant,
+        &[epidermis, dermis],
+        vol.g,
+        vol.guided_fraction,
+    );
+    // The guide's outward normal: the last face the walk touched.
+    let mut normal = entry.ng.as_dvec3();
+    let mut segment = match &guide {
+        Some(guide) => guide.along(d, normal, rng),
+        None => Segment::classic(majorant),
+    };
     while out.collisions < MAX_COLLISIONS {
         // A clear medium (σ̄ = 0) flies straight to the surface.
         let s = if majorant > 0.0 {
-            -(1.0 - rng.random::<f64>()).ln() / f64::from(majorant)
+            -(1.0 - rng.random::<f64>()).ln() / segment.rate
         } else {
             f64::INFINITY
         };
@@ -143,17 +157,27 @@ pub fn walk<R: RngCore>(
             }
         }
         if let Some(b) = ahead.filter(|b| s >= b.t) {
+            if let Some(guide) = &guide {
+                segment.reach(b.t);
+                w *= guide.weight(&segment);
+            }
             match meet_surface(&b, d, vol, directional, w, rng) {
                 Ok(exit) => {
                     out.exit = Some(exit);
                     return out;
                 }
-                Err(reflected) => d = reflected,
+                Err((reflected, n_out)) => {
+                    d = reflected;
+                    normal = n_out;
+                }
             }
             x = b.p;
             on_face = Some(b.hit.triangle);
             anchor = Anchor::surface(x);
             ahead = None;
+            if let Some(guide) = &guide {
+                segment = guide.along(d, normal, rng);
+            }
             continue;
         }
         x += d * s;
@@ -162,6 +186,7 @@ pub fn walk<R: RngCore>(
             b.t -= s;
         }
         out.tentative += 1;
+        segment.collide(s);
         let (sa, ss) = if one_layer {
             dermis
         } else if in_epidermis(region, &mut anchor, x, d_epi) {
@@ -169,15 +194,23 @@ pub fn walk<R: RngCore>(
         } else {
             dermis
         };
-        if rng.random::<f32>() * majorant >= sa + ss {
+        if rng.random::<f32>() * majorant as f32 >= sa + ss {
             continue; // null collision
         }
         out.collisions += 1;
-        match after_collision(w, sa, ss, rng) {
+        if let Some(guide) = &guide {
+            w *= guide.weight(&segment);
+        }
+        match after_collision(w, sa, ss, vol.roulette_below, rng) {
             Some(kept) => w = kept,
             None => return out,
         }
-        d = DVec3::from_array(scatter_direction(d.to_array(), &vol.hg, rng)).normalize();
+        match &guide {
+            Some(guide) => (d, segment) = guide.scatter(d, normal, &vol.hg, rng),
+            None => {
+                d = DVec3::from_array(scatter_direction(d.to_array(), &vol.hg, rng)).normalize();
+            }
+        }
         ahead = None;
     }
     out
@@ -226,7 +259,8 @@ fn look_ahead(
 }
 
 /// At the surface `b` from inside along `d`: the light leaves with probability T of its refracted
-/// direction (the exit, carrying weight `w`), or is reflected (the new direction).
+/// direction (the exit, carrying weight `w`), or is reflected (the new direction, and the face's
+/// outward normal).
 fn meet_surface<R: RngCore>(
     b: &Boundary,
     d: DVec3,
@@ -234,7 +268,7 @@ fn meet_surface<R: RngCore>(
     directional: &Directional,
     w: f64,
     rng: &mut R,
-) -> Result<Exit, DVec3> {
+) -> Result<Exit, (DVec3, DVec3)> {
     let dir32 = d.as_vec3();
     let n_out = if b.hit.ng.dot(dir32) > 0.0 {
         b.hit.ng
@@ -252,7 +286,7 @@ fn meet_surface<R: RngCore>(
         });
     }
     let n = n_out.as_dvec3();
-    Err((d - n * (2.0 * d.dot(n))).normalize())
+    Err(((d - n * (2.0 * d.dot(n))).normalize(), n))
 }
 
 /// Whether `x` lies within `d_epi` of the surface (the epidermis), from the anchor's bounds where
@@ -270,17 +304,17 @@ fn in_epidermis(region: &SurfaceDistance, anchor: &mut Anchor, x: DVec3, d_epi: 
 }
 
 /// The path's weight after a real collision of single-scattering albedo σs/(σa + σs), with Russian
-/// roulette below [`ROULETTE_BELOW`] ([AK90]); `None` when the path ends.
-fn after_collision<R: RngCore>(w: f64, sa: f32, ss: f32, rng: &mut R) -> Option<f64> {
+/// roulette below `below` ([AK90]); `None` when the path ends.
+fn after_collision<R: RngCore>(w: f64, sa: f32, ss: f32, below: f64, rng: &mut R) -> Option<f64> {
     let w = w * f64::from(ss / (sa + ss));
     if w == 0.0 {
         return None;
     }
-    if w < ROULETTE_BELOW {
-        if rng.random::<f64>() * ROULETTE_BELOW >= w {
+    if w < below {
+        if rng.random::<f64>() * below >= w {
             return None;
         }
-        return Some(ROULETTE_BELOW);
+        return Some(below);
     }
     Some(w)
 }
