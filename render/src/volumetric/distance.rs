@@ -50,6 +50,30 @@ impl Tri {
         }
     }
 
+    /// Distance along the line from `x` along `d` at which it crosses the triangle
+    /// (Möller–Trumbore, f64; barycentrics within 1e-12 outside the edges count), if it does.
+    #[inline]
+    fn crossing(&self, x: DVec3, d: DVec3) -> Option<f64> {
+        const EDGE: f64 = 1e-12;
+        let p = d.cross(self.ac);
+        let det = self.ab.dot(p);
+        if det.abs() <= 1e-300 {
+            return None;
+        }
+        let inv = 1.0 / det;
+        let ax = x - self.a;
+        let u = ax.dot(p) * inv;
+        if !(-EDGE..=1.0 + EDGE).contains(&u) {
+            return None;
+        }
+        let q = ax.cross(self.ab);
+        let v = d.dot(q) * inv;
+        if v < -EDGE || u + v > 1.0 + EDGE {
+            return None;
+        }
+        Some(self.ac.dot(q) * inv)
+    }
+
     /// Squared distance from `p`, mm² (in f64: in f32 the closest point of a face 10⁴ mm from the
     /// origin is off by its ulp, 0.001 mm, which a point just under the face would add).
     #[inline]
@@ -57,6 +81,22 @@ impl Tri {
         let ap = p - self.a;
         (ap - closest_offset(ap, self.ab, self.ac)).length_squared()
     }
+}
+
+/// What the fine grid tells of a segment ([`SurfaceDistance::segment_hit`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum SegmentHit {
+    /// The grid does not list every triangle the segment can reach.
+    Unknown,
+    /// The segment crosses no face.
+    Clear,
+    /// The first face crossed, at distance `t` mm.
+    Face {
+        /// Distance along the segment, mm.
+        t: f64,
+        /// The face's vertices, world mm.
+        face: [Vec3; 3],
+    },
 }
 
 /// The coarse grid: chessboard distances (in cells) to the nearest cell that holds surface.
@@ -166,6 +206,8 @@ pub struct SurfaceDistance {
     cell_mm: f64,
     reach_mm: f64,
     triangles: Vec<Tri>,
+    /// The triangles' f32 vertices, as given (the faces' identity).
+    faces: Vec<[Vec3; 3]>,
     /// Per occupied fine cell, its range in `lists`.
     cells: FxHashMap<[i32; 3], (u32, u32)>,
     /// (distance of the triangle from the cell's centre in mm, triangle), nearest first.
@@ -238,6 +280,7 @@ impl SurfaceDistance {
             cell_mm,
             reach_mm,
             triangles: tris,
+            faces: triangles,
             cells,
             lists,
             coarse,
@@ -277,6 +320,56 @@ impl SurfaceDistance {
             m.min(unlisted.max(self.coarse.lower(p)))
         };
         (lo, m)
+    }
+
+    /// The first face crossed by the segment from `x` along unit `d` within `reach_mm`, with its
+    /// distance t in (`ahead_min`, `reach_mm`], passing over the face `skip`, found from the fine
+    /// grid when the cell of `x` lists every triangle the segment can reach (|x − c| + reach ≤ R:
+    /// a face within reach of x lies within R of c); [`SegmentHit::Unknown`] otherwise. The test is
+    /// Möller–Trumbore in f64 with edges counted on both sides, so a segment through a shared edge
+    /// meets a face.
+    #[must_use]
+    pub fn segment_hit(
+        &self,
+        x: DVec3,
+        d: DVec3,
+        reach_mm: f64,
+        skip: Option<&[Vec3; 3]>,
+        ahead_min: f64,
+    ) -> SegmentHit {
+        let cell = cell_of(x, self.cell_mm);
+        let off_centre = (x - centre_of(cell, self.cell_mm)).length();
+        let within = off_centre + reach_mm;
+        if within > self.reach_mm {
+            return SegmentHit::Unknown;
+        }
+        let Some(&(start, len)) = self.cells.get(&cell) else {
+            return SegmentHit::Clear;
+        };
+        let mut best: Option<(f64, usize)> = None;
+        for &(from_centre, t) in &self.lists[start as usize..(start + len) as usize] {
+            if f64::from(from_centre) > within {
+                break;
+            }
+            let index = t as usize;
+            let Some(t) = self.triangles[index].crossing(x, d) else {
+                continue;
+            };
+            if t > ahead_min
+                && t <= reach_mm
+                && best.is_none_or(|(b, _)| t < b)
+                && skip != Some(&self.faces[index])
+            {
+                best = Some((t, index));
+            }
+        }
+        match best {
+            Some((t, index)) => SegmentHit::Face {
+                t,
+                face: self.faces[index],
+            },
+            None => SegmentHit::Clear,
+        }
     }
 
     /// Whether `p` lies within the mesh's bounding box (and a margin): a point outside it is outside

@@ -27,7 +27,7 @@
 //! smooth normal there would refract into directions the flat face does not allow.
 
 use super::SkinVolume;
-use super::distance::SurfaceDistance;
+use super::distance::{SegmentHit, SurfaceDistance};
 use super::guide::{Guide, Segment};
 use crate::accel::BVH_MIN_T_MM;
 use crate::bssrdf::Directional;
@@ -122,9 +122,10 @@ pub fn walk<R: RngCore>(
     let material = entry.material;
     // The walk starts on the entry face itself (its f32 hit point put back on the face's plane):
     // an origin offset into the skin would skip medium.
-    let mut x = onto_face(geometry, entry.triangle, entry.p.as_dvec3());
+    let entry_face = geometry.triangle(entry.triangle);
+    let mut x = onto_face(&entry_face, entry.p.as_dvec3());
     let mut d = dir.as_dvec3();
-    let mut on_face = Some(entry.triangle);
+    let mut on_face = Some(entry_face);
     let mut anchor = Anchor::surface(x);
     let mut ahead: Option<Boundary> = None;
     let mut w = 1.0f64;
@@ -172,7 +173,7 @@ pub fn walk<R: RngCore>(
                 }
             }
             x = b.p;
-            on_face = Some(b.hit.triangle);
+            on_face = Some(b.face);
             anchor = Anchor::surface(x);
             ahead = None;
             if let Some(guide) = &guide {
@@ -222,7 +223,7 @@ struct Flight {
     x: DVec3,
     d: DVec3,
     s: f64,
-    on_face: Option<u32>,
+    on_face: Option<[Vec3; 3]>,
 }
 
 /// The surface the flight could reach, found only when the anchor's bounds (refreshed when they
@@ -252,7 +253,17 @@ fn look_ahead(
     }
     // Only as far as the flight goes: a short ray visits few BVH nodes.
     *rays += 1;
-    match surface_ahead(geometry, material, f.x, f.d, f.s, f.on_face) {
+    let ahead_min = ahead_min(f.x);
+    let found = match region.segment_hit(f.x, f.d, f.s, f.on_face.as_ref(), ahead_min) {
+        SegmentHit::Face { t, face } => Ahead::Surface(Boundary {
+            t,
+            p: f.x + f.d * t,
+            face,
+        }),
+        SegmentHit::Clear => Ahead::Clear,
+        SegmentHit::Unknown => surface_ahead(geometry, material, f, ahead_min),
+    };
+    match found {
         Ahead::Clear if !region.encloses(f.x + f.d * f.s) => Ahead::Lost,
         found => found,
     }
@@ -270,11 +281,9 @@ fn meet_surface<R: RngCore>(
     rng: &mut R,
 ) -> Result<Exit, (DVec3, DVec3)> {
     let dir32 = d.as_vec3();
-    let n_out = if b.hit.ng.dot(dir32) > 0.0 {
-        b.hit.ng
-    } else {
-        -b.hit.ng
-    };
+    let [a, b1, c] = b.face;
+    let ng = (b1 - a).cross(c - a).normalize_or_zero();
+    let n_out = if ng.dot(dir32) > 0.0 { ng } else { -ng };
     if let Some(t) = refract(dir32, -n_out, vol.eta)
         && rng.random::<f32>() < directional.transmittance(t.dot(n_out))
     {
@@ -345,12 +354,12 @@ impl Anchor {
 }
 
 /// The surface ahead of the walk: distance along its direction, point (f64, on the face's plane)
-/// and the BVH hit.
+/// and the face.
 #[derive(Debug, Clone, Copy)]
 struct Boundary {
     t: f64,
     p: DVec3,
-    hit: SurfaceHit,
+    face: [Vec3; 3],
 }
 
 /// What lies along a flight.
@@ -364,29 +373,31 @@ enum Ahead {
     Lost,
 }
 
-/// `p` moved onto the plane of triangle `triangle`.
-fn onto_face(geometry: &Geometry, triangle: u32, p: DVec3) -> DVec3 {
-    let [a, b, c] = geometry.triangle(triangle).map(Vec3::as_dvec3);
+/// `p` moved onto the plane of the triangle `face`.
+fn onto_face(face: &[Vec3; 3], p: DVec3) -> DVec3 {
+    let [a, b, c] = face.map(Vec3::as_dvec3);
     let n = (b - a).cross(c - a).normalize_or_zero();
     p - n * n.dot(p - a)
 }
 
-/// The first surface of `material` along `d` from `x` within `reach_mm`, refined in f64 against its
-/// face, passing over faces behind `x` and the face `on_face` that `x` lies on.
-fn surface_ahead(
-    geometry: &Geometry,
-    material: u32,
-    x: DVec3,
-    d: DVec3,
-    reach_mm: f64,
-    on_face: Option<u32>,
-) -> Ahead {
+/// What f64 plane intersections from `x` can still confuse with "on the face", mm.
+fn ahead_min(x: DVec3) -> f64 {
+    64.0 * f64::EPSILON * (1.0 + x.abs().max_element())
+}
+
+/// The first surface of `material` along the flight `f` (from the BVH), refined in f64 against
+/// its face, passing over faces at most `ahead_min` ahead and the face the flight starts on.
+fn surface_ahead(geometry: &Geometry, material: u32, f: Flight, ahead_min: f64) -> Ahead {
+    let Flight {
+        x,
+        d,
+        s: reach_mm,
+        on_face,
+    } = f;
     let scale = 1.0 + x.abs().max_element();
     // Beyond the f32 rounding of x (half an ulp of the coordinates) with a wide margin, and far
     // enough that the BVH sees surfaces just ahead of x.
     let back = (16.0 * f64::from(f32::EPSILON) * scale).max(2.0 * f64::from(BVH_MIN_T_MM));
-    // What f64 plane intersections can still confuse with "on the face".
-    let ahead_min = 64.0 * f64::EPSILON * scale;
     let (o, d32) = ((x - d * back).as_vec3(), d.as_vec3());
     // Past the reach by the f32 rounding of the origin and of t.
     let t_max = (back + reach_mm + back) as f32;
@@ -395,7 +406,8 @@ fn surface_ahead(
         let Some(hit) = geometry.intersect_material(o, d32, t_min, t_max, material) else {
             return Ahead::Clear;
         };
-        let [a, b, c] = geometry.triangle(hit.triangle).map(Vec3::as_dvec3);
+        let face = geometry.triangle(hit.triangle);
+        let [a, b, c] = face.map(Vec3::as_dvec3);
         let n = (b - a).cross(c - a);
         let nd = n.dot(d);
         let t = if nd.abs() > 1e-9 * n.length() {
@@ -406,11 +418,11 @@ fn surface_ahead(
         if t > reach_mm {
             return Ahead::Clear;
         }
-        if t > ahead_min && Some(hit.triangle) != on_face {
+        if t > ahead_min && Some(face) != on_face {
             return Ahead::Surface(Boundary {
                 t,
                 p: x + d * t,
-                hit,
+                face,
             });
         }
         // Past this hit (its t may be −0 when the origin rounds onto its plane).
