@@ -13,7 +13,7 @@ use std::f64::consts::PI;
 
 /// Share of the walk's segments sampled by the guide (the rest classic), when the medium allows
 /// guiding (BENCHMARKS.md, "Volumetric reference": the equal-noise efficiency of each value).
-pub const DEFAULT_GUIDED_FRACTION: f64 = 0.9;
+pub const DEFAULT_GUIDED_FRACTION: f64 = 0.8;
 
 /// |g| below which scattering counts as isotropic (as `HgSampler` does), the only phase the
 /// guide is used for.
@@ -48,15 +48,39 @@ pub fn dwivedi_nu0(albedo: f64) -> Option<f64> {
     Some(1.0 / u)
 }
 
-/// The guide of one walk: ν₀ of the medium's most-scattering layer at the walk's wavelength, the
-/// majorant σ̄ (mm⁻¹) and the guided fraction.
+/// Dwivedi's asymptotic mode of one layer: ν₀, the direction pdf's normalisation
+/// ln((ν₀ + 1)/(ν₀ − 1)), and the decay rate κ = σt/ν₀ of the deep radiance, mm⁻¹.
+#[derive(Debug, Clone, Copy)]
+struct Mode {
+    nu0: f64,
+    log_ratio: f64,
+    kappa: f64,
+}
+
+impl Mode {
+    /// The mode of a layer of coefficients (σa, σs), mm⁻¹; `None` without absorption.
+    fn of(sa: f32, ss: f32) -> Option<Self> {
+        let st = f64::from(sa) + f64::from(ss);
+        let nu0 = dwivedi_nu0(f64::from(ss) / st)?;
+        Some(Self {
+            nu0,
+            log_ratio: ((nu0 + 1.0) / (nu0 - 1.0)).ln(),
+            kappa: st / nu0,
+        })
+    }
+
+    /// Guided direction pdf at cosine `mu` to the outward normal, sr⁻¹ ([MHD16] eq. 9).
+    fn direction_pdf(&self, mu: f64) -> f64 {
+        1.0 / (2.0 * PI * (self.nu0 - mu) * self.log_ratio)
+    }
+}
+
+/// The guide of one walk: each layer's Dwivedi mode at the walk's wavelength, the majorant σ̄
+/// (mm⁻¹) and the guided fraction.
 #[derive(Debug, Clone, Copy)]
 pub struct Guide {
-    nu0: f64,
-    /// ln((ν₀ + 1)/(ν₀ − 1)): the Dwivedi direction pdf's normalisation.
-    log_ratio: f64,
-    /// Decay rate κ = σt/ν₀ of the deep radiance, mm⁻¹.
-    kappa: f64,
+    /// Per layer (epidermis, dermis), the mode its collisions are guided by.
+    modes: [Mode; 2],
     majorant: f64,
     fraction: f64,
 }
@@ -69,6 +93,8 @@ pub struct Segment {
     pub rate: f64,
     /// Cosine of the direction to the guide's outward normal.
     mu: f64,
+    /// κ of the mode guiding the segment, mm⁻¹.
+    kappa: f64,
     /// Guided over classic direction pdf (1 when the direction was not sampled).
     direction_ratio: f64,
     /// Tentative collisions so far (null and real).
@@ -84,6 +110,7 @@ impl Segment {
         Self {
             rate: majorant,
             mu: 0.0,
+            kappa: 0.0,
             direction_ratio: 1.0,
             flights: 0,
             length_mm: 0.0,
@@ -102,69 +129,76 @@ impl Segment {
     }
 }
 
+/// The layer whose mode guides a segment.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Layer {
+    /// The epidermis (and every segment starting on the surface).
+    Epidermis,
+    /// The dermis.
+    Dermis,
+}
+
 impl Guide {
-    /// The guide of a medium of majorant `majorant` (mm⁻¹) whose layers have (σa, σs) in
-    /// `layers` (mm⁻¹) with anisotropy `g`, sampling `fraction` of its segments; `None` when
-    /// guiding does not apply (fraction 0, a clear medium, no absorption, or anisotropic
-    /// scattering). The layer of largest albedo gives ν₀ and κ: the weakest guide of the layers.
+    /// The guide of a medium of majorant `majorant` (mm⁻¹) whose epidermis and dermis have
+    /// (σa, σs) `layers` (mm⁻¹) with anisotropy `g`, sampling `fraction` of its segments; `None`
+    /// when guiding does not apply (fraction 0, a clear medium, no absorption, or anisotropic
+    /// scattering). A layer without absorption borrows the other's mode.
     #[must_use]
-    pub fn new(majorant: f64, layers: &[(f32, f32)], g: f64, fraction: f64) -> Option<Self> {
+    pub fn new(majorant: f64, layers: [(f32, f32); 2], g: f64, fraction: f64) -> Option<Self> {
         // Under Henyey–Greenstein scattering neither Dwivedi's directions (their mixture with a
         // peaked phase function gives weights of heavy tails) nor its flights alone paid
         // (BENCHMARKS.md, "Volumetric reference"): the walk stays classic there.
         if !(fraction > 0.0 && majorant > 0.0 && g.abs() < ISOTROPIC_BELOW) {
             return None;
         }
-        // (albedo, σt) of the layer of largest albedo.
-        let (albedo, sigma_t) = layers
-            .iter()
-            .map(|&(sa, ss)| {
-                let st = f64::from(sa) + f64::from(ss);
-                (f64::from(ss) / st, st)
-            })
-            .fold((0.0, 0.0), |a, b| if b.0 > a.0 { b } else { a });
-        let nu0 = dwivedi_nu0(albedo)?;
+        let [e, d] = layers.map(|(sa, ss)| Mode::of(sa, ss));
+        let modes = match (e, d) {
+            (Some(e), Some(d)) => [e, d],
+            (Some(m), None) | (None, Some(m)) => [m, m],
+            (None, None) => return None,
+        };
         Some(Self {
-            nu0,
-            log_ratio: ((nu0 + 1.0) / (nu0 - 1.0)).ln(),
-            kappa: sigma_t / nu0,
+            modes,
             majorant,
             fraction,
         })
     }
 
-    /// Dwivedi's ν₀ of the guide.
+    /// Dwivedi's ν₀ guiding collisions in `layer`.
     #[must_use]
-    pub fn nu0(&self) -> f64 {
-        self.nu0
+    pub fn nu0(&self, layer: Layer) -> f64 {
+        self.mode(layer).nu0
     }
 
-    /// Guided direction pdf at cosine `mu` to the outward normal, sr⁻¹ ([MHD16] eq. 9).
-    fn direction_pdf(&self, mu: f64) -> f64 {
-        1.0 / (2.0 * PI * (self.nu0 - mu) * self.log_ratio)
+    fn mode(&self, layer: Layer) -> &Mode {
+        &self.modes[usize::from(layer == Layer::Dermis)]
     }
 
     /// A segment along `d` (unit) whose direction was given, not sampled (the entry's refraction, a
     /// reflection at the surface): the guide or the classic rate is drawn for its flights.
     pub fn along<R: RngCore>(&self, d: DVec3, normal: DVec3, rng: &mut R) -> Segment {
         let mu = d.dot(normal).clamp(-1.0, 1.0);
-        self.segment(mu, 1.0, rng.random::<f64>() < self.fraction)
+        let mode = self.mode(Layer::Epidermis);
+        self.segment(mode, mu, 1.0, rng.random::<f64>() < self.fraction)
     }
 
-    /// A new direction after a real collision at direction `d` (unit), from the guide (towards
-    /// `normal`, the outward normal) or from the (isotropic) phase function, and its segment.
+    /// A new direction after a real collision in `layer` at direction `d` (unit), from the guide
+    /// (towards `normal`, the outward normal) or from the (isotropic) phase function, and its
+    /// segment.
     pub fn scatter<R: RngCore>(
         &self,
+        layer: Layer,
         d: DVec3,
         normal: DVec3,
         hg: &HgSampler,
         rng: &mut R,
     ) -> (DVec3, Segment) {
+        let mode = self.mode(layer);
         let guided = rng.random::<f64>() < self.fraction;
         let next = if guided {
             // Inverse CDF of 1/(ν₀ − μ) on [−1, 1] ([MHD16] eq. 10).
             let xi = rng.random::<f64>();
-            let mu = (self.nu0 - (self.nu0 + 1.0) * (-xi * self.log_ratio).exp()).clamp(-1.0, 1.0);
+            let mu = (mode.nu0 - (mode.nu0 + 1.0) * (-xi * mode.log_ratio).exp()).clamp(-1.0, 1.0);
             let phi = 2.0 * PI * rng.random::<f64>();
             let (t, b) = normal.any_orthonormal_pair();
             let sin = (1.0 - mu * mu).max(0.0).sqrt();
@@ -174,40 +208,36 @@ impl Guide {
         };
         let mu = next.dot(normal).clamp(-1.0, 1.0);
         // Over the isotropic phase function's 1/(4π).
-        let ratio = self.direction_pdf(mu) * 4.0 * PI;
-        (next, self.segment(mu, ratio, guided))
+        let ratio = mode.direction_pdf(mu) * 4.0 * PI;
+        (next, self.segment(mode, mu, ratio, guided))
     }
 
-    fn segment(&self, mu: f64, direction_ratio: f64, guided: bool) -> Segment {
+    fn segment(&self, mode: &Mode, mu: f64, direction_ratio: f64, guided: bool) -> Segment {
         Segment {
             rate: if guided {
-                self.guided_rate(mu)
+                self.majorant - mu * mode.kappa
             } else {
                 self.majorant
             },
             mu,
+            kappa: mode.kappa,
             direction_ratio,
             flights: 0,
             length_mm: 0.0,
         }
     }
 
-    /// Guided rate of tentative flights at cosine `mu` to the outward normal, σ̄ − μκ, mm⁻¹
-    /// ([KdE14]: σt(1 − μ/ν₀) in a homogeneous medium); > 0 since κ < σt ≤ σ̄.
-    fn guided_rate(&self, mu: f64) -> f64 {
-        self.majorant - mu * self.kappa
-    }
-
     /// The weight of a finished segment: its classic pdf over the mixture's,
     /// 1 / ((1 − f) + f · p_g/p_c), with p_g/p_c = (pdf ratio of the direction) ·
     /// ((σ̄ − μκ)/σ̄)ⁿ · exp(μκL) over its n tentative collisions and length L (the null/real
-    /// choices and the surface's are the same in both, and cancel).
+    /// choices and the surface's are the same in both, and cancel). The guided rate σ̄ − μκ
+    /// ([KdE14]: σt(1 − μ/ν₀) in a homogeneous medium) is > 0 since κ < σt ≤ σ̄.
     #[must_use]
     pub fn weight(&self, s: &Segment) -> f64 {
-        let stretch = self.guided_rate(s.mu) / self.majorant;
+        let stretch = 1.0 - s.mu * s.kappa / self.majorant;
         let log_ratio = s.direction_ratio.ln()
             + f64::from(s.flights) * stretch.ln()
-            + s.mu * self.kappa * s.length_mm;
+            + s.mu * s.kappa * s.length_mm;
         1.0 / ((1.0 - self.fraction) + self.fraction * log_ratio.exp())
     }
 }
@@ -240,29 +270,29 @@ mod tests {
     /// form ν₀ − 2/ln((ν₀+1)/(ν₀−1)) within 4 standard errors, and the pdf integrates to 1.
     #[test]
     fn guided_directions_follow_dwivedi() {
-        let guide = Guide::new(10.0, &[(1.0, 9.0)], 0.0, 1.0).unwrap();
+        let guide = Guide::new(10.0, [(1.0, 9.0), (1.0, 9.0)], 0.0, 1.0).unwrap();
         let normal = DVec3::new(0.3, -0.4, 0.5).normalize();
         let hg = HgSampler::new(0.0);
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(3);
         let n = 200_000;
         let (mut sum, mut sum2) = (0.0, 0.0);
         for _ in 0..n {
-            let (d, _) = guide.scatter(DVec3::X, normal, &hg, &mut rng);
+            let (d, _) = guide.scatter(Layer::Dermis, DVec3::X, normal, &hg, &mut rng);
             let mu = d.dot(normal);
             sum += mu;
             sum2 += mu * mu;
         }
         let mean = sum / f64::from(n);
         let se = ((sum2 / f64::from(n) - mean * mean) / f64::from(n)).sqrt();
-        let nu = guide.nu0();
-        let want = nu - 2.0 / guide.log_ratio;
+        let mode = guide.mode(Layer::Dermis);
+        let want = mode.nu0 - 2.0 / mode.log_ratio;
         assert!((mean - want).abs() < 4.0 * se, "{mean} ± {se} vs {want}");
         // Midpoint rule over μ of 2π p(μ): ∫ p dω = 1.
         let m = 100_000;
         let total: f64 = (0..m)
             .map(|i| {
                 let mu = -1.0 + (f64::from(i) + 0.5) * 2.0 / f64::from(m);
-                2.0 * PI * guide.direction_pdf(mu) * 2.0 / f64::from(m)
+                2.0 * PI * mode.direction_pdf(mu) * 2.0 / f64::from(m)
             })
             .sum();
         assert!((total - 1.0).abs() < 1e-6, "{total}");

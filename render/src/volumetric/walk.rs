@@ -28,7 +28,7 @@
 
 use super::SkinVolume;
 use super::distance::{SegmentHit, SurfaceDistance};
-use super::guide::{Guide, Segment};
+use super::guide::{Guide, Layer, Segment};
 use crate::accel::BVH_MIN_T_MM;
 use crate::bssrdf::Directional;
 use crate::geometry::{Geometry, SurfaceHit};
@@ -130,12 +130,7 @@ pub fn walk<R: RngCore>(
     let mut ahead: Option<Boundary> = None;
     let mut w = 1.0f64;
     let majorant = f64::from(majorant);
-    let guide = Guide::new(
-        majorant,
-        &[epidermis, dermis],
-        vol.g,
-        vol.guided_fraction,
-    );
+    let guide = Guide::new(majorant, [epidermis, dermis], vol.g, vol.guided_fraction);
     // The guide's outward normal: the last face the walk touched.
     let mut normal = entry.ng.as_dvec3();
     let mut segment = match &guide {
@@ -188,12 +183,14 @@ pub fn walk<R: RngCore>(
         }
         out.tentative += 1;
         segment.collide(s);
-        let (sa, ss) = if one_layer {
-            dermis
-        } else if in_epidermis(region, &mut anchor, x, d_epi) {
-            epidermis
+        let layer = if !one_layer && in_epidermis(region, &mut anchor, x, d_epi) {
+            Layer::Epidermis
         } else {
-            dermis
+            Layer::Dermis
+        };
+        let (sa, ss) = match layer {
+            Layer::Epidermis => epidermis,
+            Layer::Dermis => dermis,
         };
         if rng.random::<f32>() * majorant as f32 >= sa + ss {
             continue; // null collision
@@ -207,7 +204,7 @@ pub fn walk<R: RngCore>(
             None => return out,
         }
         match &guide {
-            Some(guide) => (d, segment) = guide.scatter(d, normal, &vol.hg, rng),
+            Some(guide) => (d, segment) = guide.scatter(layer, d, normal, &vol.hg, rng),
             None => {
                 d = DVec3::from_array(scatter_direction(d.to_array(), &vol.hg, rng)).normalize();
             }
