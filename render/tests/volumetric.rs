@@ -19,6 +19,7 @@ use render::material::{Material, SkinMaterial, SurfaceKind};
 use render::renderer::{RenderOptions, render_with};
 use render::scene::Scene;
 use render::spectrum::SpectrumTable;
+use render::volumetric::guide::DEFAULT_GUIDED_FRACTION;
 use render::volumetric::shapes::{box_obj, sphere_obj};
 use render::volumetric::{LayerTables, SkinVolume, Volumetric};
 use skin_optics::{Preset, SkinParams, Wavelength};
@@ -114,6 +115,51 @@ fn slab_matches_adding_doubling_and_monte_carlo() {
             mc.diffuse_reflectance.stderr
         );
     }
+}
+
+/// The guided walk (Dwivedi sampling mixed with the classic, docs/physics.md §15.6) and the
+/// classic walk on the flat two-layer slab at g = 0 (light skin, smooth surface, 550 nm): each
+/// equals F(0) + R_d of adding-doubling within 1% + 3σ (as above), and the two agree within 3σ of
+/// their difference (independent seeds; nothing but noise may separate them); the guided walk's
+/// standard error is below the classic's at the same count (it guides).
+#[test]
+fn guided_and_classic_walks_agree_with_adding_doubling() {
+    let dir = tempfile::tempdir().unwrap();
+    let params = SkinParams::preset(Preset::Light);
+    let lambda = Wavelength::new(f64::from(NM)).unwrap();
+    let keys = "preset = \"light\"\nsurface = \"smooth\"\nphase_g = 0";
+    let scene = box_scene(dir.path(), [200.0, 200.0, 20.0], 0.0, keys);
+    let ad = skin_totals(
+        &params,
+        lambda,
+        &AddingDoublingOptions::new(DEFAULT_QUADRATURE_POINTS, 0.0).unwrap(),
+    )
+    .unwrap();
+    let want = ad.specular_reflectance + ad.diffuse_reflectance;
+    let mut runs = Vec::new();
+    for (fraction, seed) in [(0.0, 21), (DEFAULT_GUIDED_FRACTION, 22)] {
+        let BodyIntegrator::Volumetric(mut walked) =
+            BodyIntegrator::build(&scene, IntegratorKind::Volumetric)
+        else {
+            unreachable!("the volumetric integrator");
+        };
+        let medium = walked.media[0].take().unwrap();
+        walked.media[0] = Some(medium.with_guided_fraction(fraction).unwrap());
+        let body = BodyIntegrator::Volumetric(walked);
+        let film = render_mono(&scene, &body, 4, 1000, seed);
+        let (l, sigma) = mean_and_sigma(&film);
+        assert!(
+            (l - want).abs() <= 0.01 * want + 3.0 * sigma,
+            "guided fraction {fraction}: walk {l} ± {sigma} vs adding-doubling {want}"
+        );
+        runs.push((l, sigma));
+    }
+    let [(classic, sc), (guided, sg)] = [runs[0], runs[1]];
+    assert!(
+        (guided - classic).abs() <= 3.0 * sc.hypot(sg),
+        "guided {guided} ± {sg} vs classic {classic} ± {sc}"
+    );
+    assert!(sg < sc, "guided ± {sg}, classic ± {sc}");
 }
 
 /// The volumetric walk with the scene's first mesh given a skin body of constant [σa, σs] (mm⁻¹)
