@@ -65,15 +65,13 @@ struct Mode {
 }
 
 impl Mode {
-    /// The mode of a layer of coefficients (σa, σs), mm⁻¹; `None` without absorption.
-    fn of(sa: f32, ss: f32) -> Option<Self> {
-        let st = f64::from(sa) + f64::from(ss);
-        let nu0 = dwivedi_nu0(f64::from(ss) / st)?;
-        Some(Self {
+    /// The mode of a layer of extinction `sigma_t` (mm⁻¹) and Dwivedi's `nu0` (> 1).
+    fn new(sigma_t: f64, nu0: f64) -> Self {
+        Self {
             nu0,
             log_ratio: ((nu0 + 1.0) / (nu0 - 1.0)).ln(),
-            kappa: st / nu0,
-        })
+            kappa: sigma_t / nu0,
+        }
     }
 
     /// Guided direction pdf at cosine `mu` to the outward normal, sr⁻¹ ([MHD16] eq. 9).
@@ -147,18 +145,29 @@ pub enum Layer {
 
 impl Guide {
     /// The guide of a medium of majorant `majorant` (mm⁻¹) whose epidermis and dermis have
-    /// (σa, σs) `layers` (mm⁻¹) with anisotropy `g`, sampling `fraction` of its segments; `None`
-    /// when guiding does not apply (fraction 0, a clear medium, no absorption, or anisotropic
-    /// scattering). A layer without absorption borrows the other's mode.
+    /// (σa, σs) `layers` (mm⁻¹) and Dwivedi's ν₀ `nu0` (values ≤ 1: none, the layer does not
+    /// absorb; [`dwivedi_nu0`], tabulated by the caller), with anisotropy `g`, sampling `fraction`
+    /// of its segments; `None` when guiding does not apply (fraction 0, a clear medium, no
+    /// absorption, or anisotropic scattering). A layer without ν₀ borrows the other's mode. Any ν₀
+    /// > 1 gives an unbiased walk: the guide only moves the samples.
     #[must_use]
-    pub fn new(majorant: f64, layers: [(f32, f32); 2], g: f64, fraction: f64) -> Option<Self> {
+    pub fn new(
+        majorant: f64,
+        layers: [(f32, f32); 2],
+        nu0: [f64; 2],
+        g: f64,
+        fraction: f64,
+    ) -> Option<Self> {
         // Under Henyey–Greenstein scattering neither Dwivedi's directions (their mixture with a
         // peaked phase function gives weights of heavy tails) nor its flights alone paid
         // (BENCHMARKS.md, "Volumetric reference"): the walk stays classic there.
         if !(fraction > 0.0 && majorant > 0.0 && g.abs() < ISOTROPIC_BELOW) {
             return None;
         }
-        let [e, d] = layers.map(|(sa, ss)| Mode::of(sa, ss));
+        let [e, d] = [0, 1].map(|i| {
+            let (sa, ss) = layers[i];
+            (nu0[i] > 1.0).then(|| Mode::new(f64::from(sa) + f64::from(ss), nu0[i]))
+        });
         let modes = match (e, d) {
             (Some(e), Some(d)) => [e, d],
             (Some(m), None) | (None, Some(m)) => [m, m],
@@ -278,7 +287,8 @@ mod tests {
     /// form ν₀ − 2/ln((ν₀+1)/(ν₀−1)) within 4 standard errors, and the pdf integrates to 1.
     #[test]
     fn guided_directions_follow_dwivedi() {
-        let guide = Guide::new(10.0, [(1.0, 9.0), (1.0, 9.0)], 0.0, 1.0).unwrap();
+        let nu = dwivedi_nu0(0.9).unwrap();
+        let guide = Guide::new(10.0, [(1.0, 9.0), (1.0, 9.0)], [nu; 2], 0.0, 1.0).unwrap();
         let normal = DVec3::new(0.3, -0.4, 0.5).normalize();
         let hg = HgSampler::new(0.0);
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(3);
@@ -318,7 +328,8 @@ mod tests {
         let (majorant, length) = (5.0, 0.4);
         for fraction in [0.0, 0.8, 1.0] {
             // One layer of albedo 0.8, and a null share of 0.3.
-            let guide = Guide::new(majorant, [(1.0, 4.0), (1.0, 4.0)], 0.0, fraction);
+            let nu = dwivedi_nu0(0.8).unwrap();
+            let guide = Guide::new(majorant, [(1.0, 4.0), (1.0, 4.0)], [nu; 2], 0.0, fraction);
             for mu in [-0.8f64, 0.3, 0.95] {
                 let d = DVec3::new((1.0f64 - mu * mu).sqrt(), 0.0, mu);
                 let null = 0.3;
@@ -355,6 +366,6 @@ mod tests {
             }
         }
         // Anisotropic scattering is not guided.
-        assert!(Guide::new(majorant, [(1.0, 4.0), (1.0, 4.0)], 0.9, 0.8).is_none());
+        assert!(Guide::new(majorant, [(1.0, 4.0), (1.0, 4.0)], [2.0; 2], 0.9, 0.8).is_none());
     }
 }

@@ -17,7 +17,7 @@ pub mod walk;
 use crate::error::SettingError;
 use crate::material::Material;
 use crate::scene::Scene;
-use crate::spectrum::{N_WAVELENGTHS, SampledSpectrum};
+use crate::spectrum::{N_WAVELENGTHS, SampledSpectrum, SpectrumTable};
 use distance::SurfaceDistance;
 use multipole::exact::montecarlo::HgSampler;
 
@@ -40,6 +40,10 @@ pub struct SkinVolume {
     pub guided_fraction: f64,
     /// Weight below which the walk plays Russian roulette (`walk::ROULETTE_BELOW` by default).
     pub roulette_below: f64,
+    /// Dwivedi's ν₀ of the epidermis and the dermis ([`guide::dwivedi_nu0`] of σs/σt; 0 where
+    /// a layer does not absorb), tabulated with the layers: the guide's only input that costs a
+    /// root-finding. Any value > 1 keeps the walk unbiased.
+    pub dwivedi_nu0: [SpectrumTable; 2],
     /// Index of refraction of the skin (outside: air, n = 1).
     pub eta: f32,
     /// Which points lie in the epidermis (within d_epi of the surface).
@@ -58,6 +62,13 @@ impl SkinVolume {
         d_epi_mm: f32,
         triangles: Vec<[glam::Vec3; 3]>,
     ) -> Self {
+        let dwivedi_nu0 = [&epidermis, &dermis].map(|layer| {
+            SpectrumTable::from_fn(|nm| {
+                let nm = nm as f32;
+                let (sa, ss) = (layer.sigma_a.at_nm(nm), layer.sigma_s.at_nm(nm));
+                guide::dwivedi_nu0(f64::from(ss) / (f64::from(sa) + f64::from(ss))).unwrap_or(0.0)
+            })
+        });
         Self {
             epidermis,
             dermis,
@@ -65,6 +76,7 @@ impl SkinVolume {
             g,
             guided_fraction: guide::DEFAULT_GUIDED_FRACTION,
             roulette_below: walk::ROULETTE_BELOW,
+            dwivedi_nu0,
             eta,
             epidermis_region: SurfaceDistance::new(triangles, d_epi_mm),
         }

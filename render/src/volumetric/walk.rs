@@ -130,7 +130,14 @@ pub fn walk<R: RngCore>(
     let mut ahead: Option<Boundary> = None;
     let mut w = 1.0f64;
     let majorant = f64::from(majorant);
-    let guide = Guide::new(majorant, [epidermis, dermis], vol.g, vol.guided_fraction);
+    let nu0 = vol.dwivedi_nu0.each_ref().map(|t| f64::from(t.at_nm(nm)));
+    let guide = Guide::new(
+        majorant,
+        [epidermis, dermis],
+        nu0,
+        vol.g,
+        vol.guided_fraction,
+    );
     // The guide's outward normal: the last face the walk touched.
     let mut normal = entry.ng.as_dvec3();
     let mut segment = match &guide {
