@@ -24,7 +24,7 @@ const NU0_ABOVE_ONE: f64 = 1e-12;
 
 /// Dwivedi's ν₀ > 1 for single-scattering albedo `albedo` in (0, 1): the root of
 /// α ν₀ artanh(1/ν₀) = 1, the decay length (in mean free paths) of the deep asymptotic radiance
-/// e^(−z/ν₀) of an isotropically scattering half-space ([KdE14] eq. 5; docs/physics.md §15.6).
+/// e^(−z/ν₀) of an isotropically scattering half-space ([KdE14]; docs/physics.md §15.6).
 /// `None` outside (0, 1) (no absorption: nothing decays).
 #[must_use]
 pub fn dwivedi_nu0(albedo: f64) -> Option<f64> {

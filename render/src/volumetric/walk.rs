@@ -3,7 +3,9 @@
 //! (a distance from the surface, not a plane) is crossed exactly without ever being intersected;
 //! at a real collision the weight keeps σs/σt (implicit capture) and the direction turns by
 //! Henyey–Greenstein — both from `multipole::exact::montecarlo`, the photon physics of the layered Monte
-//! Carlo; below weight [`ROULETTE_BELOW`] the walk plays Russian roulette. At the surface the
+//! Carlo; under isotropic scattering part of the steps are drawn towards the surface instead, with
+//! exact MIS weights ([`super::guide`], §15.6); below weight `SkinVolume::roulette_below`
+//! ([`ROULETTE_BELOW`] by default) the walk plays Russian roulette. At the surface the
 //! walk meets the skin's boundary: total internal reflection beyond the critical angle, else it
 //! leaves with probability T(θ_out) (the same energy split as the BSSRDF's, `Directional`:
 //! 1 − F for the smooth surface, 1 − ρ_dr for the oily lobe), refracted by Snell's law, or is
@@ -14,7 +16,9 @@
 //! D(x) ≥ lo − δ and D(x) ≤ hi + δ (D is 1-Lipschitz), which settles the layer of most tentative
 //! collisions (dermis when lo − δ > d_epi, epidermis when hi + δ ≤ d_epi), and a flight of length
 //! s with s < lo − δ cannot reach the surface, so no ray is cast for it. Otherwise the bounds are
-//! taken afresh at x, and a ray is cast only when the flight may still reach the surface. Every
+//! taken afresh at x, and the flight is tested against the surface only when it may still reach
+//! it: against the faces listed in x's grid cell when they hold every face within reach, else by a
+//! ray. Every
 //! decision is the one the exact distance and ray would give: the walk is unchanged in law, only
 //! cheaper.
 //!
@@ -40,10 +44,10 @@ use rand::{Rng, RngCore};
 /// below 1e-6 of the energy for skin — BENCHMARKS.md).
 pub const MAX_COLLISIONS: u32 = 1_000_000;
 
-/// Weight below which a walk plays Russian roulette: it goes on with probability w / this, at
-/// weight this, else ends (unbiased [AK90]); light skin's walks fall below it after about twenty
-/// collisions, and ending most of their tails costs less than the variance it adds
-/// (BENCHMARKS.md, "Volumetric reference").
+/// Default weight below which a walk plays Russian roulette (`SkinVolume::roulette_below`): it goes
+/// on with probability w / this, at weight this, else ends (unbiased [AK90]); light skin's walks
+/// fall below it after about twenty collisions, and ending most of their tails costs less than the
+/// variance it adds (BENCHMARKS.md, "Volumetric reference").
 pub const ROULETTE_BELOW: f64 = 0.1;
 
 /// Most BVH hits one surface query passes over (behind the walk, or its own face) before the
