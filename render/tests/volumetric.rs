@@ -148,6 +148,9 @@ fn guided_and_classic_walks_agree_with_adding_doubling() {
         let body = BodyIntegrator::Volumetric(walked);
         let film = render_mono(&scene, &body, 4, 1000, seed);
         let (l, sigma) = mean_and_sigma(&film);
+        eprintln!(
+            "guided fraction {fraction}: walk {l:.5} ± {sigma:.5}, adding-doubling {want:.5}"
+        );
         assert!(
             (l - want).abs() <= 0.01 * want + 3.0 * sigma,
             "guided fraction {fraction}: walk {l} ± {sigma} vs adding-doubling {want}"
