@@ -5,7 +5,8 @@
 //! `cargo run --release -p render --features studies --example curved_gap -- RADIUS|slab|angles
 //! [BSSRDF_SPP] [WALK_SPP]`; environment: `SKIN` (the material's keys; default C_m 0.05, β_m 0.7,
 //! C_h 0.02), `NM` (comma-separated wavelengths), `INC=normal` (the former angular factor),
-//! `LIGHT=1` (a sphere lamp and no sky). Walk renders are kept in /tmp/cg and reused.
+//! `LIGHT=1` (a sphere lamp and no sky), `CURV=planar` (no curvature term). Walk renders are kept
+//! in `CG_DIR` (default /tmp/cg) and reused.
 use glam::Vec2;
 use render::film::Film;
 use render::integrator::{BodyIntegrator, IntegratorKind};
@@ -42,14 +43,20 @@ fn knobs() -> SkinKnobs {
         } else {
             render::bssrdf::Incidence::AddingDoubling
         },
+        curvature: if std::env::var("CURV").is_ok_and(|v| v == "planar") {
+            render::bssrdf::Curvature::Planar
+        } else {
+            render::bssrdf::Curvature::FirstOrder
+        },
         ..SkinKnobs::default()
     }
 }
 
 /// Volumetric film cached on disk by key (the walk does not depend on the BSSRDF's knobs).
 fn vol(scene: &Scene, side: usize, spp: u32, nm: f32, key: &str) -> Film {
-    let _ = std::fs::create_dir_all("/tmp/cg");
-    let f = format!("/tmp/cg/vol-{key}-{side}-{spp}-{nm}.txt");
+    let dir = std::env::var("CG_DIR").unwrap_or("/tmp/cg".into());
+    let _ = std::fs::create_dir_all(&dir);
+    let f = format!("{dir}/vol-{key}-{side}-{spp}-{nm}.txt");
     if let Ok(t) = std::fs::read_to_string(&f) {
         let v: Vec<f64> = t.split_whitespace().map(|x| x.parse().unwrap()).collect();
         let means = (0..side * side).map(|i| [v[2 * i]; 3]).collect();

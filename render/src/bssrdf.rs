@@ -7,6 +7,7 @@
 //! - [`sampling`]: axis choice, probe segments and the one-sample MIS density over the axes.
 //! - [`separable`]: S = T(θ_o) R(r) S_ω(ω_i), the energy split with the specular layer, the texture.
 //! - [`incidence`]: the gain a(θ, λ) of the total at oblique incidence that multiplies T.
+//! - [`curvature`]: the first-order term 1 + κ(λ) h of a curved surface that multiplies R(r).
 //!
 //! [`Subsurface`] ties them together for a path tracer in the manner of pbrt-v4's `SampleSp` →
 //! intersect → `ProbeIntersectionToSample`: [`Subsurface::sample_probe`] says which segment to
@@ -40,12 +41,14 @@
 //! every miss (its total stays R_tot). Thin geometry needs nothing special: the normal probe
 //! crosses it and finds the far side, so backlit ears transmit (red) light.
 
+pub mod curvature;
 pub mod extent;
 pub mod incidence;
 pub mod sampling;
 pub mod separable;
 pub mod table;
 
+pub use curvature::{Curvature, CurvatureGain};
 pub use incidence::{Incidence, IncidenceGain};
 pub use sampling::{Probe, ProbeAxes, ProbeFrame, RadiusWavelength, pdf_exit, probe};
 pub use separable::{Directional, EnergySplit, texture_modulation};
@@ -75,6 +78,8 @@ pub struct Subsurface {
     pub table: Arc<ProfileTable>,
     /// T(θ) and S_ω.
     pub directional: Directional,
+    /// The curvature term's κ(λ) (`None`: the planar profile, [`Curvature::Planar`]).
+    pub curvature: Option<CurvatureGain>,
 }
 
 /// Where a subsurface path leaves the skin toward the entry point.
@@ -99,6 +104,8 @@ pub struct ProbeSample<'a> {
     pub segment: Probe,
     lanes: Lanes<'a>,
     c: [f32; N_WAVELENGTHS],
+    /// Each lane's curvature κ, mm⁻¹ (0 without the curvature term).
+    kappa: [f32; N_WAVELENGTHS],
 }
 
 impl ProbeSample<'_> {
@@ -132,7 +139,18 @@ impl Subsurface {
     /// The model for a profile table and the directional term.
     #[must_use]
     pub fn new(table: Arc<ProfileTable>, directional: Directional) -> Self {
-        Self { table, directional }
+        Self {
+            table,
+            directional,
+            curvature: None,
+        }
+    }
+
+    /// The same model with the first-order curvature term of `gain` (docs/physics.md §8.2).
+    #[must_use]
+    pub fn with_curvature(mut self, gain: CurvatureGain) -> Self {
+        self.curvature = Some(gain);
+        self
     }
 
     /// The table resolved at each active lane's wavelength (`None` for a terminated lane).
@@ -200,16 +218,27 @@ impl Subsurface {
         if r_max.is_nan() || r_max <= 0.0 {
             return None;
         }
+        let kappa = self.curvature.as_ref().map_or([0.0; N_WAVELENGTHS], |g| {
+            std::array::from_fn(|k| {
+                if lanes[k].is_some() {
+                    g.kappa_per_mm(wl.nm(k))
+                } else {
+                    0.0
+                }
+            })
+        });
         Some(ProbeSample {
             segment: probe(frame, p_o, axis, r, r_max, u[2]),
             lanes,
             c,
+            kappa,
         })
     }
 
     /// The exit at `s`, one of `hits` distinct points of the material found along `probe`'s
     /// segment from `p_o` (frame `frame`, axes `axes`) and picked uniformly: the spatial weight
-    /// R(r) · hits / pdf per wavelength. `flipped` tells that the entry frame faces against the
+    /// R(r) · hits / pdf per wavelength, times the curvature term 1 + κ h where the model has
+    /// one ([`curvature`]; h from the entry's normal and the exit's shading normal). `flipped` tells that the entry frame faces against the
     /// mesh's vertex normals (a viewer inside the mesh), so the exit normals are flipped alike.
     /// None when the point's density is 0 or not a number.
     #[must_use]
@@ -234,7 +263,14 @@ impl Subsurface {
         if pdf.is_nan() || pdf <= 0.0 {
             return None;
         }
-        let weight = self.weight(&probe.lanes, dist, hits as f32 / pdf);
+        let mut weight = self.weight(&probe.lanes, dist, hits as f32 / pdf);
+        if self.curvature.is_some()
+            && let Some(h) = curvature::depth_below_tangent_mm(p_o, frame.n, s.p, ns)
+        {
+            for (w, &k) in weight.0.iter_mut().zip(&probe.kappa) {
+                *w *= curvature::factor(k, h);
+            }
+        }
         Some(Exit {
             p: s.p,
             ng,

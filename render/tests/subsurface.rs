@@ -175,17 +175,22 @@ fn split_probes_and_stratified_light_choice_keep_the_slab_closed_form() {
 
 /// A bloodless, melanin-free light-skin sphere of `radius_mm` inside a uniform white environment
 /// of luminance 1, seen from 8 radii with a 10° field of view (the image lies inside the sphere's
-/// disc: exit angles from 0° at the centre to 79° at the corners), at full fidelity.
+/// disc: exit angles from 0° at the centre to 79° at the corners), at full fidelity, with the
+/// planar profile (`Curvature::Planar`: the separable form's closed form is what is checked).
 fn furnace(radius_mm: f32) -> render::scene::Scene {
-    SceneText::camera([0.0, 0.0, radius_mm * 8.0], 10.0)
+    let text = SceneText::camera([0.0, 0.0, radius_mm * 8.0], 10.0)
         .environment("constant", 1.0)
         .skin(
             "skin",
             "preset = \"light\"\nhemoglobin = 0.0\nmelanin = 0.0",
         )
         .mesh("sphere", "skin", radius_mm)
-        .with("[fidelity]\nfidelity = \"full\"")
-        .load()
+        .with("[fidelity]\nfidelity = \"full\"");
+    let knobs = render::material::SkinKnobs {
+        curvature: render::bssrdf::Curvature::Planar,
+        ..Default::default()
+    };
+    render::scene::Scene::from_toml(text.text(), "furnace.toml", None, &knobs).unwrap()
 }
 
 /// The image mean of the surface lobe's albedo ρ_dr(θ_o) over the film, and the exit cosines it

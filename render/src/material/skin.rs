@@ -8,7 +8,9 @@
 //! the Lambertian stand-in tabulates the same model's totals (`multipole::skin::total_reflectance`)
 //! on the same 10-nm grid.
 
-use crate::bssrdf::{Directional, EnergySplit, Incidence, IncidenceGain, Subsurface};
+use crate::bssrdf::{
+    Curvature, CurvatureGain, Directional, EnergySplit, Incidence, IncidenceGain, Subsurface,
+};
 use crate::fidelity::SKIN_TABLE_STEP_NM;
 use crate::fidelity::wavelengths::FROM_NM;
 use crate::material::{SurfaceKind, TextureRef};
@@ -46,6 +48,9 @@ pub struct SkinKnobs {
     /// How the BSSRDF's angular factor treats oblique incidence (default the adding-doubling
     /// gain, docs/physics.md §8.1).
     pub incidence: Incidence,
+    /// Whether the BSSRDF's profile carries the first-order curvature term (default on,
+    /// docs/physics.md §8.2).
+    pub curvature: Curvature,
 }
 
 /// Why a skin material could not be built.
@@ -143,6 +148,10 @@ impl SkinMaterial {
         }
         let totals = SpectrumTable::from_fn(|nm| f64::from(table.total(nm as f32)));
         let subsurface = Subsurface::new(Arc::new(table), directional.clone());
+        let subsurface = match knobs.curvature {
+            Curvature::Planar => subsurface,
+            Curvature::FirstOrder => subsurface.with_curvature(CurvatureGain::new(&media)),
+        };
         let mut skin = Self::new(params, surface, totals, albedo_texture, media)
             .with_surface_kind(knobs.surface)
             .with_directional(directional)
