@@ -166,6 +166,10 @@ struct RenderStudyArgs {
     /// volumetric), no case table; with --only, the chart cases whose label contains the text.
     #[arg(long)]
     charts: bool,
+    /// Render the BSSRDF with the planar profile, without its curvature term (the former form,
+    /// for before/after comparisons; docs/physics.md §8.2).
+    #[arg(long)]
+    planar: bool,
 }
 
 fn parse_case_spp(s: &str) -> Result<(String, u32), String> {
@@ -471,6 +475,11 @@ fn main() {
                 reference_cache: args.reference_cache.clone(),
                 threads: args.threads.map(|t| t as usize),
                 charts_only: args.charts,
+                curvature: if args.planar {
+                    render::bssrdf::Curvature::Planar
+                } else {
+                    render::bssrdf::Curvature::FirstOrder
+                },
             };
             run_render(study, &run, &args.out).map(|md| println!("{md}"))
         }

@@ -28,6 +28,7 @@
 use anyhow::Context;
 use render::film::Film;
 use render::integrator::{BodyIntegrator, IntegratorKind};
+use render::bssrdf::Curvature;
 use render::material::SkinKnobs;
 use render::passes::Passes;
 use render::renderer::{RenderOptions, render_with};
@@ -89,6 +90,9 @@ pub struct StudyRun {
     /// Only the error-against-time charts (of the chart cases `only` selects, every one when
     /// empty), no case table.
     pub charts_only: bool,
+    /// The BSSRDF's curvature term (default on; `Curvature::Planar` for the former planar
+    /// profile, docs/physics.md §8.2).
+    pub curvature: Curvature,
 }
 
 impl StudyRun {
@@ -327,7 +331,7 @@ fn reference(
     if let Some(f) = file.as_ref().filter(|f| f.exists()) {
         return read_cached(f, case.width, case.height, spp);
     }
-    let vol = load(&case.toml, true)?;
+    let vol = load(&case.toml, true, Curvature::default())?;
     let (film, t) = timed(&vol, case.width, case.height, spp, seed, run.threads)?;
     if let Some(f) = file {
         let mut text = format!("{t}\n");
@@ -410,7 +414,7 @@ impl Config {
     }
 }
 
-fn load(toml: &str, volumetric: bool) -> anyhow::Result<Loaded> {
+fn load(toml: &str, volumetric: bool, curvature: Curvature) -> anyhow::Result<Loaded> {
     load_as(
         toml,
         if volumetric {
@@ -418,11 +422,15 @@ fn load(toml: &str, volumetric: bool) -> anyhow::Result<Loaded> {
         } else {
             Config::Default
         },
+        curvature,
     )
 }
 
-fn load_as(toml: &str, config: Config) -> anyhow::Result<Loaded> {
-    let mut knobs = SkinKnobs::default();
+fn load_as(toml: &str, config: Config, curvature: Curvature) -> anyhow::Result<Loaded> {
+    let mut knobs = SkinKnobs {
+        curvature,
+        ..SkinKnobs::default()
+    };
     if config == Config::BssrdfOnly {
         // A thin-walk length of 0 never walks (the BSSRDF at every hit), whatever the default.
         knobs.fidelity.thin_walk_r99 = Some(0.0);
@@ -560,7 +568,7 @@ pub fn run_render(study: RenderStudy, run: &StudyRun, out: &Path) -> anyhow::Res
             continue;
         }
         log::info!("[{}/{}] {label}", k + 1, cases.len());
-        let bssrdf = load(&c.toml, false)?;
+        let bssrdf = load(&c.toml, false, run.curvature)?;
         let (test, t_b) = timed(&bssrdf, c.width, c.height, study.bssrdf_spp, 1, run.threads)?;
         let ref_spp = run.reference_spp(&label).unwrap_or(if c.builtin {
             study.builtin_reference_spp
@@ -662,9 +670,9 @@ fn time_chart(
     let top = *study.ladder.last().unwrap_or(&16);
     let threads = run.threads;
     let (w, h) = (case.width, case.height);
-    let vol = load_as(&case.toml, Config::Volumetric)?;
+    let vol = load_as(&case.toml, Config::Volumetric, run.curvature)?;
     let (reference, t_ref) = timed(&vol, w, h, 4 * top, 99, threads)?;
-    let default = load_as(&case.toml, Config::Default)?;
+    let default = load_as(&case.toml, Config::Default, run.curvature)?;
     let (pilot, _) = timed(&default, w, h, study.bssrdf_spp, 3, threads)?;
     let skin = Passes::first_hit(&default.scene, w, h).skin;
     let pixels = compared_pixels(&pilot, &skin);
@@ -687,7 +695,7 @@ fn time_chart(
         } else if config == Config::Default {
             &default
         } else {
-            &load_as(&case.toml, config)?
+            &load_as(&case.toml, config, run.curvature)?
         };
         let mut pts = Vec::new();
         for &spp in study.ladder {
