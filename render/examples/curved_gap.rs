@@ -36,6 +36,69 @@ fn mean(film: &Film, px: &[usize], side: usize) -> (f64, f64) {
     (s / n, v.sqrt() / n)
 }
 
+/// Where the planar BSSRDF's energy goes on a sphere of radius `r` (mm) under the uniform sky
+/// at `nm`: the closed form of the separable model there (surface F plus T a R_tot per pixel, 4×4
+/// rays per pixel of the 0.9-radius region; what the BSSRDF must render if probes, fallback,
+/// axis MIS and the area measure lose nothing), the profile's energy beyond √2 R and 2R (the
+/// exits facing away, and the fallback), and the first-order curvature gain the term adds on
+/// this sphere, κ ∫ d²/2R R(d) 2πd dd over d < √2 R, against its plane value κ ⟨d²⟩ / 2R.
+fn budget(scene: &Scene, side: usize, r: f32, nm: f32) {
+    let render::material::Material::Skin(skin) = &scene.materials[0] else {
+        return;
+    };
+    let Some(ss) = &skin.subsurface else { return };
+    let (table, dir) = (&ss.table, &ss.directional);
+    let r_tot = f64::from(table.total(nm));
+    let px = region(scene, side, |p| p.truncate().length() / r < 0.9);
+    let (mut sum, k) = (0.0, 4);
+    for &i in &px {
+        for j in 0..k * k {
+            let ndc = Vec2::new(
+                ((i % side) as f32 + ((j % k) as f32 + 0.5) / k as f32) / side as f32,
+                ((i / side) as f32 + ((j / k) as f32 + 0.5) / k as f32) / side as f32,
+            );
+            let (o, d) = scene.camera.generate_ray(ndc, 1.0, Vec2::ZERO);
+            if let Some(Hit::Surface(si)) = scene.intersect(o, d, 0.0, f32::INFINITY) {
+                let mu = (-d).dot(si.ns).clamp(0.0, 1.0);
+                let t = f64::from(dir.transmittance(mu));
+                sum += (1.0 - t) + f64::from(dir.factor(mu, nm)) * r_tot;
+            }
+        }
+    }
+    let closed = sum / (px.len() * k * k) as f64;
+    let kappa = ss
+        .curvature
+        .as_ref()
+        .map_or(0.0, |c| f64::from(c.kappa_per_mm(nm)));
+    let (n, r_max) = (20_000, f64::from(table.r_max_mm(nm)));
+    let (mut beyond_hemi, mut beyond_2r, mut m2_hemi, mut m2_all) = (0.0, 0.0, 0.0, 0.0);
+    let rr = f64::from(r);
+    for i in 0..n {
+        let d = (i as f64 + 0.5) / n as f64 * r_max;
+        let e = f64::from(table.eval(nm, d as f32)) * 2.0 * std::f64::consts::PI * d * r_max
+            / n as f64
+            / r_tot;
+        m2_all += e * d * d;
+        if d > std::f64::consts::SQRT_2 * rr {
+            beyond_hemi += e;
+        } else {
+            m2_hemi += e * d * d;
+        }
+        if d > 2.0 * rr {
+            beyond_2r += e;
+        }
+    }
+    println!(
+        "sphere r {r} nm {nm} budget: closed form of the planar model {closed:.5} (R_tot {r_tot:.4}); \
+         energy beyond √2R {:.2}%, beyond 2R {:.2}%; κ {kappa:.3}/mm, ⟨d²⟩ {m2_all:.3} mm²; \
+         first-order gain on this sphere {:+.2}% of R_tot (plane value {:+.2}%)",
+        100.0 * beyond_hemi,
+        100.0 * beyond_2r,
+        100.0 * kappa * m2_hemi / (2.0 * rr),
+        100.0 * kappa * m2_all / (2.0 * rr),
+    );
+}
+
 fn knobs() -> SkinKnobs {
     SkinKnobs {
         incidence: if std::env::var("INC").is_ok_and(|v| v == "normal") {
@@ -189,6 +252,9 @@ fn main() {
         let rings: Vec<(f32, f32)> =
             vec![(0.0, 0.9), (0.0, 0.3), (0.3, 0.6), (0.6, 0.8), (0.8, 0.9)];
         for &nm in &nms {
+            if std::env::var("LIGHT").map_or(true, |v| v.is_empty()) {
+                budget(&scene, side, r, nm);
+            }
             let bf = run(&scene, IntegratorKind::Bssrdf, side, spp, nm);
             let vf = vol(
                 &scene,

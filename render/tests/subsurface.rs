@@ -388,11 +388,23 @@ mod against_the_walk {
     pub fn gap(
         scene: &Scene,
         side: usize,
-        (spp_bssrdf, spp_walk): (u32, u32),
+        spp: (u32, u32),
         nm: f32,
         keep: impl Fn(glam::Vec3) -> bool,
     ) -> (f64, f64) {
-        let px = region(scene, side, keep);
+        gaps(&[scene], side, spp, nm, keep)[0]
+    }
+
+    /// [`gap`] of each scene's BSSRDF against one walk (of the first scene: the scenes differ
+    /// only in the BSSRDF's knobs, which the walk does not read).
+    pub fn gaps(
+        scenes: &[&Scene],
+        side: usize,
+        (spp_bssrdf, spp_walk): (u32, u32),
+        nm: f32,
+        keep: impl Fn(glam::Vec3) -> bool,
+    ) -> Vec<(f64, f64)> {
+        let px = region(scenes[0], side, keep);
         assert!(px.len() > side * side / 4, "{} pixels", px.len());
         let mean = |f: &Film| {
             let (s, v) = px.iter().fold((0.0, 0.0), |(s, v), &i| {
@@ -401,15 +413,20 @@ mod against_the_walk {
             });
             (s, v.sqrt() / s)
         };
-        let (b, sb) = mean(&render(scene, IntegratorKind::Bssrdf, side, spp_bssrdf, nm));
         let (w, sw) = mean(&render(
-            scene,
+            scenes[0],
             IntegratorKind::Volumetric,
             side,
             spp_walk,
             nm,
         ));
-        (b / w - 1.0, (b / w) * sb.hypot(sw))
+        scenes
+            .iter()
+            .map(|scene| {
+                let (b, sb) = mean(&render(scene, IntegratorKind::Bssrdf, side, spp_bssrdf, nm));
+                (b / w - 1.0, (b / w) * sb.hypot(sw))
+            })
+            .collect()
     }
 }
 
@@ -445,10 +462,10 @@ fn tilted_slab_under_a_sky_matches_the_volumetric_walk() {
 
 /// A 10-mm sphere of skin under a uniform sky, region within 0.9 radii of the view axis (exit
 /// angles to 64°): the BSSRDF renders what the volumetric walk does within 1% + 3σ at 450 and
-/// 550 nm (σ the ratio's standard error, 0.4–0.6%). The 1% is the curvature the planar profile
-/// does not see, measured at 10 mm: −0.2% ± 0.3% (450 nm) and −0.8% ± 0.3% (550 nm); it grows
-/// as 1/radius and with the profile's reach (650 nm: −2.7% at 10 mm, −5.1% at 5 mm;
-/// docs/physics.md §8.1). Before the incidence gain the BSSRDF was 3.7–3.9% dark here.
+/// 550 nm (σ the ratio's standard error, 0.4–0.6%). The 1% bounds what the model leaves at 10 mm,
+/// measured (512 / 1,024 spp) −0.0% ± 0.3% (450 nm) and −0.2% ± 0.3% (550 nm) with the curvature
+/// term, −0.2% and −0.8% with the planar profile (docs/physics.md §8.2). Before the incidence
+/// gain the BSSRDF was 3.7–3.9% dark here.
 #[test]
 fn sphere_under_a_sky_matches_the_volumetric_walk() {
     let scene = SceneText::camera([0.0, 0.0, 120.0], 11.0)
@@ -464,4 +481,146 @@ fn sphere_under_a_sky_matches_the_volumetric_walk() {
             "{nm} nm: BSSRDF / walk − 1 = {g:+.4} ± {se:.4}"
         );
     }
+}
+
+/// A 5-mm sphere of light skin under a uniform sky (region within 0.9 radii), where the planar
+/// profile fails most: the BSSRDF with the curvature term (docs/physics.md §8.2) renders what the
+/// volumetric walk does within 2% + 3σ at 550 and 650 nm (σ the ratio's standard error, 0.3–0.5%
+/// at these counts; the 2% is the target, the model's error measured at 512 / 512 spp: +1.6% ±
+/// 0.2% and −1.3% ± 0.2%), while the planar profile (`Curvature::Planar`) stays 5% and 9% dark,
+/// beyond 2% + 3σ: the case tells the two apart.
+#[test]
+fn small_light_skin_sphere_matches_the_volumetric_walk_with_the_curvature_term() {
+    use render::bssrdf::Curvature;
+    use render::material::SkinKnobs;
+    let text = SceneText::camera([0.0, 0.0, 60.0], 11.0)
+        .with("[environment]\nspectral_radiance = 1")
+        .skin(
+            "skin",
+            "preset = \"light\"\nsurface = \"smooth\"\nphase_g = 0",
+        )
+        .with("[[meshes]]\nshape = \"sphere\"\nmaterial = \"skin\"\nunits_mm = 5");
+    let load = |curvature| {
+        let knobs = SkinKnobs {
+            curvature,
+            ..SkinKnobs::default()
+        };
+        render::scene::Scene::from_toml(text.text(), "sphere.toml", None, &knobs).unwrap()
+    };
+    let (curved, planar) = (load(Curvature::FirstOrder), load(Curvature::Planar));
+    let region = |p: Vec3| p.truncate().length() < 4.5;
+    for nm in [550.0, 650.0] {
+        let gaps = against_the_walk::gaps(&[&curved, &planar], 12, (64, 512), nm, region);
+        let ((g, se), (gp, sep)) = (gaps[0], gaps[1]);
+        assert!(
+            g.abs() <= 0.02 + 3.0 * se,
+            "{nm} nm: BSSRDF / walk − 1 = {g:+.4} ± {se:.4}"
+        );
+        assert!(
+            gp < -(0.02 + 3.0 * sep),
+            "{nm} nm, planar: BSSRDF / walk − 1 = {gp:+.4} ± {sep:.4}"
+        );
+    }
+}
+
+/// The curvature term integrates to its closed form on a sphere: under a uniform sky of radiance 1
+/// each pixel of a convex body is its albedo for light from the camera, so a 5-mm sphere of light
+/// skin at 650 nm renders (1 − T(μ)) + T(μ) a(μ) R_tot (1 + G), G = κ ∫ d²/2R · R(d) 2πd dd / R_tot
+/// over the chords d < √2 R (docs/physics.md §8.2: h = d²/2R on a sphere, dA = 2πd dd by
+/// Archimedes' hat-box theorem), the integral by a 20,000-point midpoint rule on the table, T and
+/// a from 4×4 camera rays per pixel. G is 9.6% here; the BSSRDF must render it within 4 standard
+/// errors of the region's mean (0.1%) plus 0.3% for the tessellated sphere (its points lie
+/// inside the true sphere and the shading normals are interpolated, so h is d²/2R only to the
+/// mesh's accuracy) and the f32 tables. This checks the probes, their MIS density and the
+/// per-exit factor together, against quadrature rather than against another render.
+#[test]
+fn curvature_term_on_a_sphere_renders_its_closed_form() {
+    use render::film::Film;
+    use render::integrator::{BodyIntegrator, IntegratorKind};
+    use render::renderer::{RenderOptions, render_with};
+    let (radius, nm, side) = (5.0f32, 650.0f32, 16usize);
+    let scene = SceneText::camera([0.0, 0.0, 12.0 * radius], 11.0)
+        .with("[environment]\nspectral_radiance = 1")
+        .skin(
+            "skin",
+            "preset = \"light\"\nsurface = \"smooth\"\nphase_g = 0",
+        )
+        .mesh("sphere", "skin", radius)
+        .load();
+    let Material::Skin(skin) = &scene.materials[0] else {
+        unreachable!("the scene holds one skin")
+    };
+    let ss = skin.subsurface.as_ref().unwrap();
+    let (table, dir) = (&ss.table, &ss.directional);
+    let r_tot = f64::from(table.total(nm));
+    let kappa = f64::from(ss.curvature.as_ref().unwrap().kappa_per_mm(nm));
+    let (n, r_max) = (
+        20_000,
+        f64::from(table.r_max_mm(nm)).min(2f64.sqrt() * f64::from(radius)),
+    );
+    let m2: f64 = (0..n)
+        .map(|i| {
+            let d = (i as f64 + 0.5) / n as f64 * r_max;
+            f64::from(table.eval(nm, d as f32)) * 2.0 * std::f64::consts::PI * d * d * d * r_max
+                / n as f64
+        })
+        .sum::<f64>()
+        / r_tot;
+    let gain = kappa * m2 / (2.0 * f64::from(radius));
+    assert!(gain > 0.05, "G = {gain}: the case must test the term");
+    let inside = |p: Vec3| p.truncate().length() < 0.9 * radius;
+    let film: Film = {
+        let body = BodyIntegrator::build(&scene, IntegratorKind::Bssrdf);
+        let opts = RenderOptions {
+            width: side,
+            height: side,
+            spp: 128,
+            seed: SEED,
+            wavelength_nm: Some(nm),
+            ..Default::default()
+        };
+        render_with(&scene, &body, &opts.validate().unwrap(), None)
+            .unwrap()
+            .0
+    };
+    let (mut got, mut var, mut want, mut pixels) = (0.0, 0.0, 0.0, 0usize);
+    let k = 4;
+    for py in 0..side {
+        for px in 0..side {
+            let centre = Vec2::new(
+                (px as f32 + 0.5) / side as f32,
+                (py as f32 + 0.5) / side as f32,
+            );
+            let (o, d) = scene.camera.generate_ray(centre, 1.0, Vec2::ZERO);
+            if !matches!(scene.intersect(o, d, 0.0, f32::INFINITY), Some(Hit::Surface(si)) if inside(si.p))
+            {
+                continue;
+            }
+            let mut closed = 0.0;
+            for j in 0..k * k {
+                let ndc = Vec2::new(
+                    (px as f32 + ((j % k) as f32 + 0.5) / k as f32) / side as f32,
+                    (py as f32 + ((j / k) as f32 + 0.5) / k as f32) / side as f32,
+                );
+                let (o, d) = scene.camera.generate_ray(ndc, 1.0, Vec2::ZERO);
+                let Some(Hit::Surface(si)) = scene.intersect(o, d, 0.0, f32::INFINITY) else {
+                    panic!("pixel {px},{py} leaves the sphere")
+                };
+                let mu = (-d).dot(si.ns).clamp(0.0, 1.0);
+                let t = f64::from(dir.transmittance(mu));
+                closed += (1.0 - t) + f64::from(dir.factor(mu, nm)) * r_tot * (1.0 + gain);
+            }
+            want += closed / (k * k) as f64;
+            got += f64::from(film.xyz(px, py)[1]);
+            var += film.variance(px, py);
+            pixels += 1;
+        }
+    }
+    assert!(pixels > side * side / 4, "{pixels} pixels");
+    let se = var.sqrt() / want;
+    let rel = got / want - 1.0;
+    assert!(
+        rel.abs() <= 4.0 * se + 3e-3,
+        "rendered / closed form − 1 = {rel:+.4} ± {se:.4} (G = {gain:.4})"
+    );
 }

@@ -26,9 +26,9 @@
 //! around the render.
 
 use anyhow::Context;
+use render::bssrdf::Curvature;
 use render::film::Film;
 use render::integrator::{BodyIntegrator, IntegratorKind};
-use render::bssrdf::Curvature;
 use render::material::SkinKnobs;
 use render::passes::Passes;
 use render::renderer::{RenderOptions, render_with};
