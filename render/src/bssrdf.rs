@@ -38,7 +38,8 @@
 //! [`ARC_SEGMENTS`] chords, same end points): when it crosses the material, skin lies at distance r
 //! and the probes account for that energy; the fallback fires only when it does not. On the
 //! sphere that is exactly r > 2R (total R_tot; `render/tests/subsurface.rs`), on a flat patch
-//! every miss (its total stays R_tot). Thin geometry needs nothing special: the normal probe
+//! every miss (its total stays R_tot). These totals are the planar model's; the curvature term
+//! ([`curvature`]) multiplies each found exit by 1 + κ h on top. Thin geometry needs nothing special: the normal probe
 //! crosses it and finds the far side, so backlit ears transmit (red) light.
 
 pub mod curvature;
