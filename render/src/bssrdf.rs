@@ -44,12 +44,14 @@
 
 pub mod curvature;
 pub mod extent;
+pub mod grid;
 pub mod incidence;
 pub mod sampling;
 pub mod separable;
 pub mod table;
 
 pub use curvature::{Curvature, CurvatureGain};
+pub use grid::{Corners, ProfileGrid};
 pub use incidence::{Incidence, IncidenceGain};
 pub use sampling::{Probe, ProbeAxes, ProbeFrame, RadiusWavelength, pdf_exit, probe};
 pub use separable::{Directional, EnergySplit, texture_modulation};

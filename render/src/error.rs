@@ -60,6 +60,17 @@ pub enum RenderError {
         /// What is wrong with it.
         message: String,
     },
+    /// A chromophore map of a skin material (scene keys `maps`, `melanin_map`, `edit_mask`, …)
+    /// that cannot be read or whose texels are unusable: missing, wrong size, NaN or out of range.
+    #[error("scene key `{key}`: map {path}: {message}")]
+    ChromophoreMap {
+        /// Dotted scene key, e.g. `materials.skin.melanin_map`.
+        key: String,
+        /// The map file as given.
+        path: PathBuf,
+        /// What is wrong, with the valid range where one applies.
+        message: String,
+    },
     /// A scene setting outside its valid range (the camera's).
     #[error("{name} = {value} outside {range}")]
     Setting {

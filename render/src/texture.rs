@@ -36,7 +36,7 @@ fn image_err(path: &Path, message: impl Into<String>) -> RenderError {
 }
 
 /// Refuse a declared size over [`MAX_SIDE`] or [`MAX_TEXELS`].
-fn check_size(width: usize, height: usize, path: &Path) -> Result<(), RenderError> {
+pub(crate) fn check_size(width: usize, height: usize, path: &Path) -> Result<(), RenderError> {
     if width == 0 || height == 0 {
         return Err(image_err(path, format!("empty image ({width}×{height})")));
     }
@@ -75,17 +75,7 @@ impl Texture {
     /// they declare checked first; texels must be finite, ≥ 0 and at most [`MAX_TEXEL`].
     pub fn from_exr_bytes(bytes: &[u8], path: &Path) -> Result<Self, RenderError> {
         use exr::prelude::*;
-        let meta = exr::meta::MetaData::read_from_buffered(std::io::Cursor::new(bytes), false)
-            .map_err(|e| image_err(path, e.to_string()))?;
-        for h in &meta.headers {
-            check_size(h.layer_size.0, h.layer_size.1, path)?;
-            if h.chunk_count > MAX_EXR_CHUNKS {
-                return Err(image_err(
-                    path,
-                    format!("{} chunks, over the cap of {MAX_EXR_CHUNKS}", h.chunk_count),
-                ));
-            }
-        }
+        check_exr_headers(bytes, path)?;
         let img = read()
             .no_deep_data()
             .largest_resolution_level()
@@ -198,6 +188,23 @@ impl Texture {
         }
         s.map(|v| (v / self.texels.len() as f64) as f32)
     }
+}
+
+/// Read an EXR's headers and refuse sizes over [`MAX_SIDE`], [`MAX_TEXELS`] or
+/// [`MAX_EXR_CHUNKS`] before any texel is allocated.
+pub(crate) fn check_exr_headers(bytes: &[u8], path: &Path) -> Result<(), RenderError> {
+    let meta = exr::meta::MetaData::read_from_buffered(std::io::Cursor::new(bytes), false)
+        .map_err(|e| image_err(path, e.to_string()))?;
+    for h in &meta.headers {
+        check_size(h.layer_size.0, h.layer_size.1, path)?;
+        if h.chunk_count > MAX_EXR_CHUNKS {
+            return Err(image_err(
+                path,
+                format!("{} chunks, over the cap of {MAX_EXR_CHUNKS}", h.chunk_count),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// A baseline or progressive JPEG as 8-bit RGB, decoded strictly (a truncated file is an error).

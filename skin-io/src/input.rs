@@ -73,6 +73,13 @@ pub const ALBEDO: InputKind = InputKind {
     extensions: &["jpg", "jpeg", "png", "exr"],
     max_bytes: 256 * MIB,
 };
+/// A skin chromophore map (`maps.exr` of `skin maps`, or one parameter per file): OpenEXR or a grey
+/// 8- or 16-bit PNG holding the values directly, at most 256 MiB.
+pub const CHROMOPHORE_MAP: InputKind = InputKind {
+    what: "chromophore map",
+    extensions: &["exr", "png"],
+    max_bytes: 256 * MIB,
+};
 /// A lat-long OpenEXR environment map, at most 256 MiB.
 pub const ENVIRONMENT: InputKind = InputKind {
     what: "environment map",
@@ -170,7 +177,15 @@ mod tests {
 
     #[test]
     fn dev_zero_is_refused_as_every_kind_of_input() {
-        for kind in [SCENE, MESH, TEXTURE, ALBEDO, ENVIRONMENT, SPECTRUM] {
+        for kind in [
+            SCENE,
+            MESH,
+            TEXTURE,
+            ALBEDO,
+            CHROMOPHORE_MAP,
+            ENVIRONMENT,
+            SPECTRUM,
+        ] {
             // The extension is checked before anything is opened.
             let e = message(kind.read(Path::new("/dev/zero")));
             assert!(e.contains("expected a ."), "{e}");

@@ -24,6 +24,7 @@
 //! error names its own knob and valid values.
 
 pub mod explain;
+pub mod grid;
 pub mod key;
 pub mod lod;
 pub mod photons;

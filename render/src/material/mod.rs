@@ -40,6 +40,8 @@ use brdf::TorranceSparrow;
 use glam::{Vec2, Vec3};
 use std::f32::consts::{FRAC_1_PI, PI};
 
+pub mod hetero;
+pub mod maps;
 mod skin;
 mod surface;
 
@@ -180,8 +182,7 @@ impl Material {
                 }
             }
             Material::Skin(s) => {
-                let m = s.texture_factor(uv, textures);
-                let rd = s.total_reflectance.eval(wl).map(|r| (r * m).min(1.0));
+                let rd = s.body_totals(uv, wl, textures);
                 Lobes::Skin {
                     surface: Surface::of(s),
                     body: rd,

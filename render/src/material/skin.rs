@@ -102,6 +102,8 @@ pub struct SkinMaterial {
     /// Both layers' coefficients at the skin's Henyey–Greenstein g, built once: what the totals,
     /// the shapes and the volumetric walks use.
     pub media: Arc<SkinMedia>,
+    /// Per-texel chromophores and what is built from them (`None`: the skin is uniform).
+    pub maps: Option<Arc<super::hetero::SkinMaps>>,
 }
 
 impl SkinMaterial {
@@ -180,6 +182,7 @@ impl SkinMaterial {
             choices: None,
             surface_kind: SurfaceKind::Oily,
             media,
+            maps: None,
         }
     }
 
@@ -212,12 +215,32 @@ impl SkinMaterial {
         self.choices.as_ref().and_then(|c| c.lod)
     }
 
-    /// The albedo texture's relative luminance m(uv) (texture luminance / its mean; 1 without one).
+    /// The albedo texture's relative luminance m(uv) (texture luminance / its mean; 1 without one,
+    /// and 1 with chromophore maps, which give the skin's colour per texel instead).
     #[must_use]
     pub fn texture_factor(&self, uv: Vec2, textures: &[Texture]) -> f32 {
+        if self.maps.is_some() {
+            return 1.0;
+        }
         self.albedo_texture.map_or(1.0, |t| {
             textures[t.index].lookup_luminance(uv) / t.mean_luminance
         })
+    }
+
+    /// The body's total diffuse reflectance per lane at `uv`: the texel's totals with maps, else
+    /// R_tot(λ) times the texture's modulation, each at most 1.
+    #[must_use]
+    pub fn body_totals(
+        &self,
+        uv: Vec2,
+        wl: &crate::spectrum::SampledWavelengths,
+        textures: &[Texture],
+    ) -> crate::spectrum::SampledSpectrum {
+        if let Some(maps) = &self.maps {
+            return maps.totals(wl, uv).map(|r| r.min(1.0));
+        }
+        let m = self.texture_factor(uv, textures);
+        self.total_reflectance.eval(wl).map(|r| (r * m).min(1.0))
     }
 }
 

@@ -1,0 +1,137 @@
+//! Radial profiles over a box of skin parameters: one [`ProfileTable`] per node of a grid over
+//! (C_m, β_m, C_h) (an axis whose range is one value has one node), interpolated multilinearly
+//! in R(r) at a hit's parameters (docs/physics.md §19.2). The grid is built by
+//! `crate::fidelity::grid`, which chooses its resolution from the interpolation error it measures.
+
+use super::ProfileTable;
+use crate::spectrum::{N_WAVELENGTHS, SampledSpectrum, SampledWavelengths};
+use std::sync::Arc;
+
+/// Profile tables at the nodes of a grid over (C_m, β_m, C_h).
+#[derive(Debug, Clone)]
+pub struct ProfileGrid {
+    /// Node values of each axis (C_m, β_m, C_h), increasing.
+    axes: [Vec<f32>; 3],
+    /// The tables, C_m fastest, then β_m, then C_h.
+    tables: Vec<Arc<ProfileTable>>,
+    /// The largest relative L1 error of the interpolated radial energy 2πr R(r) against directly
+    /// built profiles, measured at the cells' centres when the grid was built.
+    pub max_error: f32,
+}
+
+/// Up to eight tables and their multilinear weights (those of weight 0 left out).
+#[derive(Debug, Clone, Copy)]
+pub struct Corners<'a> {
+    tables: [Option<(&'a ProfileTable, f32)>; 8],
+}
+
+impl ProfileGrid {
+    /// A grid of `tables` (C_m fastest) over node values `axes`; `max_error` as measured.
+    ///
+    /// # Panics
+    /// If the table count is not the product of the axes' lengths or an axis is empty.
+    #[must_use]
+    pub fn new(axes: [Vec<f32>; 3], tables: Vec<Arc<ProfileTable>>, max_error: f32) -> Self {
+        assert!(axes.iter().all(|a| !a.is_empty()), "every axis has a node");
+        assert_eq!(
+            tables.len(),
+            axes.iter().map(Vec::len).product::<usize>(),
+            "one table per node"
+        );
+        Self {
+            axes,
+            tables,
+            max_error,
+        }
+    }
+
+    /// The node values of each axis (C_m, β_m, C_h).
+    #[must_use]
+    pub fn axes(&self) -> &[Vec<f32>; 3] {
+        &self.axes
+    }
+
+    /// Every node's table, C_m fastest.
+    #[must_use]
+    pub fn tables(&self) -> &[Arc<ProfileTable>] {
+        &self.tables
+    }
+
+    /// The table at the lowest node of every axis (least melanin and blood: the widest profile).
+    #[must_use]
+    pub fn lowest(&self) -> &Arc<ProfileTable> {
+        &self.tables[0]
+    }
+
+    /// The tables around parameters `p` = (C_m, β_m, C_h) and their multilinear weights (each
+    /// coordinate clamped to its axis).
+    #[must_use]
+    pub fn corners(&self, p: [f32; 3]) -> Corners<'_> {
+        let locate = |axis: &[f32], x: f32| -> (usize, f32) {
+            if axis.len() == 1 {
+                return (0, 0.0);
+            }
+            let last = axis.len() - 1;
+            let i = axis.partition_point(|&a| a <= x).clamp(1, last) - 1;
+            let t = ((x - axis[i]) / (axis[i + 1] - axis[i])).clamp(0.0, 1.0);
+            (i, t)
+        };
+        let at = [0, 1, 2].map(|k| locate(&self.axes[k], p[k]));
+        let (n0, n1) = (self.axes[0].len(), self.axes[1].len());
+        let mut tables = [None; 8];
+        for (c, slot) in tables.iter_mut().enumerate() {
+            let bits = [c & 1, (c >> 1) & 1, (c >> 2) & 1];
+            let mut w = 1.0;
+            let mut index = [0usize; 3];
+            for k in 0..3 {
+                let (i, t) = at[k];
+                w *= if bits[k] == 1 { t } else { 1.0 - t };
+                index[k] = i + bits[k];
+            }
+            if w > 0.0 {
+                *slot = Some((
+                    &*self.tables[index[0] + n0 * (index[1] + n1 * index[2])],
+                    w,
+                ));
+            }
+        }
+        Corners { tables }
+    }
+}
+
+impl Corners<'_> {
+    /// R(r) at `r_mm` for each active lane of `wl` (0 for terminated lanes), mm⁻².
+    #[must_use]
+    pub fn eval(&self, wl: &SampledWavelengths, r_mm: f32) -> SampledSpectrum {
+        let mut out = [0.0f32; N_WAVELENGTHS];
+        for (table, w) in self.tables.iter().flatten() {
+            let lanes: [_; N_WAVELENGTHS] =
+                std::array::from_fn(|k| (wl.pdf()[k] > 0.0).then(|| table.at(wl.nm(k))));
+            let r = table.eval_each(&lanes, r_mm);
+            for k in 0..N_WAVELENGTHS {
+                out[k] += w * r[k];
+            }
+        }
+        SampledSpectrum(out)
+    }
+
+    /// R(r) at one wavelength `nm`, mm⁻².
+    #[must_use]
+    pub fn eval_nm(&self, nm: f32, r_mm: f32) -> f32 {
+        self.tables
+            .iter()
+            .flatten()
+            .map(|(t, w)| w * t.eval(nm, r_mm))
+            .sum()
+    }
+
+    /// The total diffuse reflectance R_tot at `nm`, interpolated alike.
+    #[must_use]
+    pub fn total(&self, nm: f32) -> f32 {
+        self.tables
+            .iter()
+            .flatten()
+            .map(|(t, w)| w * t.total(nm))
+            .sum()
+    }
+}

@@ -1,0 +1,293 @@
+//! What a skin material with chromophore maps holds (docs/physics.md §19, "Heterogeneous skin"):
+//! the maps, both layers' absorption at any parameters (for the volumetric walk) and the profile
+//! grid (for the BSSRDF), with the rule that combines the profiles of the two ends of a path.
+
+use super::maps::ChromophoreMaps;
+use crate::bssrdf::ProfileGrid;
+use crate::media::{MediaError, SkinMedia};
+use crate::spectrum::{N_WAVELENGTHS, SampledSpectrum, SampledWavelengths, SpectrumTable};
+use glam::Vec2;
+use skin_optics::SkinParams;
+use std::fmt;
+use std::str::FromStr;
+
+/// How the BSSRDF combines the profiles at the point where light enters (p_i) and where it
+/// leaves (p_o) when they lie in different skin (docs/physics.md §19.3).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ProfileBlend {
+    /// R(r; p_o): the profile of the point the light leaves from (not reciprocal).
+    Exit,
+    /// R(r; p_i): the profile of the point the light entered at (not reciprocal).
+    Entry,
+    /// ½ (R(r; p_i) + R(r; p_o)) (reciprocal).
+    Mean,
+    /// √(R(r; p_i) R(r; p_o)) (reciprocal): the product of the two ends' epidermal filters when
+    /// the profile is a filter T_epi² times the dermis' (§19.3).
+    #[default]
+    Geometric,
+}
+
+impl ProfileBlend {
+    /// Every rule, in the order `explain` lists them.
+    pub const ALL: [ProfileBlend; 4] = [Self::Exit, Self::Entry, Self::Mean, Self::Geometric];
+
+    /// Whether swapping p_i and p_o leaves the profile unchanged.
+    #[must_use]
+    pub fn is_reciprocal(self) -> bool {
+        matches!(self, Self::Mean | Self::Geometric)
+    }
+
+    /// The combined profile from the two ends' values `at_entry` and `at_exit`.
+    #[must_use]
+    #[inline]
+    pub fn combine(self, at_entry: f32, at_exit: f32) -> f32 {
+        match self {
+            Self::Exit => at_exit,
+            Self::Entry => at_entry,
+            Self::Mean => 0.5 * (at_entry + at_exit),
+            Self::Geometric => (at_entry * at_exit).max(0.0).sqrt(),
+        }
+    }
+}
+
+impl fmt::Display for ProfileBlend {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Self::Exit => "exit",
+            Self::Entry => "entry",
+            Self::Mean => "mean",
+            Self::Geometric => "geometric",
+        })
+    }
+}
+
+/// A profile rule name that is none of `exit`, `entry`, `mean`, `geometric`.
+#[derive(Debug, Clone, thiserror::Error)]
+#[error("unknown profile rule '{0}' (valid: exit, entry, mean, geometric)")]
+pub struct UnknownProfileBlend(pub String);
+
+impl FromStr for ProfileBlend {
+    type Err = UnknownProfileBlend;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        Self::ALL
+            .into_iter()
+            .find(|b| b.to_string().eq_ignore_ascii_case(s))
+            .ok_or_else(|| UnknownProfileBlend(s.to_string()))
+    }
+}
+
+/// Both layers' σa at the eight corners of the unit cube of (C_m, β_m, C_h), mm⁻¹, corner c
+/// at (c & 1, c >> 1 & 1, c >> 2 & 1). The model's σa is multilinear in the three ([DJ06] eqs 1
+/// and 5: C_m β_m, C_m and C_h appear in products of at most one of each), so the trilinear
+/// interpolation of the corners is σa itself at any parameters.
+#[derive(Debug, Clone)]
+pub struct CornerAbsorption {
+    epidermis: Vec<SpectrumTable>,
+    dermis: Vec<SpectrumTable>,
+}
+
+/// [`CornerAbsorption`] read at one wavelength.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CornersAt {
+    /// The epidermis' σa at the corners, mm⁻¹.
+    pub epidermis: [f32; 8],
+    /// The dermis' σa at the corners, mm⁻¹.
+    pub dermis: [f32; 8],
+}
+
+impl CornerAbsorption {
+    /// The corners of skin `params` (its other constants kept) at anisotropy `g`.
+    pub fn new(params: &SkinParams, g: f64) -> Result<Self, MediaError> {
+        let mut epidermis = Vec::with_capacity(8);
+        let mut dermis = Vec::with_capacity(8);
+        for c in 0..8 {
+            let bit = |k: usize| f64::from(((c >> k) & 1) as u8);
+            let p = params
+                .with_melanin(bit(0))
+                .and_then(|p| p.with_eumelanin_blend(bit(1)))
+                .and_then(|p| p.with_hemoglobin(bit(2)))
+                .expect("0 and 1 are valid fractions");
+            let media = SkinMedia::new(&p, g)?;
+            epidermis.push(media.epidermis.sigma_a);
+            dermis.push(media.dermis.sigma_a);
+        }
+        Ok(Self { epidermis, dermis })
+    }
+
+    /// The corners at wavelength `nm`.
+    #[must_use]
+    pub fn at_nm(&self, nm: f32) -> CornersAt {
+        CornersAt {
+            epidermis: std::array::from_fn(|c| self.epidermis[c].at_nm(nm)),
+            dermis: std::array::from_fn(|c| self.dermis[c].at_nm(nm)),
+        }
+    }
+}
+
+impl CornersAt {
+    /// σa of the epidermis (`epidermis`) or dermis at parameters `p` = (C_m, β_m, C_h), mm⁻¹.
+    #[must_use]
+    #[inline]
+    pub fn sigma_a(&self, epidermis: bool, p: [f32; 3]) -> f32 {
+        let v = if epidermis {
+            &self.epidermis
+        } else {
+            &self.dermis
+        };
+        let lerp = |a: f32, b: f32, t: f32| a + t * (b - a);
+        let x00 = lerp(v[0], v[1], p[0]);
+        let x10 = lerp(v[2], v[3], p[0]);
+        let x01 = lerp(v[4], v[5], p[0]);
+        let x11 = lerp(v[6], v[7], p[0]);
+        let y0 = lerp(x00, x10, p[1]);
+        let y1 = lerp(x01, x11, p[1]);
+        lerp(y0, y1, p[2]).max(0.0)
+    }
+
+    /// The largest σa of each layer (epidermis, dermis) over the box `range` of parameters: a
+    /// multilinear function's largest value over a box is at one of its corners.
+    #[must_use]
+    pub fn largest(&self, range: [[f32; 2]; 3]) -> (f32, f32) {
+        let mut out = (0.0f32, 0.0f32);
+        for c in 0..8 {
+            let p = std::array::from_fn(|k| range[k][(c >> k) & 1]);
+            out.0 = out.0.max(self.sigma_a(true, p));
+            out.1 = out.1.max(self.sigma_a(false, p));
+        }
+        out
+    }
+}
+
+/// A skin material's maps and what is built from them.
+#[derive(Debug, Clone)]
+pub struct SkinMaps {
+    /// Per-texel (C_m, β_m, C_h).
+    pub maps: ChromophoreMaps,
+    /// Both layers' σa at any parameters (the volumetric walk).
+    pub absorption: CornerAbsorption,
+    /// Profiles over the maps' parameter box (the BSSRDF and the diffuse body).
+    pub grid: ProfileGrid,
+    /// How the BSSRDF combines the two ends' profiles.
+    pub blend: ProfileBlend,
+}
+
+impl SkinMaps {
+    /// R(r) per lane of a path through skin from `uv_i` (entry) to `uv_o` (exit) at distance
+    /// `r_mm`, combined by the material's rule, mm⁻².
+    #[must_use]
+    pub fn profile(
+        &self,
+        wl: &SampledWavelengths,
+        uv_i: Vec2,
+        uv_o: Vec2,
+        r_mm: f32,
+    ) -> SampledSpectrum {
+        let at_o = self.grid.corners(self.maps.at(uv_o)).eval(wl, r_mm);
+        let at_i = self.grid.corners(self.maps.at(uv_i)).eval(wl, r_mm);
+        SampledSpectrum(std::array::from_fn(|k| {
+            self.blend.combine(at_i.0[k], at_o.0[k])
+        }))
+    }
+
+    /// The total diffuse reflectance R_tot per lane at the texel of `uv`.
+    #[must_use]
+    pub fn totals(&self, wl: &SampledWavelengths, uv: Vec2) -> SampledSpectrum {
+        let corners = self.grid.corners(self.maps.at(uv));
+        SampledSpectrum(std::array::from_fn(|k| {
+            if k < N_WAVELENGTHS && wl.pdf()[k] > 0.0 {
+                corners.total(wl.nm(k))
+            } else {
+                0.0
+            }
+        }))
+    }
+}
+
+impl super::SkinMaterial {
+    /// The same skin with chromophore maps `maps`: the corners of its absorption, the profile
+    /// grid over the maps' parameter box (error target `grid_error`,
+    /// `crate::fidelity::grid::DEFAULT_GRID_ERROR` by default) and the rule `blend`. The BSSRDF
+    /// samples radii from the grid's widest profile (least melanin and blood) and weights each
+    /// sample by the combined profile of its two ends (§19.3).
+    pub fn with_maps(
+        mut self,
+        maps: ChromophoreMaps,
+        blend: ProfileBlend,
+        knobs: &super::SkinKnobs,
+        grid_error: f32,
+    ) -> Result<Self, super::SkinBuildError> {
+        let g = self.media.phase_g;
+        let absorption = CornerAbsorption::new(&self.params, g)?;
+        let settings = crate::fidelity::grid::GridSettings {
+            params: &self.params,
+            phase_g: g,
+            method: knobs.method,
+            shape_escapes: knobs.shape_escapes,
+            fidelity: &knobs.fidelity,
+            target: grid_error,
+        };
+        let grid = crate::fidelity::grid::profile_grid(&settings, maps.range())
+            .map_err(super::SkinBuildError::Profiles)?;
+        if let Some(ss) = &mut self.subsurface {
+            ss.table = grid.lowest().clone();
+        }
+        self.maps = Some(std::sync::Arc::new(SkinMaps {
+            maps,
+            absorption,
+            grid,
+            blend,
+        }));
+        Ok(self)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{Rng, SeedableRng};
+    use rand_xoshiro::Xoshiro256PlusPlus;
+
+    /// The trilinear interpolation of the corners is the model's σa at random parameters (the
+    /// model is multilinear; only f32 rounding, 1e-5 relative, separates them), in both layers
+    /// and across the visible range; the largest over a box bounds every value inside it.
+    #[test]
+    fn corners_give_the_models_absorption_anywhere() {
+        let base = SkinParams::preset(skin_optics::Preset::Medium);
+        let corners = CornerAbsorption::new(&base, 0.9).unwrap();
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(3);
+        for _ in 0..40 {
+            let p: [f32; 3] = std::array::from_fn(|_| rng.random_range(0.0..1.0));
+            let q = base
+                .with_melanin(f64::from(p[0]))
+                .unwrap()
+                .with_eumelanin_blend(f64::from(p[1]))
+                .unwrap()
+                .with_hemoglobin(f64::from(p[2]))
+                .unwrap();
+            let media = SkinMedia::new(&q, 0.9).unwrap();
+            for nm in [380.0, 455.0, 560.0, 700.0] {
+                let at = corners.at_nm(nm);
+                let (e, d) = (
+                    media.epidermis.sigma_a.at_nm(nm),
+                    media.dermis.sigma_a.at_nm(nm),
+                );
+                assert!((at.sigma_a(true, p) / e - 1.0).abs() < 1e-5, "{p:?} {nm}");
+                assert!((at.sigma_a(false, p) / d - 1.0).abs() < 1e-5, "{p:?} {nm}");
+                let (me, md) = at.largest([[0.0, 1.0]; 3]);
+                assert!(me >= e * (1.0 - 1e-6) && md >= d * (1.0 - 1e-6));
+            }
+        }
+    }
+
+    /// The reciprocal rules are symmetric in the two ends; the others are not.
+    #[test]
+    fn reciprocal_rules_are_symmetric() {
+        for b in ProfileBlend::ALL {
+            let same = b.combine(0.2, 0.8) == b.combine(0.8, 0.2);
+            assert_eq!(same, b.is_reciprocal(), "{b}");
+            assert_eq!(b.to_string().parse::<ProfileBlend>().unwrap(), b);
+        }
+        assert!((ProfileBlend::Geometric.combine(0.2, 0.8) - 0.4).abs() < 1e-6);
+        assert!("median".parse::<ProfileBlend>().is_err());
+    }
+}

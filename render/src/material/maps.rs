@@ -1,0 +1,430 @@
+//! Chromophore maps: per-texel skin parameters (C_m, β_m, C_h) over a mesh's texture coordinates
+//! (docs/physics.md §19, "Heterogeneous skin"), read from the `maps.exr` of `skin maps` or from one
+//! file per parameter, edited at load, and checked: every texel finite and in [0, 1] after the
+//! edits (an error names the key, the file, the texel and the range; nothing is clamped).
+//!
+//! A per-parameter file is a single-channel OpenEXR (its one channel, or the channel named after
+//! the parameter) or a grey PNG whose 8- or 16-bit values hold the parameter directly
+//! (value / 255 or value / 65535; no transfer curve). Sizes are capped as textures are
+//! (`crate::texture::MAX_TEXELS`), checked before anything is allocated.
+
+use crate::error::RenderError;
+use crate::texture::{Texture, check_exr_headers, check_size};
+use glam::Vec2;
+use skin_optics::echo::Num;
+use std::path::{Path, PathBuf};
+
+/// A skin parameter a map may hold.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Parameter {
+    /// Melanin fraction C_m.
+    Melanin,
+    /// Eumelanin blend β_m.
+    Eumelanin,
+    /// Hemoglobin fraction C_h.
+    Hemoglobin,
+}
+
+impl Parameter {
+    /// All three, in texel order (C_m, β_m, C_h).
+    pub const ALL: [Parameter; 3] = [Self::Melanin, Self::Eumelanin, Self::Hemoglobin];
+
+    /// The channel name in `maps.exr` (and the scene key's stem).
+    #[must_use]
+    pub fn channel(self) -> &'static str {
+        match self {
+            Self::Melanin => "melanin",
+            Self::Eumelanin => "eumelanin",
+            Self::Hemoglobin => "hemoglobin",
+        }
+    }
+}
+
+/// One parameter's values, row-major, rows top to bottom (v = 0 at the top row).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ValueImage {
+    /// Width, texels.
+    pub width: usize,
+    /// Height, texels.
+    pub height: usize,
+    /// The values, `width × height`.
+    pub values: Vec<f32>,
+}
+
+/// A load-time edit of a parameter: v' = v + m (s v + o − v), m the mask's value (1 without one).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Edit {
+    /// Scale s (scene key `melanin_scale`, `hemoglobin_scale`; default 1).
+    pub scale: f64,
+    /// Offset o (scene key `melanin_offset`, `hemoglobin_offset`; default 0).
+    pub offset: f64,
+}
+
+/// Where one parameter comes from: a map (its scene key and file) or the material's scalar.
+#[derive(Debug, Clone)]
+pub enum Source {
+    /// A map read from `path` under scene key `key`.
+    Map {
+        /// Dotted scene key.
+        key: String,
+        /// The file as given.
+        path: PathBuf,
+        /// The values.
+        image: ValueImage,
+    },
+    /// The same value at every texel (the material's scalar or preset).
+    Scalar(f64),
+}
+
+/// What the scene gives for a skin's maps, before assembly.
+#[derive(Debug, Clone)]
+pub struct MapInputs {
+    /// The material's scene key, e.g. `materials.skin`.
+    pub material_key: String,
+    /// Per parameter (C_m, β_m, C_h), where its values come from.
+    pub sources: [Source; 3],
+    /// Edits of C_m and C_h (β_m is not edited), each under its scene key stem.
+    pub edits: [(Parameter, Edit); 2],
+    /// The mask weighting the edits (`edit_mask`): scene key, file and values in [0, 1].
+    pub mask: Option<(String, PathBuf, ValueImage)>,
+}
+
+/// Per-texel (C_m, β_m, C_h) of one skin material, bilinearly filtered like a texture (u wraps,
+/// v clamps), with each parameter's range over the texels.
+#[derive(Debug, Clone)]
+pub struct ChromophoreMaps {
+    texels: Texture,
+    range: [[f32; 2]; 3],
+}
+
+fn map_err(key: &str, path: &Path, message: impl Into<String>) -> RenderError {
+    RenderError::ChromophoreMap {
+        key: key.to_string(),
+        path: path.to_path_buf(),
+        message: message.into(),
+    }
+}
+
+impl ChromophoreMaps {
+    /// Assemble the maps: all given images of one size, the scalars filling the rest, the edits
+    /// applied under the mask, every texel finite and in [0, 1] (else an error naming the key, the
+    /// file, the texel and the range). `None` when no parameter has a map and no mask is given.
+    pub fn assemble(inputs: MapInputs) -> Result<Option<Self>, RenderError> {
+        let mut size: Option<(usize, usize, String, PathBuf)> = None;
+        let images = inputs
+            .sources
+            .iter()
+            .filter_map(|s| match s {
+                Source::Map { key, path, image } => Some((key, path, image)),
+                Source::Scalar(_) => None,
+            })
+            .chain(inputs.mask.iter().map(|(k, p, i)| (k, p, i)));
+        for (key, path, image) in images {
+            if let Some(v) = image.values.iter().position(|v| !v.is_finite()) {
+                return Err(map_err(
+                    key,
+                    path,
+                    format!(
+                        "texel ({}, {}) is not a number",
+                        v % image.width,
+                        v / image.width
+                    ),
+                ));
+            }
+            match &size {
+                None => size = Some((image.width, image.height, key.clone(), path.clone())),
+                Some((w, h, first_key, first_path))
+                    if (*w, *h) != (image.width, image.height) =>
+                {
+                    return Err(map_err(
+                        key,
+                        path,
+                        format!(
+                            "{}×{} texels, but `{first_key}` ({}) has {w}×{h}: the maps must \
+                             share one size",
+                            image.width,
+                            image.height,
+                            first_path.display()
+                        ),
+                    ));
+                }
+                Some(_) => {}
+            }
+        }
+        let Some((width, height, _, first_path)) = size else {
+            return Ok(None);
+        };
+        let n = width * height;
+        let mut values: [Vec<f32>; 3] = std::array::from_fn(|k| match &inputs.sources[k] {
+            Source::Map { image, .. } => image.values.clone(),
+            Source::Scalar(v) => vec![*v as f32; n],
+        });
+        for (param, edit) in inputs.edits {
+            if edit == (Edit {
+                scale: 1.0,
+                offset: 0.0,
+            }) {
+                continue;
+            }
+            let k = param as usize;
+            for (i, v) in values[k].iter_mut().enumerate() {
+                let m = inputs.mask.as_ref().map_or(1.0, |(_, _, mask)| mask.values[i]);
+                let x = f64::from(*v);
+                *v = (x + f64::from(m) * (edit.scale * x + edit.offset - x)) as f32;
+            }
+        }
+        if let Some((key, path, mask)) = &inputs.mask
+            && let Some(i) = mask.values.iter().position(|v| !(0.0..=1.0).contains(v))
+        {
+            return Err(map_err(
+                key,
+                path,
+                format!(
+                    "texel ({}, {}) = {} outside the mask's range [0, 1]",
+                    i % width,
+                    i / width,
+                    Num(f64::from(mask.values[i]))
+                ),
+            ));
+        }
+        for (k, param) in Parameter::ALL.iter().enumerate() {
+            if let Some(i) = values[k].iter().position(|v| !(0.0..=1.0).contains(v)) {
+                let (key, path) = match &inputs.sources[k] {
+                    Source::Map { key, path, .. } => (key.clone(), path.clone()),
+                    // A scalar leaves [0, 1] only through its edit: name the edit's key.
+                    Source::Scalar(_) => (
+                        format!("{}.{}_offset", inputs.material_key, param.channel()),
+                        first_path.clone(),
+                    ),
+                };
+                let edited = inputs
+                    .edits
+                    .iter()
+                    .any(|(p, e)| p == param && (e.scale != 1.0 || e.offset != 0.0));
+                return Err(map_err(
+                    &key,
+                    &path,
+                    format!(
+                        "{} at texel ({}, {}) is {}{}, outside [0, 1]",
+                        param.channel(),
+                        i % width,
+                        i / width,
+                        Num(f64::from(values[k][i])),
+                        if edited {
+                            format!(
+                                " after {0}_scale and {0}_offset (nothing is clamped)",
+                                param.channel()
+                            )
+                        } else {
+                            String::new()
+                        }
+                    ),
+                ));
+            }
+        }
+        let range = std::array::from_fn(|k| {
+            values[k]
+                .iter()
+                .fold([f32::INFINITY, f32::NEG_INFINITY], |[lo, hi], &v| {
+                    [lo.min(v), hi.max(v)]
+                })
+        });
+        let texels = (0..n)
+            .map(|i| [values[0][i], values[1][i], values[2][i]])
+            .collect();
+        Ok(Some(Self {
+            texels: Texture::from_texels(width, height, texels),
+            range,
+        }))
+    }
+
+    /// (C_m, β_m, C_h) at `uv`, bilinearly filtered.
+    #[must_use]
+    #[inline]
+    pub fn at(&self, uv: Vec2) -> [f32; 3] {
+        self.texels.lookup(uv)
+    }
+
+    /// [lo, hi] of each parameter (C_m, β_m, C_h) over the texels.
+    #[must_use]
+    pub fn range(&self) -> [[f32; 2]; 3] {
+        self.range
+    }
+
+    /// Width × height, texels.
+    #[must_use]
+    pub fn size(&self) -> (usize, usize) {
+        self.texels.size()
+    }
+}
+
+/// The three channels `melanin`, `eumelanin`, `hemoglobin` of a `maps.exr` (each `None` when
+/// absent; other channels are ignored). An error when none of the three is present.
+pub fn read_maps_exr(bytes: &[u8], path: &Path) -> Result<[Option<ValueImage>; 3], RenderError> {
+    let channels = exr_channels(bytes, path)?;
+    let found: [Option<ValueImage>; 3] = std::array::from_fn(|k| {
+        channels
+            .iter()
+            .find(|(name, _)| name == Parameter::ALL[k].channel())
+            .map(|(_, image)| image.clone())
+    });
+    if found.iter().all(Option::is_none) {
+        let names: Vec<&str> = channels.iter().map(|(n, _)| n.as_str()).collect();
+        return Err(RenderError::Image {
+            path: path.to_path_buf(),
+            message: format!(
+                "none of the channels melanin, eumelanin, hemoglobin (found {})",
+                names.join(", ")
+            ),
+        });
+    }
+    Ok(found)
+}
+
+/// One parameter's values from a single-channel EXR (its one channel, or the channel named
+/// `name`) or a grey 8- or 16-bit PNG (value / 255 or / 65535).
+pub fn read_value_image(bytes: &[u8], path: &Path, name: &str) -> Result<ValueImage, RenderError> {
+    let image_err = |message: String| RenderError::Image {
+        path: path.to_path_buf(),
+        message,
+    };
+    if bytes.starts_with(&[0x76, 0x2f, 0x31, 0x01]) {
+        let mut channels = exr_channels(bytes, path)?;
+        if let Some(k) = channels.iter().position(|(n, _)| n == name) {
+            return Ok(channels.swap_remove(k).1);
+        }
+        if channels.len() == 1 {
+            return Ok(channels.remove(0).1);
+        }
+        let names: Vec<&str> = channels.iter().map(|(n, _)| n.as_str()).collect();
+        return Err(image_err(format!(
+            "expected one channel (or one named {name}), found {}",
+            names.join(", ")
+        )));
+    }
+    let reader = || {
+        image::ImageReader::new(std::io::Cursor::new(bytes))
+            .with_guessed_format()
+            .map_err(|e| image_err(e.to_string()))
+    };
+    let (w, h) = reader()?
+        .into_dimensions()
+        .map_err(|e| image_err(e.to_string()))?;
+    check_size(w as usize, h as usize, path)?;
+    let img = reader()?.decode().map_err(|e| image_err(e.to_string()))?;
+    let values = match &img {
+        image::DynamicImage::ImageLuma8(g) => {
+            g.as_raw().iter().map(|&v| f32::from(v) / 255.0).collect()
+        }
+        image::DynamicImage::ImageLuma16(g) => {
+            g.as_raw().iter().map(|&v| f32::from(v) / 65535.0).collect()
+        }
+        other => {
+            return Err(image_err(format!(
+                "expected a grey 8- or 16-bit PNG holding the values, found {:?}",
+                other.color()
+            )));
+        }
+    };
+    Ok(ValueImage {
+        width: w as usize,
+        height: h as usize,
+        values,
+    })
+}
+
+/// Every channel of an EXR's first layer (largest resolution), by name, as f32.
+fn exr_channels(bytes: &[u8], path: &Path) -> Result<Vec<(String, ValueImage)>, RenderError> {
+    use exr::prelude::*;
+    check_exr_headers(bytes, path)?;
+    let img = read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .first_valid_layer()
+        .all_attributes()
+        .from_buffered(std::io::Cursor::new(bytes))
+        .map_err(|e| RenderError::Image {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        })?;
+    let (width, height) = (img.layer_data.size.0, img.layer_data.size.1);
+    Ok(img
+        .layer_data
+        .channel_data
+        .list
+        .iter()
+        .map(|c| {
+            (
+                c.name.to_string(),
+                ValueImage {
+                    width,
+                    height,
+                    values: c.sample_data.values_as_f32().collect(),
+                },
+            )
+        })
+        .collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn image(width: usize, height: usize, v: f32) -> ValueImage {
+        ValueImage {
+            width,
+            height,
+            values: vec![v; width * height],
+        }
+    }
+
+    fn inputs(melanin: ValueImage, edit: Edit) -> MapInputs {
+        MapInputs {
+            material_key: "materials.s".into(),
+            sources: [
+                Source::Map {
+                    key: "materials.s.melanin_map".into(),
+                    path: "m.png".into(),
+                    image: melanin,
+                },
+                Source::Scalar(0.5),
+                Source::Scalar(0.02),
+            ],
+            edits: [
+                (Parameter::Melanin, edit),
+                (
+                    Parameter::Hemoglobin,
+                    Edit {
+                        scale: 1.0,
+                        offset: 0.0,
+                    },
+                ),
+            ],
+            mask: None,
+        }
+    }
+
+    /// Scalars fill the parameters without a map; the edit v' = s v + o applies everywhere without
+    /// a mask; a value pushed past 1 is an error naming the key, the texel and the range.
+    #[test]
+    fn edits_apply_and_out_of_range_values_are_named() {
+        let edit = Edit {
+            scale: 2.0,
+            offset: 0.1,
+        };
+        let maps = ChromophoreMaps::assemble(inputs(image(2, 2, 0.1), edit))
+            .unwrap()
+            .unwrap();
+        let [cm, bm, ch] = maps.at(Vec2::new(0.3, 0.6));
+        assert!((cm - 0.3).abs() < 1e-6 && bm == 0.5 && ch == 0.02, "{cm} {bm} {ch}");
+        assert_eq!(maps.range()[0], [0.3, 0.3]);
+        let e = ChromophoreMaps::assemble(inputs(image(2, 2, 0.5), edit))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("materials.s.melanin_map") && e.contains("outside [0, 1]"),
+            "{e}"
+        );
+    }
+}
