@@ -98,6 +98,9 @@ pub struct Exit {
     pub hit: Option<SurfaceHit>,
     /// Spatial weight per wavelength, R(r) · N / pdf (dimensionless: mm⁻² / mm⁻²).
     pub weight: SampledSpectrum,
+    /// The distance r the weight's R(r) was read at, mm (the probe's radius for the local
+    /// fallback).
+    pub r_mm: f32,
 }
 
 /// A sampled probe: the segment to intersect, and the lanes' densities that weight what it finds.
@@ -280,6 +283,7 @@ impl Subsurface {
             ns,
             hit: Some(s),
             weight,
+            r_mm: dist,
         })
     }
 
@@ -304,6 +308,7 @@ impl Subsurface {
             ns: frame.n,
             hit: None,
             weight,
+            r_mm: r,
         }
     }
 }

@@ -111,6 +111,22 @@ impl Geometry {
             .collect()
     }
 
+    /// The vertices (world mm) and texture coordinates of every triangle of material `material`.
+    #[must_use]
+    pub fn triangles_with_uvs_of(&self, material: u32) -> Vec<([Vec3; 3], [Vec2; 3])> {
+        self.triangles
+            .iter()
+            .zip(&self.materials)
+            .filter(|&(_, &m)| m == material)
+            .map(|(t, _)| {
+                (
+                    t.map(|i| self.positions[i as usize]),
+                    t.map(|i| self.uvs[i as usize]),
+                )
+            })
+            .collect()
+    }
+
     /// Material index of a triangle.
     #[must_use]
     pub fn material_of(&self, triangle: u32) -> u32 {

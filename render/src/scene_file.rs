@@ -301,6 +301,36 @@ pub enum MaterialDesc {
         phase_g: Option<f64>,
         /// Surface model: "oily" (default) or "smooth".
         surface: Option<String>,
+        /// Chromophore maps over the mesh's texture coordinates: the `maps.exr` of `skin maps`
+        /// (channels `melanin`, `eumelanin`, `hemoglobin`; others ignored).
+        maps: Option<String>,
+        /// C_m per texel: a single-channel EXR or a grey 8/16-bit PNG holding the value (instead
+        /// of the `melanin` channel of `maps`).
+        melanin_map: Option<String>,
+        /// β_m per texel (as `melanin_map`).
+        eumelanin_map: Option<String>,
+        /// C_h per texel (as `melanin_map`).
+        hemoglobin_map: Option<String>,
+        /// Scale s of the load-time edit C_m' = C_m + m (s C_m + o − C_m) (default 1).
+        #[serde(default, deserialize_with = "opt_finite_f64")]
+        melanin_scale: Option<f64>,
+        /// Offset o of the melanin edit (default 0).
+        #[serde(default, deserialize_with = "opt_finite_f64")]
+        melanin_offset: Option<f64>,
+        /// Scale of the hemoglobin edit (default 1).
+        #[serde(default, deserialize_with = "opt_finite_f64")]
+        hemoglobin_scale: Option<f64>,
+        /// Offset of the hemoglobin edit (default 0).
+        #[serde(default, deserialize_with = "opt_finite_f64")]
+        hemoglobin_offset: Option<f64>,
+        /// Mask m in [0, 1] weighting the edits per texel (as `melanin_map`; default 1 everywhere).
+        edit_mask: Option<String>,
+        /// How the BSSRDF combines the profiles of a path's two ends in different skin: "exit",
+        /// "entry", "mean" or "geometric" (default; docs/physics.md §19.3).
+        profile_blend: Option<String>,
+        /// Target of the profile grid's measured interpolation error, (0, 1) (default 0.01).
+        #[serde(default, deserialize_with = "opt_finite")]
+        map_profile_error: Option<f32>,
     },
     /// Lambertian.
     Diffuse {

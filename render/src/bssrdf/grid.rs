@@ -89,10 +89,7 @@ impl ProfileGrid {
                 index[k] = i + bits[k];
             }
             if w > 0.0 {
-                *slot = Some((
-                    &*self.tables[index[0] + n0 * (index[1] + n1 * index[2])],
-                    w,
-                ));
+                *slot = Some((&*self.tables[index[0] + n0 * (index[1] + n1 * index[2])], w));
             }
         }
         Corners { tables }

@@ -163,12 +163,18 @@ impl PathTracer<'_> {
             u,
             rays,
         )?;
+        let t_o = ss.directional.factors(hit.wo.dot(hit.ns), wl);
+        if let Some(maps) = &skin.maps {
+            // The profile of the skin at both ends instead of the texture's modulation.
+            let uv_i = exit.hit.map_or(si.uv, |h| h.uv);
+            let weight = exit.weight * maps.reweight(&ss.table, wl, uv_i, si.uv, exit.r_mm) * t_o;
+            return (!weight.is_black() && weight.is_finite()).then_some((exit, weight));
+        }
         let m_o = skin.texture_factor(si.uv, &scene.textures);
         let m_i = exit
             .hit
             .map_or(m_o, |h| skin.texture_factor(h.uv, &scene.textures));
         let m = texture_modulation(m_o, m_i);
-        let t_o = ss.directional.factors(hit.wo.dot(hit.ns), wl);
         let cap = SampledSpectrum(std::array::from_fn(|k| {
             m.min(1.0 / ss.table.total(wl.nm(k)).max(1e-6))
         }));

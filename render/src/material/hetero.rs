@@ -189,6 +189,31 @@ impl SkinMaps {
         }))
     }
 
+    /// The factor turning a BSSRDF sample drawn and weighted with `table` (the widest profile)
+    /// into one of this skin: R_het(r) / R_table(r) per lane for a path from `uv_i` (entry) to
+    /// `uv_o` (exit), 0 where the table's profile is 0.
+    #[must_use]
+    pub fn reweight(
+        &self,
+        table: &crate::bssrdf::ProfileTable,
+        wl: &SampledWavelengths,
+        uv_i: Vec2,
+        uv_o: Vec2,
+        r_mm: f32,
+    ) -> SampledSpectrum {
+        let het = self.profile(wl, uv_i, uv_o, r_mm);
+        let lanes: [_; N_WAVELENGTHS] =
+            std::array::from_fn(|k| (wl.pdf()[k] > 0.0).then(|| table.at(wl.nm(k))));
+        let base = table.eval_each(&lanes, r_mm);
+        SampledSpectrum(std::array::from_fn(|k| {
+            if base[k] > 0.0 {
+                het.0[k] / base[k]
+            } else {
+                0.0
+            }
+        }))
+    }
+
     /// The total diffuse reflectance R_tot per lane at the texel of `uv`.
     #[must_use]
     pub fn totals(&self, wl: &SampledWavelengths, uv: Vec2) -> SampledSpectrum {

@@ -133,9 +133,7 @@ impl ChromophoreMaps {
             }
             match &size {
                 None => size = Some((image.width, image.height, key.clone(), path.clone())),
-                Some((w, h, first_key, first_path))
-                    if (*w, *h) != (image.width, image.height) =>
-                {
+                Some((w, h, first_key, first_path)) if (*w, *h) != (image.width, image.height) => {
                     return Err(map_err(
                         key,
                         path,
@@ -160,15 +158,20 @@ impl ChromophoreMaps {
             Source::Scalar(v) => vec![*v as f32; n],
         });
         for (param, edit) in inputs.edits {
-            if edit == (Edit {
-                scale: 1.0,
-                offset: 0.0,
-            }) {
+            if edit
+                == (Edit {
+                    scale: 1.0,
+                    offset: 0.0,
+                })
+            {
                 continue;
             }
             let k = param as usize;
             for (i, v) in values[k].iter_mut().enumerate() {
-                let m = inputs.mask.as_ref().map_or(1.0, |(_, _, mask)| mask.values[i]);
+                let m = inputs
+                    .mask
+                    .as_ref()
+                    .map_or(1.0, |(_, _, mask)| mask.values[i]);
                 let x = f64::from(*v);
                 *v = (x + f64::from(m) * (edit.scale * x + edit.offset - x)) as f32;
             }
@@ -417,7 +420,10 @@ mod tests {
             .unwrap()
             .unwrap();
         let [cm, bm, ch] = maps.at(Vec2::new(0.3, 0.6));
-        assert!((cm - 0.3).abs() < 1e-6 && bm == 0.5 && ch == 0.02, "{cm} {bm} {ch}");
+        assert!(
+            (cm - 0.3).abs() < 1e-6 && bm == 0.5 && ch == 0.02,
+            "{cm} {bm} {ch}"
+        );
         assert_eq!(maps.range()[0], [0.3, 0.3]);
         let e = ChromophoreMaps::assemble(inputs(image(2, 2, 0.5), edit))
             .unwrap_err()

@@ -249,6 +249,7 @@ impl Loader<'_> {
                 albedo_texture: Some(_),
                 ..
             })
+            | Material::Skin(SkinMaterial { maps: Some(_), .. })
             | Material::Diffuse(DiffuseMaterial {
                 albedo_texture: Some(_),
                 ..

@@ -3,6 +3,7 @@
 //! physics is built by [`SkinMaterial::build`].
 
 use super::load::Loader;
+use super::maps::MapKeys;
 use crate::error::RenderError;
 use crate::fidelity::{FidelityKnobs, LodBand, LodSetting};
 use crate::material::{
@@ -63,6 +64,17 @@ impl Loader<'_> {
                     albedo_texture,
                     phase_g,
                     surface,
+                    maps,
+                    melanin_map,
+                    eumelanin_map,
+                    hemoglobin_map,
+                    melanin_scale,
+                    melanin_offset,
+                    hemoglobin_scale,
+                    hemoglobin_offset,
+                    edit_mask,
+                    profile_blend,
+                    map_profile_error,
                 } => {
                     let params =
                         self.skin_params(&key, preset, [*melanin, *eumelanin, *hemoglobin, *oil])?;
@@ -79,6 +91,18 @@ impl Loader<'_> {
                             SkinBuildError::Surface(e) => rough_err(e),
                             other => self.err(&key, other.to_string()),
                         })?;
+                    let map_keys = MapKeys {
+                        maps,
+                        per_parameter: [melanin_map, eumelanin_map, hemoglobin_map],
+                        edits: [
+                            (melanin_scale, melanin_offset),
+                            (hemoglobin_scale, hemoglobin_offset),
+                        ],
+                        edit_mask,
+                        profile_blend,
+                        map_profile_error,
+                    };
+                    let skin = self.skin_with_maps(&key, skin, &map_keys, &knobs)?;
                     Material::Skin(skin)
                 }
                 MaterialDesc::Diffuse {

@@ -6,6 +6,7 @@
 //! texture names its path.
 
 mod load;
+mod maps;
 mod materials;
 
 use crate::builtin;

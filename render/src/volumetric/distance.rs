@@ -428,7 +428,7 @@ pub fn distance_squared(p: DVec3, t: &[Vec3; 3]) -> f64 {
 /// The closest point of the triangle (a, a + `ab`, a + `ac`) to a + `ap`, relative to a
 /// ([Ericson05] §5.1.5).
 #[inline]
-fn closest_offset(ap: DVec3, ab: DVec3, ac: DVec3) -> DVec3 {
+pub(crate) fn closest_offset(ap: DVec3, ab: DVec3, ac: DVec3) -> DVec3 {
     let (d1, d2) = (ab.dot(ap), ac.dot(ap));
     if d1 <= 0.0 && d2 <= 0.0 {
         return DVec3::ZERO;

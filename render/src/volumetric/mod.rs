@@ -9,6 +9,8 @@
 
 pub mod distance;
 pub mod guide;
+pub mod hetero;
+pub mod nearest;
 pub mod shapes;
 pub mod slab_table;
 pub mod thin;
@@ -48,6 +50,8 @@ pub struct SkinVolume {
     pub eta: f32,
     /// Which points lie in the epidermis (within d_epi of the surface).
     pub epidermis_region: SurfaceDistance,
+    /// Per-texel absorption of a skin with chromophore maps (`None`: the layers are uniform).
+    pub maps: Option<hetero::MapMedium>,
 }
 
 impl SkinVolume {
@@ -79,6 +83,7 @@ impl SkinVolume {
             dwivedi_nu0,
             eta,
             epidermis_region: SurfaceDistance::new(triangles, d_epi_mm),
+            maps: None,
         }
     }
 
@@ -135,14 +140,21 @@ impl Volumetric {
                 continue;
             };
             let triangles = scene.geometry.triangles_of(index as u32);
-            media.push(Some(SkinVolume::new(
+            let mut volume = SkinVolume::new(
                 skin.media.epidermis.clone(),
                 skin.media.dermis.clone(),
                 skin.media.phase_g,
                 skin.params.eta() as f32,
                 skin.params.epidermis_thickness_mm() as f32,
                 triangles,
-            )));
+            );
+            volume.maps = skin.maps.as_ref().map(|maps| hetero::MapMedium {
+                maps: maps.clone(),
+                nearest: nearest::NearestSurface::new(
+                    &scene.geometry.triangles_with_uvs_of(index as u32),
+                ),
+            });
+            media.push(Some(volume));
         }
         Self { media }
     }

@@ -105,11 +105,16 @@ pub fn walk<R: RngCore>(
     rng: &mut R,
     rays: &mut u64,
 ) -> Walk {
-    let epidermis = (
+    let mut epidermis = (
         vol.epidermis.sigma_a.at_nm(nm),
         vol.epidermis.sigma_s.at_nm(nm),
     );
-    let dermis = (vol.dermis.sigma_a.at_nm(nm), vol.dermis.sigma_s.at_nm(nm));
+    let mut dermis = (vol.dermis.sigma_a.at_nm(nm), vol.dermis.sigma_s.at_nm(nm));
+    // With maps σa varies per point: the majorant (and the guide) take each layer's largest.
+    let maps = vol.maps.as_ref().map(|m| m.at_nm(nm));
+    if let Some(m) = &maps {
+        (epidermis.0, dermis.0) = m.largest;
+    }
     let majorant = (epidermis.0 + epidermis.1).max(dermis.0 + dermis.1);
     let mut out = Walk {
         exit: None,
@@ -122,7 +127,7 @@ pub fn walk<R: RngCore>(
     );
     let region = &vol.epidermis_region;
     let d_epi = region.radius_mm();
-    let one_layer = epidermis == dermis;
+    let one_layer = epidermis == dermis && maps.is_none();
     let material = entry.material;
     // The walk starts on the entry face itself (its f32 hit point put back on the face's plane):
     // an origin offset into the skin would skip medium.
@@ -203,6 +208,9 @@ pub fn walk<R: RngCore>(
             Layer::Epidermis => epidermis,
             Layer::Dermis => dermis,
         };
+        let sa = maps
+            .as_ref()
+            .map_or(sa, |m| m.sigma_a(layer == Layer::Epidermis, x));
         if rng.random::<f32>() * majorant as f32 >= sa + ss {
             continue; // null collision
         }

@@ -1,0 +1,145 @@
+//! A skin material's chromophore-map keys (`maps`, `melanin_map`, `eumelanin_map`,
+//! `hemoglobin_map`, the edits and `edit_mask`, `profile_blend`, `map_profile_error`): each file
+//! read through the guarded reader and decoded by `material::maps`, every error naming its key.
+
+use super::load::Loader;
+use crate::error::RenderError;
+use crate::fidelity::grid::DEFAULT_GRID_ERROR;
+use crate::material::hetero::ProfileBlend;
+use crate::material::maps::{
+    ChromophoreMaps, Edit, MapInputs, Parameter, Source, ValueImage, read_maps_exr,
+    read_value_image,
+};
+use crate::material::{SkinBuildError, SkinKnobs, SkinMaterial};
+use std::path::PathBuf;
+
+/// The map keys of one skin material, as parsed.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct MapKeys<'a> {
+    pub maps: &'a Option<String>,
+    /// `melanin_map`, `eumelanin_map`, `hemoglobin_map`.
+    pub per_parameter: [&'a Option<String>; 3],
+    /// (scale, offset) of melanin, then of hemoglobin.
+    pub edits: [(&'a Option<f64>, &'a Option<f64>); 2],
+    pub edit_mask: &'a Option<String>,
+    pub profile_blend: &'a Option<String>,
+    pub map_profile_error: &'a Option<f32>,
+}
+
+impl Loader<'_> {
+    /// `skin` with the maps its keys give (unchanged when there are none).
+    pub(super) fn skin_with_maps(
+        &self,
+        key: &str,
+        skin: SkinMaterial,
+        keys: &MapKeys<'_>,
+        knobs: &SkinKnobs,
+    ) -> Result<SkinMaterial, RenderError> {
+        let edited = keys.edits.iter().any(|(s, o)| s.is_some() || o.is_some());
+        let Some(maps) = self.chromophore_maps(key, &skin, keys)? else {
+            if edited || keys.profile_blend.is_some() || keys.map_profile_error.is_some() {
+                return Err(self.err(
+                    key,
+                    "the edits, profile_blend and map_profile_error need a map (maps, \
+                     melanin_map, eumelanin_map, hemoglobin_map or edit_mask)",
+                ));
+            }
+            return Ok(skin);
+        };
+        let blend = match keys.profile_blend {
+            Some(b) => b
+                .parse::<ProfileBlend>()
+                .map_err(|e| self.err(format!("{key}.profile_blend"), e.to_string()))?,
+            None => ProfileBlend::default(),
+        };
+        let target = match *keys.map_profile_error {
+            Some(e) if e > 0.0 && e < 1.0 => e,
+            Some(e) => {
+                return Err(self.err(
+                    format!("{key}.map_profile_error"),
+                    format!("{e} outside (0, 1)"),
+                ));
+            }
+            None => DEFAULT_GRID_ERROR,
+        };
+        skin.with_maps(maps, blend, knobs, target)
+            .map_err(|e: SkinBuildError| self.err(key, e.to_string()))
+    }
+
+    /// The maps of `skin`'s keys: each given file read and decoded, the scalars filling the
+    /// parameters without one, the edits applied; `None` when no map or mask is given.
+    fn chromophore_maps(
+        &self,
+        key: &str,
+        skin: &SkinMaterial,
+        keys: &MapKeys<'_>,
+    ) -> Result<Option<ChromophoreMaps>, RenderError> {
+        let read = |name: &str, spec: &str| -> Result<(Vec<u8>, PathBuf), RenderError> {
+            let map_key = format!("{key}.{name}");
+            self.read(skin_io::input::CHROMOPHORE_MAP, spec)
+                .map(|(b, p)| (b.into_owned(), p))
+                .map_err(|e| RenderError::ChromophoreMap {
+                    key: map_key,
+                    path: PathBuf::from(spec),
+                    message: e.to_string(),
+                })
+        };
+        let named = |name: &str, spec: &str, e: RenderError| RenderError::ChromophoreMap {
+            key: format!("{key}.{name}"),
+            path: PathBuf::from(spec),
+            message: e.to_string(),
+        };
+        let mut from_exr: [Option<ValueImage>; 3] = [None, None, None];
+        if let Some(spec) = keys.maps {
+            let (bytes, path) = read("maps", spec)?;
+            from_exr = read_maps_exr(&bytes, &path).map_err(|e| named("maps", spec, e))?;
+        }
+        let scalars = [
+            skin.params.melanin(),
+            skin.params.eumelanin_blend(),
+            skin.params.hemoglobin(),
+        ];
+        let mut sources: [Source; 3] = scalars.map(Source::Scalar);
+        for (k, param) in Parameter::ALL.iter().enumerate() {
+            let name = format!("{}_map", param.channel());
+            if let Some(spec) = keys.per_parameter[k] {
+                let (bytes, path) = read(&name, spec)?;
+                let image = read_value_image(&bytes, &path, param.channel())
+                    .map_err(|e| named(&name, spec, e))?;
+                sources[k] = Source::Map {
+                    key: format!("{key}.{name}"),
+                    path: PathBuf::from(spec),
+                    image,
+                };
+            } else if let (Some(image), Some(spec)) = (from_exr[k].take(), keys.maps) {
+                sources[k] = Source::Map {
+                    key: format!("{key}.maps"),
+                    path: PathBuf::from(spec),
+                    image,
+                };
+            }
+        }
+        let mask = match keys.edit_mask {
+            Some(spec) => {
+                let (bytes, path) = read("edit_mask", spec)?;
+                let image = read_value_image(&bytes, &path, "mask")
+                    .map_err(|e| named("edit_mask", spec, e))?;
+                Some((format!("{key}.edit_mask"), PathBuf::from(spec), image))
+            }
+            None => None,
+        };
+        let edit = |(scale, offset): (&Option<f64>, &Option<f64>)| Edit {
+            scale: scale.unwrap_or(1.0),
+            offset: offset.unwrap_or(0.0),
+        };
+        ChromophoreMaps::assemble(MapInputs {
+            material_key: key.to_string(),
+            sources,
+            edits: [
+                (Parameter::Melanin, edit(keys.edits[0])),
+                (Parameter::Hemoglobin, edit(keys.edits[1])),
+            ],
+            mask,
+        })
+    }
+}

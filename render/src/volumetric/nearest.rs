@@ -1,0 +1,208 @@
+//! The nearest surface point of a closed mesh to any point inside it, with its texture
+//! coordinates (docs/physics.md §19.1): where the volumetric walk reads a heterogeneous skin's
+//! chromophores. A bounding-volume hierarchy over the triangles answers by branch and bound
+//! (children visited nearest box first, a box skipped once it is farther than the best triangle);
+//! the triangle distance is the walk's own ([Ericson05] §5.1.5, `super::distance`).
+
+use super::distance::closest_offset;
+use glam::{DVec3, Vec2, Vec3};
+
+/// Most triangles in a leaf.
+const LEAF: usize = 4;
+
+#[derive(Debug, Clone, Copy)]
+struct Tri {
+    a: DVec3,
+    ab: DVec3,
+    ac: DVec3,
+    uv: [Vec2; 3],
+}
+
+#[derive(Debug, Clone, Copy)]
+struct Node {
+    lo: DVec3,
+    hi: DVec3,
+    /// Leaf: first triangle and count; inner: index of the first child (the second follows it).
+    start: u32,
+    count: u32,
+}
+
+/// Triangles (world mm) with their vertices' texture coordinates, for nearest-point queries.
+#[derive(Debug, Clone)]
+pub struct NearestSurface {
+    tris: Vec<Tri>,
+    nodes: Vec<Node>,
+}
+
+impl NearestSurface {
+    /// The hierarchy over `triangles`, each with its vertices' texture coordinates.
+    #[must_use]
+    pub fn new(triangles: &[([Vec3; 3], [Vec2; 3])]) -> Self {
+        let mut tris: Vec<Tri> = triangles
+            .iter()
+            .map(|(t, uv)| {
+                let [a, b, c] = t.map(Vec3::as_dvec3);
+                Tri {
+                    a,
+                    ab: b - a,
+                    ac: c - a,
+                    uv: *uv,
+                }
+            })
+            .collect();
+        let mut nodes = Vec::with_capacity(2 * tris.len() / LEAF + 1);
+        nodes.push(Node {
+            lo: DVec3::ZERO,
+            hi: DVec3::ZERO,
+            start: 0,
+            count: tris.len() as u32,
+        });
+        let mut todo = vec![0usize];
+        while let Some(n) = todo.pop() {
+            let (start, count) = (nodes[n].start as usize, nodes[n].count as usize);
+            let part = &mut tris[start..start + count];
+            let (lo, hi) = bounds(part);
+            nodes[n].lo = lo;
+            nodes[n].hi = hi;
+            if count <= LEAF {
+                continue;
+            }
+            let centre = |t: &Tri| t.a + (t.ab + t.ac) / 3.0;
+            let axis = (hi - lo).max_position();
+            part.sort_by(|x, y| centre(x)[axis].total_cmp(&centre(y)[axis]));
+            let half = count / 2;
+            let first = nodes.len();
+            nodes[n] = Node {
+                lo,
+                hi,
+                start: first as u32,
+                count: 0,
+            };
+            for (s, c) in [(start, half), (start + half, count - half)] {
+                nodes.push(Node {
+                    lo: DVec3::ZERO,
+                    hi: DVec3::ZERO,
+                    start: s as u32,
+                    count: c as u32,
+                });
+                todo.push(nodes.len() - 1);
+            }
+        }
+        Self { tris, nodes }
+    }
+
+    /// The texture coordinates of the surface point nearest `p` (barycentric on its triangle);
+    /// `None` without triangles.
+    #[must_use]
+    pub fn uv(&self, p: DVec3) -> Option<Vec2> {
+        let mut best = (f64::INFINITY, None::<(usize, DVec3)>);
+        let mut stack = vec![0usize];
+        while let Some(n) = stack.pop() {
+            let node = self.nodes[n];
+            if box_distance_squared(p, node.lo, node.hi) >= best.0 {
+                continue;
+            }
+            if node.count > 0 || node.start == 0 && self.nodes.len() == 1 {
+                let (s, c) = (node.start as usize, node.count as usize);
+                for (i, t) in self.tris[s..s + c].iter().enumerate() {
+                    let off = closest_offset(p - t.a, t.ab, t.ac);
+                    let d2 = (p - t.a - off).length_squared();
+                    if d2 < best.0 {
+                        best = (d2, Some((s + i, off)));
+                    }
+                }
+                continue;
+            }
+            let (a, b) = (node.start as usize, node.start as usize + 1);
+            let da = box_distance_squared(p, self.nodes[a].lo, self.nodes[a].hi);
+            let db = box_distance_squared(p, self.nodes[b].lo, self.nodes[b].hi);
+            // The nearer child is popped first.
+            if da <= db {
+                stack.extend([b, a]);
+            } else {
+                stack.extend([a, b]);
+            }
+        }
+        let (i, off) = best.1?;
+        let t = &self.tris[i];
+        let (v, w) = barycentric(off, t.ab, t.ac);
+        Some(t.uv[0] * (1.0 - v - w) as f32 + t.uv[1] * v as f32 + t.uv[2] * w as f32)
+    }
+}
+
+/// (v, w) with `off` = v·ab + w·ac (off lies in the triangle's plane); (0, 0) for a degenerate
+/// triangle.
+fn barycentric(off: DVec3, ab: DVec3, ac: DVec3) -> (f64, f64) {
+    let (d00, d01, d11) = (ab.dot(ab), ab.dot(ac), ac.dot(ac));
+    let (d20, d21) = (off.dot(ab), off.dot(ac));
+    let det = d00 * d11 - d01 * d01;
+    if det.abs() <= f64::EPSILON * d00 * d11 {
+        return (0.0, 0.0);
+    }
+    let v = (d11 * d20 - d01 * d21) / det;
+    let w = (d00 * d21 - d01 * d20) / det;
+    (v.clamp(0.0, 1.0), w.clamp(0.0, 1.0 - v.clamp(0.0, 1.0)))
+}
+
+fn bounds(tris: &[Tri]) -> (DVec3, DVec3) {
+    tris.iter().fold(
+        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+        |(lo, hi), t| {
+            let (b, c) = (t.a + t.ab, t.a + t.ac);
+            (lo.min(t.a).min(b).min(c), hi.max(t.a).max(b).max(c))
+        },
+    )
+}
+
+fn box_distance_squared(p: DVec3, lo: DVec3, hi: DVec3) -> f64 {
+    let d = (lo - p).max(p - hi).max(DVec3::ZERO);
+    d.length_squared()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{Rng, SeedableRng};
+    use rand_xoshiro::Xoshiro256PlusPlus;
+
+    /// On a 1,280-triangle sphere of radius 10 mm with uv = (x, y) / 10 of each vertex, the
+    /// nearest point's uv equals that of the brute-force nearest triangle at random points inside
+    /// (exact up to f32 rounding, 1e-5: the same distance function, and ties have one point), and
+    /// a point just under a vertex reads that vertex's uv.
+    #[test]
+    fn nearest_uv_agrees_with_brute_force() {
+        let mesh = crate::mesh::TriangleMesh::sphere(3);
+        let tris: Vec<([Vec3; 3], [Vec2; 3])> = mesh
+            .indices
+            .iter()
+            .map(|t| {
+                let v = t.map(|i| mesh.positions[i as usize] * 10.0);
+                (v, v.map(|p| Vec2::new(p.x, p.y) / 10.0))
+            })
+            .collect();
+        let near = NearestSurface::new(&tris);
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(4);
+        for _ in 0..2000 {
+            let p = DVec3::new(
+                rng.random_range(-9.5..9.5),
+                rng.random_range(-9.5..9.5),
+                rng.random_range(-9.5..9.5),
+            );
+            let (i, _) = tris
+                .iter()
+                .map(|(t, _)| super::super::distance::distance_squared(p, t))
+                .enumerate()
+                .fold(
+                    (0, f64::INFINITY),
+                    |b, (i, d)| if d < b.1 { (i, d) } else { b },
+                );
+            let one = NearestSurface::new(&tris[i..=i]);
+            let (got, want) = (near.uv(p).unwrap(), one.uv(p).unwrap());
+            assert!((got - want).length() < 1e-5, "{p}: {got} vs {want}");
+        }
+        let v0 = tris[0].0[0];
+        let uv = near.uv(v0.as_dvec3() * 0.99).unwrap();
+        assert!((uv - tris[0].1[0]).length() < 1e-4, "{uv}");
+        assert!(NearestSurface::new(&[]).uv(DVec3::ZERO).is_none());
+    }
+}
