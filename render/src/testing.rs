@@ -214,3 +214,172 @@ pub fn grey_exr_2x2() -> Vec<u8> {
     .unwrap();
     bytes
 }
+
+/// Heterogeneous skin on a flat slab (docs/physics.md §19.4): a 40 × 40 × 20 mm box whose
+/// texture coordinates map x ∈ [−20, 20] mm to u ∈ [0, 1] and y ∈ [20, −20] mm to v ∈ [0, 1]
+/// (every vertex, so a point's nearest surface point reads the texel above or below it), under a
+/// sky of spectral radiance 1, seen from +Z along a strip across x.
+pub mod hetero {
+    use crate::film::Film;
+    use crate::integrator::{BodyIntegrator, IntegratorKind};
+    use crate::material::SkinKnobs;
+    use crate::renderer::{RenderOptions, render_with};
+    use crate::scene::Scene;
+    use std::fmt::Write as _;
+    use std::path::Path;
+
+    /// Side of the slab's square face, mm.
+    pub const SLAB_SIDE_MM: f32 = 40.0;
+    /// Depth of the slab, mm.
+    pub const SLAB_DEPTH_MM: f32 = 20.0;
+
+    /// The slab as OBJ with its planar texture coordinates (12 triangles, outward faces).
+    #[must_use]
+    pub fn slab_obj() -> String {
+        let (h, d) = (0.5 * SLAB_SIDE_MM, 0.5 * SLAB_DEPTH_MM);
+        let mut obj = String::from("# slab with planar uv\n");
+        for i in 0..8 {
+            let sign = |bit: usize| if i & bit == 0 { -1.0 } else { 1.0 };
+            let (x, y, z) = (sign(1) * h, sign(2) * h, sign(4) * d);
+            let _ = writeln!(
+                obj,
+                "v {x} {y} {z}\nvt {} {}",
+                (x + h) / SLAB_SIDE_MM,
+                (h - y) / SLAB_SIDE_MM
+            );
+        }
+        let faces = [
+            [1, 3, 7, 5],
+            [2, 6, 8, 4],
+            [1, 5, 6, 2],
+            [3, 4, 8, 7],
+            [1, 2, 4, 3],
+            [5, 7, 8, 6],
+        ];
+        let normals = ["-1 0 0", "1 0 0", "0 -1 0", "0 1 0", "0 0 -1", "0 0 1"];
+        for (k, ([a, b, c, e], n)) in faces.iter().zip(normals).enumerate() {
+            let k = k + 1;
+            let _ = writeln!(
+                obj,
+                "vn {n}\nf {a}/{a}/{k} {b}/{b}/{k} {c}/{c}/{k}\nf {a}/{a}/{k} {c}/{c}/{k} {e}/{e}/{k}"
+            );
+        }
+        obj
+    }
+
+    /// A 32-bit float OpenEXR of `channels` (name, row-major values) at `width` × `height`.
+    #[must_use]
+    pub fn exr_bytes(width: usize, height: usize, channels: Vec<(&str, Vec<f32>)>) -> Vec<u8> {
+        use exr::prelude::*;
+        let list: Vec<AnyChannel<FlatSamples>> = channels
+            .into_iter()
+            .map(|(name, data)| AnyChannel::new(name, FlatSamples::F32(data)))
+            .collect();
+        let layer = Layer::new(
+            (width, height),
+            LayerAttributes::default(),
+            Encoding::FAST_LOSSLESS,
+            AnyChannels::sort(list.into()),
+        );
+        let mut out = std::io::Cursor::new(Vec::new());
+        Image::from_layer(layer)
+            .write()
+            .to_buffered(&mut out)
+            .unwrap();
+        out.into_inner()
+    }
+
+    /// A `melanin` channel of `side_x` × `side_y` texels over the slab's face, C_m = `f(x, y)` at
+    /// each texel's centre (x, y in mm).
+    #[must_use]
+    pub fn melanin_exr(side_x: usize, side_y: usize, f: impl Fn(f32, f32) -> f32) -> Vec<u8> {
+        let h = 0.5 * SLAB_SIDE_MM;
+        let values = (0..side_y)
+            .flat_map(|j| (0..side_x).map(move |i| (i, j)))
+            .map(|(i, j)| {
+                let x = -h + (i as f32 + 0.5) * SLAB_SIDE_MM / side_x as f32;
+                let y = h - (j as f32 + 0.5) * SLAB_SIDE_MM / side_y as f32;
+                f(x, y)
+            })
+            .collect();
+        exr_bytes(side_x, side_y, vec![("melanin", values)])
+    }
+
+    /// The slab scene in `dir` (writes slab.obj there) with skin keys `skin_keys`, seen from
+    /// 400 mm along a strip x ∈ [−`half_mm`, `half_mm`] of `columns` × 2 pixels.
+    #[must_use]
+    pub fn strip_scene(dir: &Path, half_mm: f32, columns: usize, skin_keys: &str) -> Scene {
+        std::fs::write(dir.join("slab.obj"), slab_obj()).unwrap();
+        let distance = 400.0f32;
+        let top = 0.5 * SLAB_DEPTH_MM;
+        let half_height = half_mm * 2.0 / columns as f32;
+        let fov = 2.0 * (half_height / (distance - top)).atan().to_degrees();
+        let text = format!(
+            "[camera]\nposition_mm = [0, 0, {distance}]\nlook_at_mm = [0, 0, 0]\nfov_deg = {fov}\n\
+             [environment]\nspectral_radiance = 1\n\
+             [materials.skin]\ntype = \"skin\"\n{skin_keys}\n\
+             [[meshes]]\nfile = \"slab.obj\"\nmaterial = \"skin\"\n"
+        );
+        Scene::from_toml(&text, "slab.toml", Some(dir), &SkinKnobs::default()).unwrap()
+    }
+
+    /// Render `scene` at one wavelength `nm`, `columns` × 2 pixels, with integrator `kind`.
+    #[must_use]
+    pub fn render_strip(
+        scene: &Scene,
+        kind: IntegratorKind,
+        columns: usize,
+        nm: f32,
+        spp: u32,
+        seed: u64,
+    ) -> Film {
+        let body = BodyIntegrator::build(scene, kind);
+        let opts = RenderOptions {
+            width: columns,
+            height: 2,
+            spp,
+            seed,
+            wavelength_nm: Some(nm),
+            ..Default::default()
+        };
+        render_with(scene, &body, &opts.validate().unwrap(), None)
+            .unwrap()
+            .0
+    }
+
+    /// Per column: the mean radiance of its pixels and its standard error.
+    #[must_use]
+    pub fn columns(film: &Film) -> Vec<(f64, f64)> {
+        let (w, h) = film.size();
+        (0..w)
+            .map(|x| {
+                let (mut s, mut v) = (0.0, 0.0);
+                for y in 0..h {
+                    s += f64::from(film.linear_srgb(x, y)[1]);
+                    v += film.variance(x, y);
+                }
+                (s / h as f64, v.sqrt() / h as f64)
+            })
+            .collect()
+    }
+
+    /// The mean and standard error over the columns whose centres lie in [`from_mm`, `to_mm`]
+    /// of a strip x ∈ [−`half_mm`, `half_mm`].
+    #[must_use]
+    pub fn region(cols: &[(f64, f64)], half_mm: f32, from_mm: f32, to_mm: f32) -> (f64, f64) {
+        let n = cols.len();
+        let picked: Vec<(f64, f64)> = cols
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| {
+                let x = -half_mm + (*i as f32 + 0.5) * 2.0 * half_mm / n as f32;
+                (from_mm..=to_mm).contains(&x)
+            })
+            .map(|(_, c)| *c)
+            .collect();
+        let k = picked.len() as f64;
+        let mean = picked.iter().map(|c| c.0).sum::<f64>() / k;
+        let se = picked.iter().map(|c| c.1 * c.1).sum::<f64>().sqrt() / k;
+        (mean, se)
+    }
+}
