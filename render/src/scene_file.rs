@@ -328,7 +328,7 @@ pub enum MaterialDesc {
         /// How the BSSRDF combines the profiles of a path's two ends in different skin: "exit",
         /// "entry", "mean" or "geometric" (default; docs/physics.md §19.3).
         profile_blend: Option<String>,
-        /// Target of the profile grid's measured interpolation error, (0, 1) (default 0.01).
+        /// Target of the profile grid's measured interpolation error, (0, 1) (default 0.02).
         #[serde(default, deserialize_with = "opt_finite")]
         map_profile_error: Option<f32>,
     },

@@ -3,6 +3,7 @@
 
 mod adaptive;
 mod fidelity;
+mod hetero;
 mod passes;
 mod sampler;
 mod scene_presets;

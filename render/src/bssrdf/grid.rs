@@ -1,6 +1,6 @@
 //! Radial profiles over a box of skin parameters: one [`ProfileTable`] per node of a grid over
 //! (C_m, β_m, C_h) (an axis whose range is one value has one node), interpolated multilinearly
-//! in R(r) at a hit's parameters (docs/physics.md §19.2). The grid is built by
+//! in ln R(r) at a hit's parameters (docs/physics.md §19.2). The grid is built by
 //! `crate::fidelity::grid`, which chooses its resolution from the interpolation error it measures.
 
 use super::ProfileTable;
@@ -97,38 +97,51 @@ impl ProfileGrid {
 }
 
 impl Corners<'_> {
+    /// The multilinear interpolation of ln v over the corners' values `v` (weights `w`):
+    /// ∏ v_c^{w_c}, exact where v is exponential in the parameters (an absorbing layer's
+    /// filter, §19.2); linear where a corner's value is 0 (beyond its profile's end).
+    #[inline]
+    fn blend(values: impl Iterator<Item = (f32, f32)> + Clone) -> f32 {
+        if values.clone().all(|(v, _)| v > 0.0) {
+            values.map(|(v, w)| w * v.ln()).sum::<f32>().exp()
+        } else {
+            values.map(|(v, w)| w * v).sum()
+        }
+    }
+
     /// R(r) at `r_mm` for each active lane of `wl` (0 for terminated lanes), mm⁻².
     #[must_use]
     pub fn eval(&self, wl: &SampledWavelengths, r_mm: f32) -> SampledSpectrum {
-        let mut out = [0.0f32; N_WAVELENGTHS];
+        let mut at = [[(0.0f32, 0.0f32); 8]; N_WAVELENGTHS];
+        let mut n = 0;
         for (table, w) in self.tables.iter().flatten() {
             let lanes: [_; N_WAVELENGTHS] =
                 std::array::from_fn(|k| (wl.pdf()[k] > 0.0).then(|| table.at(wl.nm(k))));
             let r = table.eval_each(&lanes, r_mm);
             for k in 0..N_WAVELENGTHS {
-                out[k] += w * r[k];
+                at[k][n] = (r[k], *w);
             }
+            n += 1;
         }
-        SampledSpectrum(out)
+        SampledSpectrum(std::array::from_fn(|k| {
+            Self::blend(at[k][..n].iter().copied())
+        }))
     }
 
     /// R(r) at one wavelength `nm`, mm⁻².
     #[must_use]
     pub fn eval_nm(&self, nm: f32, r_mm: f32) -> f32 {
-        self.tables
-            .iter()
-            .flatten()
-            .map(|(t, w)| w * t.eval(nm, r_mm))
-            .sum()
+        Self::blend(
+            self.tables
+                .iter()
+                .flatten()
+                .map(|(t, w)| (t.eval(nm, r_mm), *w)),
+        )
     }
 
     /// The total diffuse reflectance R_tot at `nm`, interpolated alike.
     #[must_use]
     pub fn total(&self, nm: f32) -> f32 {
-        self.tables
-            .iter()
-            .flatten()
-            .map(|(t, w)| w * t.total(nm))
-            .sum()
+        Self::blend(self.tables.iter().flatten().map(|(t, w)| (t.total(nm), *w)))
     }
 }

@@ -15,7 +15,7 @@ use std::sync::{Arc, Mutex};
 
 /// Default target of the grid's interpolation error: the relative L1 error of the radial energy
 /// 2πr R(r) at the worst wavelength (every 20 nm), measured at the cells' centres.
-pub const DEFAULT_GRID_ERROR: f32 = 0.01;
+pub const DEFAULT_GRID_ERROR: f32 = 0.02;
 
 /// Most nodes per axis (2⁵ + 1): the refinement stops there whatever the error.
 pub const MAX_NODES_PER_AXIS: usize = 33;

@@ -218,13 +218,7 @@ impl SkinMaps {
     #[must_use]
     pub fn totals(&self, wl: &SampledWavelengths, uv: Vec2) -> SampledSpectrum {
         let corners = self.grid.corners(self.maps.at(uv));
-        SampledSpectrum(std::array::from_fn(|k| {
-            if k < N_WAVELENGTHS && wl.pdf()[k] > 0.0 {
-                corners.total(wl.nm(k))
-            } else {
-                0.0
-            }
-        }))
+        SampledSpectrum(std::array::from_fn(|k| corners.total(wl.nm(k))))
     }
 }
 
@@ -243,12 +237,22 @@ impl super::SkinMaterial {
     ) -> Result<Self, super::SkinBuildError> {
         let g = self.media.phase_g;
         let absorption = CornerAbsorption::new(&self.params, g)?;
+        // Every node on the scalar table's wavelength rows: interpolating between tables of
+        // different rows would add their wavelength interpolations' difference to the error.
+        let mut fidelity = knobs.fidelity.clone();
+        fidelity.wavelength_step_nm = Some(
+            self.choices
+                .as_ref()
+                .map_or(crate::fidelity::SKIN_TABLE_STEP_NM, |c| {
+                    c.wavelengths.step_nm
+                }),
+        );
         let settings = crate::fidelity::grid::GridSettings {
             params: &self.params,
             phase_g: g,
             method: knobs.method,
             shape_escapes: knobs.shape_escapes,
-            fidelity: &knobs.fidelity,
+            fidelity: &fidelity,
             target: grid_error,
         };
         let grid = crate::fidelity::grid::profile_grid(&settings, maps.range())

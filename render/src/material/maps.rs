@@ -11,7 +11,6 @@
 use crate::error::RenderError;
 use crate::texture::{Texture, check_exr_headers, check_size};
 use glam::Vec2;
-use skin_optics::echo::Num;
 use std::path::{Path, PathBuf};
 
 /// A skin parameter a map may hold.
@@ -186,7 +185,7 @@ impl ChromophoreMaps {
                     "texel ({}, {}) = {} outside the mask's range [0, 1]",
                     i % width,
                     i / width,
-                    Num(f64::from(mask.values[i]))
+                    mask.values[i]
                 ),
             ));
         }
@@ -212,7 +211,7 @@ impl ChromophoreMaps {
                         param.channel(),
                         i % width,
                         i / width,
-                        Num(f64::from(values[k][i])),
+                        values[k][i],
                         if edited {
                             format!(
                                 " after {0}_scale and {0}_offset (nothing is clamped)",

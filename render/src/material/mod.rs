@@ -175,10 +175,16 @@ impl Material {
         let frame = Frame::from_normal(n);
         let lobes = match self {
             Material::Skin(s) if s.subsurface.is_some() && !collapsed => {
-                let m = s.texture_factor(uv, textures);
+                let subsurface_albedo = match &s.maps {
+                    Some(maps) => maps.totals(wl, uv).average().min(1.0),
+                    None => {
+                        let m = s.texture_factor(uv, textures);
+                        (s.total_reflectance.eval(wl).average() * m).min(1.0)
+                    }
+                };
                 Lobes::SkinSurface {
                     surface: Surface::of(s),
-                    subsurface_albedo: (s.total_reflectance.eval(wl).average() * m).min(1.0),
+                    subsurface_albedo,
                 }
             }
             Material::Skin(s) => {
