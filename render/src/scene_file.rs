@@ -278,6 +278,9 @@ pub struct EnvironmentDesc {
 /// `[materials.NAME]`.
 #[derive(Debug, Deserialize)]
 #[serde(tag = "type", rename_all = "lowercase", deny_unknown_fields)]
+// Parsed once per material and dropped after loading: boxing the skin's keys would only add a
+// level to every pattern that reads them.
+#[allow(clippy::large_enum_variant)]
 pub enum MaterialDesc {
     /// Skin: a preset with optional explicit fractions.
     Skin {

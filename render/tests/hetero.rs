@@ -55,10 +55,10 @@ fn uniform_map_renders_as_the_scalar_skin() {
 
 /// The BSSRDF with the default rule against the volumetric walk at 650 nm on the slab split at
 /// x = 0 (C_m 0.3 left, 0.02 right) and on a 1-mm freckle of C_m 0.15: region means ≥ 1 mm from
-/// the boundaries within 4% + 3σ (the uniform slab's BSSRDF–walk gap at this wavelength is about
-/// 1–3%, BENCHMARKS.md "Heterogeneous skin"); at the freckle's centre within 12% + 3σ (the
-/// transition measured there: 4% at high counts); and the geometric rule's transition nearer
-/// the walk than the entry rule's, by the measured margin (RMS 12–19% against 67–110%).
+/// the boundaries within 8% + 3σ (the uniform slabs' own BSSRDF–walk gap at this wavelength is
+/// 3.7–5.9%, and heterogeneity adds at most 2% to it, BENCHMARKS.md "Heterogeneous skin"); at the
+/// freckle's centre within 12% + 3σ (5.5% measured at high counts); and the geometric rule's
+/// transition nearer the walk than half the entry rule's (RMS 8% against 55–90% measured).
 #[test]
 fn split_slab_and_freckle_follow_the_volumetric_walk() {
     let dir = tempfile::tempdir().unwrap();
@@ -69,7 +69,7 @@ fn split_slab_and_freckle_follow_the_volumetric_walk() {
         (
             "split",
             melanin_exr(256, 1, |x, _| if x < 0.0 { 0.3 } else { 0.02 }),
-            &[(-4.0, -1.0, 0.04), (1.0, 4.0, 0.04)],
+            &[(-4.0, -1.0, 0.08), (1.0, 4.0, 0.08)],
         ),
         (
             "freckle",
@@ -78,7 +78,7 @@ fn split_slab_and_freckle_follow_the_volumetric_walk() {
                 256,
                 |x, y| if x * x + y * y <= 0.25 { 0.15 } else { 0.02 },
             ),
-            &[(-4.0, -1.5, 0.04), (-0.3, 0.3, 0.12), (1.5, 4.0, 0.04)],
+            &[(-4.0, -1.5, 0.08), (-0.3, 0.3, 0.12), (1.5, 4.0, 0.08)],
         ),
     ];
     for (name, map, regions) in cases {

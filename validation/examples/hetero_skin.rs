@@ -53,6 +53,32 @@ fn main() -> anyhow::Result<()> {
         },
     ];
     let start = cpu_time::ProcessTime::now();
+    // The homogeneous gap: each side's skin alone, BSSRDF against the walk over the whole strip.
+    let uniform_dir = tempfile::tempdir()?;
+    for nm in [550.0f32, 650.0] {
+        for cm in [0.02, 0.15, 0.3] {
+            let scene = strip_scene(
+                uniform_dir.path(),
+                HALF_MM,
+                COLUMNS,
+                &format!("melanin = {cm}"),
+            );
+            let mean = |kind, spp, seed| {
+                region(
+                    &columns(&render_strip(&scene, kind, COLUMNS, nm, spp, seed)),
+                    HALF_MM,
+                    -HALF_MM,
+                    HALF_MM,
+                )
+            };
+            let (v, vs) = mean(IntegratorKind::Volumetric, spp_vol / 4, 1);
+            let (b, bs) = mean(IntegratorKind::Bssrdf, spp_bss / 4, 2);
+            println!(
+                "uniform C_m {cm} at {nm} nm: walk {v:.4} ± {vs:.4}, BSSRDF {b:.4} ± {bs:.4} ({:+.2}%)",
+                100.0 * (b / v - 1.0)
+            );
+        }
+    }
     let mut panels = Vec::new();
     for case in &cases {
         let dir = tempfile::tempdir()?;

@@ -239,7 +239,7 @@ impl super::SkinMaterial {
         let absorption = CornerAbsorption::new(&self.params, g)?;
         // Every node on the scalar table's wavelength rows: interpolating between tables of
         // different rows would add their wavelength interpolations' difference to the error.
-        let mut fidelity = knobs.fidelity.clone();
+        let mut fidelity = knobs.fidelity;
         fidelity.wavelength_step_nm = Some(
             self.choices
                 .as_ref()
