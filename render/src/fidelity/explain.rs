@@ -150,6 +150,25 @@ pub struct SkinChoices {
     pub build_ms: f64,
     /// With `--method multipole`: where diffusion is wrong.
     pub diffusion_failures: Option<DiffusionFailures>,
+    /// With chromophore maps: their size and the profile grid (`None`: a uniform skin).
+    pub maps: Option<MapChoice>,
+}
+
+/// The chromophore maps of a skin and the profile grid built over them (docs/physics.md §19).
+#[derive(Debug, Clone, PartialEq)]
+pub struct MapChoice {
+    /// Width × height of the maps, texels.
+    pub texels: (usize, usize),
+    /// [lo, hi] of C_m, β_m and C_h over the texels.
+    pub range: [[f32; 2]; 3],
+    /// Nodes of the profile grid per axis (C_m, β_m, C_h).
+    pub nodes: [usize; 3],
+    /// The grid's measured interpolation error (relative L1 of 2πr R(r), worst wavelength).
+    pub max_error: f32,
+    /// Its target.
+    pub target: f32,
+    /// The rule combining the profiles of a path's two ends.
+    pub blend: String,
 }
 
 /// Why the shapes have their photon count, in words.
@@ -255,6 +274,28 @@ pub fn explain_table(skins: &[(&str, &SkinChoices)]) -> String {
         ];
         for (k, v) in rows {
             let _ = writeln!(s, "  {k:<16} {v}");
+        }
+        if let Some(m) = &c.maps {
+            let [cm, bm, ch] = m.range;
+            let _ = writeln!(
+                s,
+                "  {:<16} {}×{} texels, C_m {:.3}–{:.3}, β_m {:.3}–{:.3}, C_h {:.4}–{:.4}; profile grid                  {}×{}×{} tables, interpolation error {:.2}% (target {:.2}%); ends combined: {}",
+                "maps",
+                m.texels.0,
+                m.texels.1,
+                cm[0],
+                cm[1],
+                bm[0],
+                bm[1],
+                ch[0],
+                ch[1],
+                m.nodes[0],
+                m.nodes[1],
+                m.nodes[2],
+                100.0 * m.max_error,
+                100.0 * m.target,
+                m.blend
+            );
         }
         if let Some(f) = &c.diffusion_failures {
             let _ = writeln!(

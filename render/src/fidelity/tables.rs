@@ -157,6 +157,7 @@ pub fn skin_table(
         diffusion_failures: (method == Method::Multipole)
             .then(|| diffusion_failures(params, media))
             .flatten(),
+        maps: None,
     };
     Ok((table, choices))
 }

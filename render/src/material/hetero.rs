@@ -260,6 +260,16 @@ impl super::SkinMaterial {
         if let Some(ss) = &mut self.subsurface {
             ss.table = grid.lowest().clone();
         }
+        if let Some(c) = &mut self.choices {
+            c.maps = Some(crate::fidelity::explain::MapChoice {
+                texels: maps.size(),
+                range: maps.range(),
+                nodes: grid.axes().clone().map(|a| a.len()),
+                max_error: grid.max_error,
+                target: grid_error,
+                blend: blend.to_string(),
+            });
+        }
         self.maps = Some(std::sync::Arc::new(SkinMaps {
             maps,
             absorption,
