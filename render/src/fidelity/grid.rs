@@ -20,6 +20,10 @@ pub const DEFAULT_GRID_ERROR: f32 = 0.02;
 /// Most nodes per axis (2⁵ + 1): the refinement stops there whatever the error.
 pub const MAX_NODES_PER_AXIS: usize = 33;
 
+/// Most tables in a grid (33², the finest grid over two parameters; a table is about 40 KiB): the
+/// refinement stops before a grid would hold more, whatever the error (`explain` shows it).
+pub const MAX_GRID_TABLES: usize = 33 * 33;
+
 /// Most cell centres the error is measured at per refinement step (spread over the cells).
 const MAX_PROBED_CELLS: usize = 24;
 
@@ -103,8 +107,9 @@ pub fn interpolation_error(grid: &Corners<'_>, direct: &ProfileTable) -> f32 {
 }
 
 /// The grid over `range` (per axis [lo, hi]; lo = hi gives one node): 2 nodes per varying axis,
-/// doubled in resolution until the error at the cells' centres is at most `settings.target` or
-/// an axis has [`MAX_NODES_PER_AXIS`] nodes.
+/// doubled in resolution until the error at the cells' centres is at most `settings.target`, an
+/// axis has [`MAX_NODES_PER_AXIS`] nodes or the next grid would hold more than
+/// [`MAX_GRID_TABLES`] tables.
 pub fn profile_grid(
     settings: &GridSettings<'_>,
     range: [[f32; 2]; 3],
@@ -148,11 +153,13 @@ pub fn profile_grid(
             })
             .collect::<Result<Vec<f32>, MultipoleError>>()?;
         grid.max_error = errors.into_iter().fold(0.0, f32::max);
-        let full = nodes.iter().any(|&n| n >= MAX_NODES_PER_AXIS);
+        let next = nodes.map(|n| if n > 1 { 2 * n - 1 } else { 1 });
+        let full = nodes.iter().any(|&n| n >= MAX_NODES_PER_AXIS)
+            || next.iter().product::<usize>() > MAX_GRID_TABLES;
         if grid.max_error <= settings.target || full || nodes == [1, 1, 1] {
             return Ok(grid);
         }
-        nodes = nodes.map(|n| if n > 1 { 2 * n - 1 } else { 1 });
+        nodes = next;
     }
 }
 

@@ -204,7 +204,11 @@ mod tests {
         // 1 µm under the vertex: the nearest point lies within about 1 µm of it, so its uv within
         // the uv slope (0.1 per mm) times that, 1e-4.
         let uv = near.uv(v0.as_dvec3() * 0.9999).unwrap();
-        assert!((uv - tris[0].1[0]).length() < 2e-4, "{uv} vs {}", tris[0].1[0]);
+        assert!(
+            (uv - tris[0].1[0]).length() < 2e-4,
+            "{uv} vs {}",
+            tris[0].1[0]
+        );
         assert!(NearestSurface::new(&[]).uv(DVec3::ZERO).is_none());
     }
 }
