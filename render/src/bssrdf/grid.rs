@@ -7,6 +7,24 @@ use super::ProfileTable;
 use crate::spectrum::{N_WAVELENGTHS, SampledSpectrum, SampledWavelengths};
 use std::sync::Arc;
 
+/// The knee c₀ of each axis's warp w(v) = ln(v + c₀) (C_m, C_h; as the forward table of §18 spaces
+/// them: even in the logarithm above the knee, nearly linear below), `None` for a linear axis (β_m).
+/// Nodes are even in w and the interpolation weights are linear in w.
+pub const AXIS_KNEES: [Option<f32>; 3] = [Some(0.005), None, Some(0.001)];
+
+/// The warped coordinate of `v` on an axis of knee `knee`.
+#[must_use]
+#[inline]
+pub fn warp(knee: Option<f32>, v: f32) -> f32 {
+    knee.map_or(v, |c| (v + c).ln())
+}
+
+/// The value at warped coordinate `w` on an axis of knee `knee` (the inverse of [`warp`]).
+#[must_use]
+pub fn unwarp(knee: Option<f32>, w: f32) -> f32 {
+    knee.map_or(w, |c| w.exp() - c)
+}
+
 /// Profile tables at the nodes of a grid over (C_m, β_m, C_h).
 #[derive(Debug, Clone)]
 pub struct ProfileGrid {
@@ -67,16 +85,18 @@ impl ProfileGrid {
     /// coordinate clamped to its axis).
     #[must_use]
     pub fn corners(&self, p: [f32; 3]) -> Corners<'_> {
-        let locate = |axis: &[f32], x: f32| -> (usize, f32) {
+        let locate = |k: usize, x: f32| -> (usize, f32) {
+            let axis = &self.axes[k];
             if axis.len() == 1 {
                 return (0, 0.0);
             }
             let last = axis.len() - 1;
             let i = axis.partition_point(|&a| a <= x).clamp(1, last) - 1;
-            let t = ((x - axis[i]) / (axis[i + 1] - axis[i])).clamp(0.0, 1.0);
+            let w = |v: f32| warp(AXIS_KNEES[k], v);
+            let t = ((w(x) - w(axis[i])) / (w(axis[i + 1]) - w(axis[i]))).clamp(0.0, 1.0);
             (i, t)
         };
-        let at = [0, 1, 2].map(|k| locate(&self.axes[k], p[k]));
+        let at = [0, 1, 2].map(|k| locate(k, p[k]));
         let (n0, n1) = (self.axes[0].len(), self.axes[1].len());
         let mut tables = [None; 8];
         for (c, slot) in tables.iter_mut().enumerate() {

@@ -279,7 +279,7 @@ pub fn explain_table(skins: &[(&str, &SkinChoices)]) -> String {
             let [cm, bm, ch] = m.range;
             let _ = writeln!(
                 s,
-                "  {:<16} {}×{} texels, C_m {:.3}–{:.3}, β_m {:.3}–{:.3}, C_h {:.4}–{:.4}; profile grid                  {}×{}×{} tables, interpolation error {:.2}% (target {:.2}%); ends combined: {}",
+                "  {:<16} {}×{} texels, C_m {:.3}–{:.3}, β_m {:.3}–{:.3}, C_h {:.4}–{:.4}; profile grid {}×{}×{} tables, interpolation error {:.2}% (target {:.2}%); ends combined: {}",
                 "maps",
                 m.texels.0,
                 m.texels.1,

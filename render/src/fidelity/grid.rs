@@ -5,6 +5,7 @@
 
 use super::FidelityKnobs;
 use super::tables::skin_table;
+use crate::bssrdf::grid::{AXIS_KNEES, unwarp, warp};
 use crate::bssrdf::{Corners, ProfileGrid, ProfileTable};
 use crate::media::SkinMedia;
 use multipole::{Method, MultipoleError};
@@ -123,13 +124,13 @@ pub fn profile_grid(
             if n == 1 {
                 return vec![lo];
             }
+            let (wl, wh) = (warp(AXIS_KNEES[k], lo), warp(AXIS_KNEES[k], hi));
             (0..n)
-                .map(|i| {
-                    if i == n - 1 {
-                        hi
-                    } else {
-                        lo + (hi - lo) * i as f32 / (n - 1) as f32
-                    }
+                .map(|i| match i {
+                    0 => lo,
+                    _ if i == n - 1 => hi,
+                    _ => unwarp(AXIS_KNEES[k], wl + (wh - wl) * i as f32 / (n - 1) as f32)
+                        .clamp(lo, hi),
                 })
                 .collect()
         });
@@ -163,16 +164,21 @@ pub fn profile_grid(
     }
 }
 
-/// The centre of every cell of the grid with node values `axes` (a one-node axis keeps its node).
+/// The centre of every cell of the grid with node values `axes`, midway in each axis's warped
+/// coordinate (a one-node axis keeps its node).
 fn cell_centres(axes: &[Vec<f32>; 3]) -> Vec<[f32; 3]> {
-    let mids = |a: &Vec<f32>| -> Vec<f32> {
+    let mids = |k: usize| -> Vec<f32> {
+        let a = &axes[k];
         if a.len() == 1 {
             a.clone()
         } else {
-            a.windows(2).map(|w| 0.5 * (w[0] + w[1])).collect()
+            let w = |v: f32| warp(AXIS_KNEES[k], v);
+            a.windows(2)
+                .map(|p| unwarp(AXIS_KNEES[k], 0.5 * (w(p[0]) + w(p[1]))))
+                .collect()
         }
     };
-    let [m0, m1, m2] = [mids(&axes[0]), mids(&axes[1]), mids(&axes[2])];
+    let [m0, m1, m2] = [mids(0), mids(1), mids(2)];
     let mut out = Vec::with_capacity(m0.len() * m1.len() * m2.len());
     for &c in &m2 {
         for &b in &m1 {
