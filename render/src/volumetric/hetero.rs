@@ -6,6 +6,7 @@
 use super::nearest::NearestSurface;
 use crate::material::hetero::{CornersAt, SkinMaps};
 use glam::DVec3;
+use std::cell::Cell;
 use std::sync::Arc;
 
 /// A skin material's maps and the nearest-point queries over its meshes.
@@ -17,13 +18,15 @@ pub struct MapMedium {
     pub nearest: NearestSurface,
 }
 
-/// [`MapMedium`] at one wavelength.
-#[derive(Debug, Clone, Copy)]
+/// [`MapMedium`] at one wavelength, for one walk (it remembers the last nearest triangle, which
+/// starts the next query).
+#[derive(Debug, Clone)]
 pub struct MapAbsorption<'a> {
     corners: CornersAt,
     /// The largest σa over the maps of the epidermis and of the dermis, mm⁻¹.
     pub largest: (f32, f32),
     medium: &'a MapMedium,
+    hint: Cell<Option<u32>>,
 }
 
 impl MapMedium {
@@ -35,6 +38,7 @@ impl MapMedium {
             corners,
             largest: corners.largest(self.maps.maps.range()),
             medium: self,
+            hint: Cell::new(None),
         }
     }
 }
@@ -45,7 +49,9 @@ impl MapAbsorption<'_> {
     #[must_use]
     #[inline]
     pub fn sigma_a(&self, epidermis: bool, x: DVec3) -> f32 {
-        let uv = self.medium.nearest.uv(x).unwrap_or_default();
+        let mut hint = self.hint.get();
+        let uv = self.medium.nearest.uv_from(x, &mut hint).unwrap_or_default();
+        self.hint.set(hint);
         self.corners
             .sigma_a(epidermis, self.medium.maps.maps.at(uv))
     }

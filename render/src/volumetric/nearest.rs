@@ -95,7 +95,20 @@ impl NearestSurface {
     /// `None` without triangles.
     #[must_use]
     pub fn uv(&self, p: DVec3) -> Option<Vec2> {
+        self.uv_from(p, &mut None)
+    }
+
+    /// [`NearestSurface::uv`], starting from triangle `hint` (the nearest one of a point close
+    /// by, updated to this point's): its distance bounds the search from the start, so most of
+    /// the hierarchy is skipped. The answer does not depend on the hint.
+    #[must_use]
+    pub fn uv_from(&self, p: DVec3, hint: &mut Option<u32>) -> Option<Vec2> {
         let mut best = (f64::INFINITY, None::<(usize, DVec3)>);
+        if let Some(i) = hint.map(|i| i as usize).filter(|&i| i < self.tris.len()) {
+            let t = &self.tris[i];
+            let off = closest_offset(p - t.a, t.ab, t.ac);
+            best = ((p - t.a - off).length_squared(), Some((i, off)));
+        }
         let mut stack = vec![0usize];
         while let Some(n) = stack.pop() {
             let node = self.nodes[n];
@@ -124,6 +137,7 @@ impl NearestSurface {
             }
         }
         let (i, off) = best.1?;
+        *hint = Some(i as u32);
         let t = &self.tris[i];
         let (v, w) = barycentric(off, t.ab, t.ac);
         Some(t.uv[0] * (1.0 - v - w) as f32 + t.uv[1] * v as f32 + t.uv[2] * w as f32)
@@ -199,6 +213,9 @@ mod tests {
             let one = NearestSurface::new(&tris[i..=i]);
             let (got, want) = (near.uv(p).unwrap(), one.uv(p).unwrap());
             assert!((got - want).length() < 1e-5, "{p}: {got} vs {want}");
+            // From any hint, the same point.
+            let mut hint = Some(rng.random_range(0..tris.len() as u32));
+            assert_eq!(near.uv_from(p, &mut hint), Some(got), "{p}");
         }
         let v0 = tris[0].0[0];
         // 1 µm under the vertex: the nearest point lies within about 1 µm of it, so its uv within
