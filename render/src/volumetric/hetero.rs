@@ -50,7 +50,11 @@ impl MapAbsorption<'_> {
     #[inline]
     pub fn sigma_a(&self, epidermis: bool, x: DVec3) -> f32 {
         let mut hint = self.hint.get();
-        let uv = self.medium.nearest.uv_from(x, &mut hint).unwrap_or_default();
+        let uv = self
+            .medium
+            .nearest
+            .uv_from(x, &mut hint)
+            .unwrap_or_default();
         self.hint.set(hint);
         self.corners
             .sigma_a(epidermis, self.medium.maps.maps.at(uv))
