@@ -76,6 +76,13 @@ impl Passes {
                         p.depth[i] = s.t;
                         p.normal[i] = s.ns.to_array();
                         let (rgb, is_skin) = match &scene.materials[s.material as usize] {
+                            Material::Skin(crate::material::SkinMaterial {
+                                maps: Some(maps),
+                                ..
+                            }) => {
+                                let at = maps.grid.corners(maps.maps.at(s.uv));
+                                (reflectance_rgb(|nm| at.total(nm).min(1.0)), 1.0)
+                            }
                             Material::Skin(m) => {
                                 let f = m.texture_factor(s.uv, &scene.textures);
                                 let t = &m.total_reflectance;
