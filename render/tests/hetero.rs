@@ -57,7 +57,7 @@ fn uniform_map_renders_as_the_scalar_skin() {
 /// x = 0 (C_m 0.3 left, 0.02 right) and on a 1-mm freckle of C_m 0.15: region means ≥ 1 mm from
 /// the boundaries within 8% + 3σ (the uniform slabs' own BSSRDF–walk gap at this wavelength is
 /// 3.7–5.9%, and heterogeneity adds at most 2% to it, BENCHMARKS.md "Heterogeneous skin"); at the
-/// freckle's centre within 12% + 3σ (5.5% measured at high counts); and the geometric rule's
+/// freckle's centre within 12% + 3σ (5.7% measured at high counts); and the geometric rule's
 /// transition nearer the walk than half the entry rule's (RMS 8% against 55–90% measured).
 #[test]
 fn split_slab_and_freckle_follow_the_volumetric_walk() {
