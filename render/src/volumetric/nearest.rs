@@ -109,8 +109,13 @@ impl NearestSurface {
             let off = closest_offset(p - t.a, t.ab, t.ac);
             best = ((p - t.a - off).length_squared(), Some((i, off)));
         }
-        let mut stack = vec![0usize];
-        while let Some(n) = stack.pop() {
+        // The hierarchy halves each node, so a traversal holds at most one node per level and
+        // one more: 64 cover any mesh (no allocation per query).
+        let mut stack = [0usize; 64];
+        let mut top = 1;
+        while top > 0 {
+            top -= 1;
+            let n = stack[top];
             let node = self.nodes[n];
             if box_distance_squared(p, node.lo, node.hi) >= best.0 {
                 continue;
@@ -130,11 +135,10 @@ impl NearestSurface {
             let da = box_distance_squared(p, self.nodes[a].lo, self.nodes[a].hi);
             let db = box_distance_squared(p, self.nodes[b].lo, self.nodes[b].hi);
             // The nearer child is popped first.
-            if da <= db {
-                stack.extend([b, a]);
-            } else {
-                stack.extend([a, b]);
-            }
+            let (far, near) = if da <= db { (b, a) } else { (a, b) };
+            stack[top] = far;
+            stack[top + 1] = near;
+            top += 2;
         }
         let (i, off) = best.1?;
         *hint = Some(i as u32);
