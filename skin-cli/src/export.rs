@@ -179,15 +179,23 @@ fn run_textured(
     maps: &std::path::Path,
     out: &std::path::Path,
 ) -> anyhow::Result<()> {
-    use crate::maps::image_file::{exr_bytes, read_channels};
-    let (width, height, mut channels) =
-        read_channels(maps, &["melanin", "eumelanin", "hemoglobin"]).context("--maps")?;
+    use crate::maps::image_file::exr_bytes;
+    let bytes = skin_io::input::CHROMOPHORE_MAP
+        .read(maps)
+        .with_context(|| format!("--maps {}", maps.display()))?;
+    let channels = render::material::maps::read_maps_exr(&bytes, maps).context("--maps")?;
+    let [melanin, eumelanin, hemoglobin] = channels;
+    let missing = |name: &str| anyhow::anyhow!("--maps {}: no channel '{name}'", maps.display());
+    let melanin = melanin.ok_or_else(|| missing("melanin"))?;
+    let eumelanin = eumelanin.ok_or_else(|| missing("eumelanin"))?;
+    let hemoglobin = hemoglobin.ok_or_else(|| missing("hemoglobin"))?;
+    let (width, height) = (melanin.width, melanin.height);
     let texture = ChromophoreTexture {
         width,
         height,
-        hemoglobin: channels.pop().unwrap_or_default(),
-        eumelanin: channels.pop().unwrap_or_default(),
-        melanin: channels.pop().unwrap_or_default(),
+        melanin: melanin.values,
+        eumelanin: eumelanin.values,
+        hemoglobin: hemoglobin.values,
     };
     let topts = TexturedOptions {
         nodes: args.texture_nodes,

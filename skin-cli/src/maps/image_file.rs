@@ -208,57 +208,6 @@ pub fn png_bytes(width: usize, height: usize, rgb: &[u8]) -> anyhow::Result<Vec<
     Ok(out)
 }
 
-/// The channels `names` of an OpenEXR file (maps.exr of `skin maps`), row-major from the top
-/// row: (width, height, one value list per name). A missing channel is an error naming it.
-pub fn read_channels(path: &Path, names: &[&str]) -> anyhow::Result<(usize, usize, Vec<Vec<f32>>)> {
-    use exr::prelude::*;
-    let bytes = skin_io::input::ALBEDO.read(path)?;
-    let context = || format!("{}", path.display());
-    if !bytes.starts_with(&[0x76, 0x2F, 0x31, 0x01]) {
-        bail!("{}: not an OpenEXR file", context());
-    }
-    let meta = exr::meta::MetaData::read_from_buffered(std::io::Cursor::new(&bytes), false)
-        .map_err(|e| anyhow::anyhow!("{}: EXR: {e}", context()))?;
-    for h in &meta.headers {
-        check_size(h.layer_size.0, h.layer_size.1).with_context(context)?;
-        if h.chunk_count > MAX_EXR_CHUNKS {
-            bail!(
-                "{}: {} chunks, over the cap of {MAX_EXR_CHUNKS}",
-                context(),
-                h.chunk_count
-            );
-        }
-    }
-    let img = read()
-        .no_deep_data()
-        .largest_resolution_level()
-        .all_channels()
-        .first_valid_layer()
-        .all_attributes()
-        .from_buffered(std::io::Cursor::new(&bytes))
-        .map_err(|e| anyhow::anyhow!("{}: EXR: {e}", context()))?;
-    let (w, h) = (img.layer_data.size.0, img.layer_data.size.1);
-    let channels = &img.layer_data.channel_data.list;
-    let values = names
-        .iter()
-        .map(|name| {
-            channels
-                .iter()
-                .find(|c| c.name.to_string() == *name)
-                .map(|c| c.sample_data.values_as_f32().collect::<Vec<f32>>())
-                .ok_or_else(|| {
-                    let found: Vec<String> = channels.iter().map(|c| c.name.to_string()).collect();
-                    anyhow::anyhow!(
-                        "{}: no channel '{name}' (found: {})",
-                        context(),
-                        found.join(", ")
-                    )
-                })
-        })
-        .collect::<anyhow::Result<Vec<_>>>()?;
-    Ok((w, h, values))
-}
-
 /// The bytes of a 32-bit float OpenEXR holding `channels` (name, row-major values).
 pub fn exr_bytes(
     width: usize,
