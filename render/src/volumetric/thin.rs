@@ -16,6 +16,11 @@
 //! only from the front (an eyelid over the eye's cavity) keeps the BSSRDF: there the walk would
 //! add a heavy-tailed estimate for light the BSSRDF misses by little.
 //!
+//! A skin with chromophore maps walks through its maps, each collision's absorption from the
+//! texel of its nearest surface point as in the volumetric reference (§19.1); the criterion reads
+//! the material's scalar skin, so where the maps reach much darker or lighter skin than the
+//! scalars it judges that skin's slab, not the texel's.
+//!
 //! The walk needs each material's epidermis region, a distance grid over its triangles that takes
 //! seconds for a head: it is built at the first thin hit of that material (`OnceLock`), so a scene
 //! without thin parts pays one short probe ray per subsurface hit and nothing else.
@@ -26,16 +31,19 @@
 //! about fifty BSSRDF paths. There the hit keeps the BSSRDF and no probe ray is traced, as the
 //! level of detail (`crate::fidelity::lod`) keeps no profile the footprint cannot resolve.
 
+use super::hetero::MapMedium;
+use super::nearest::NearestSurface;
 use super::slab_table::SlabTable;
 use super::{LayerTables, SkinVolume};
 use crate::geometry::{SurfaceHit, offset_origin};
 use crate::light::{Light, QuadLight};
 use crate::material::Material;
+use crate::material::hetero::SkinMaps;
 use crate::scene::Scene;
 use glam::Vec3;
 use std::fmt::Write;
-use std::sync::OnceLock;
 use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Arc, OnceLock};
 
 /// One skin material's thin-part walk: its threshold, its medium (built at first use) and the
 /// counts of the hits tested and walked.
@@ -50,6 +58,9 @@ pub struct ThinPart {
     phase_g: f64,
     eta: f32,
     d_epi_mm: f32,
+    /// The material's chromophore maps: the walk takes each collision's absorption from them,
+    /// as the volumetric reference does (docs/physics.md §19.1).
+    maps: Option<Arc<SkinMaps>>,
     volume: OnceLock<SkinVolume>,
     tested: AtomicU64,
     walked: AtomicU64,
@@ -99,6 +110,7 @@ impl ThinParts {
                 phase_g: skin.media.phase_g,
                 eta: skin.params.eta() as f32,
                 d_epi_mm: skin.params.epidermis_thickness_mm() as f32,
+                maps: skin.maps.clone(),
                 volume: OnceLock::new(),
                 tested: AtomicU64::new(0),
                 walked: AtomicU64::new(0),
@@ -156,14 +168,19 @@ impl ThinParts {
         }
         part.walked.fetch_add(1, Ordering::Relaxed);
         Some(part.volume.get_or_init(|| {
-            SkinVolume::new(
+            let mut volume = SkinVolume::new(
                 part.epidermis.clone(),
                 part.dermis.clone(),
                 part.phase_g,
                 part.eta,
                 part.d_epi_mm,
                 geometry.triangles_of(si.material),
-            )
+            );
+            volume.maps = part.maps.as_ref().map(|maps| MapMedium {
+                maps: maps.clone(),
+                nearest: NearestSurface::new(&geometry.triangles_with_uvs_of(si.material)),
+            });
+            volume
         }))
     }
 }
