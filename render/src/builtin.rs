@@ -14,8 +14,12 @@ pub const EAR: &str = include_str!("../assets/scenes/ear.toml");
 /// detail has most to gain.
 pub const THREE_HEADS_FAR: &str = include_str!("../assets/scenes/three_heads_far.toml");
 
+/// The default scene's heads with chromophore maps fitted at load to the head's texture, the
+/// melanin shifted to medium and dark skin on the second and third head.
+pub const THREE_HEADS_MAPS: &str = include_str!("../assets/scenes/three_heads_maps.toml");
+
 /// Built-in scene names, the first is the default.
-pub const SCENES: [&str; 3] = ["three-heads", "ear", "three-heads-far"];
+pub const SCENES: [&str; 4] = ["three-heads", "ear", "three-heads-far", "three-heads-maps"];
 
 /// The text of a built-in scene by name.
 #[must_use]
@@ -24,6 +28,7 @@ pub fn scene(name: &str) -> Option<&'static str> {
         "three-heads" => Some(THREE_HEADS),
         "ear" => Some(EAR),
         "three-heads-far" => Some(THREE_HEADS_FAR),
+        "three-heads-maps" => Some(THREE_HEADS_MAPS),
         _ => None,
     }
 }

@@ -307,6 +307,10 @@ pub enum MaterialDesc {
         /// Chromophore maps over the mesh's texture coordinates: the `maps.exr` of `skin maps`
         /// (channels `melanin`, `eumelanin`, `hemoglobin`; others ignored).
         maps: Option<String>,
+        /// Chromophore maps fitted to `albedo_texture` at load, as `skin maps --exposure VALUE`
+        /// fits them (`1`: the texture is the skin's albedo; `auto`, `auto-rgb`, `G` or `R,G,B`:
+        /// gains for a photograph), kept in the disk cache; instead of `maps`.
+        fit_maps: Option<String>,
         /// C_m per texel: a single-channel EXR or a grey 8/16-bit PNG holding the value (instead
         /// of the `melanin` channel of `maps`).
         melanin_map: Option<String>,

@@ -121,6 +121,12 @@ impl Texture {
         }
     }
 
+    /// The linear texels, row-major from the top row.
+    #[must_use]
+    pub fn texels(&self) -> &[[f32; 3]] {
+        &self.texels
+    }
+
     /// Width × height, texels.
     #[must_use]
     pub fn size(&self) -> (usize, usize) {

@@ -330,3 +330,72 @@ fn bad_maps_are_errors_naming_key_and_file() {
     );
     assert!(m.contains("hemoglobin") && m.contains("1.01"), "{m}");
 }
+
+/// `fit_maps` fits the maps to the albedo texture at load, as `skin maps` does: a 2 × 1 PNG of
+/// two skins of the exact model (C_m 0.02 and 0.2, β_m 0.6, C_h 0.02 and 0.05; 8-bit sRGB)
+/// gives each texel back its C_m within 10 %, and the lighter one its C_h within 20 %: 8-bit sRGB
+/// cannot tell C_h 0.02 from 0.0175 there (both encode as #9c7f6e, 0.38 ΔE2000 apart), nor C_h
+/// 0.05 from 0.01 in the darker skin (#362920 against #362a20), whose C_h is not checked. Without
+/// an albedo texture, beside `maps`, or with a bad exposure the key is named.
+#[test]
+fn fit_maps_fits_the_albedo_texture() {
+    use skin_fit::ColourModel;
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let model = ColourModel::new(
+        10.0,
+        multipole::Method::Exact,
+        skin_fit::FitOptions::default().base,
+    )
+    .unwrap();
+    let truth = [[0.02, 0.6, 0.02], [0.2, 0.6, 0.05]];
+    let rgb: Vec<u8> = truth
+        .iter()
+        .flat_map(|p| {
+            let skin = model.skin(p[0], p[1], p[2]).unwrap();
+            let linear = model.xyz(&skin).unwrap().to_linear_srgb().0;
+            linear.map(|c| (skin_optics::color::srgb_encode(c) * 255.0).round() as u8)
+        })
+        .collect();
+    image::RgbImage::from_raw(2, 1, rgb)
+        .unwrap()
+        .save(d.join("albedo.png"))
+        .unwrap();
+    let scene = strip_scene(
+        d,
+        1.0,
+        4,
+        "albedo_texture = \"albedo.png\"\nfit_maps = \"1\"",
+    );
+    let render::material::Material::Skin(skin) = &scene.materials[0] else {
+        panic!("skin");
+    };
+    let maps = &skin.maps.as_ref().expect("fitted maps").maps;
+    for (k, p) in truth.iter().enumerate() {
+        let uv = glam::Vec2::new(0.25 + 0.5 * k as f32, 0.5);
+        let [c_m, _, c_h] = maps.at(uv).map(f64::from);
+        assert!((c_m / p[0] - 1.0).abs() < 0.1, "texel {k}: C_m {c_m}");
+        assert!(
+            k == 1 || (c_h / p[2] - 1.0).abs() < 0.2,
+            "texel {k}: C_h {c_h}"
+        );
+    }
+    std::fs::write(d.join("maps.exr"), melanin_exr(2, 1, |_, _| 0.1)).unwrap();
+    for (keys, want) in [
+        ("fit_maps = \"1\"", "needs an albedo_texture"),
+        (
+            "albedo_texture = \"albedo.png\"\nfit_maps = \"1\"\nmaps = \"maps.exr\"",
+            "not both",
+        ),
+        (
+            "albedo_texture = \"albedo.png\"\nfit_maps = \"bright\"",
+            "[0.125, 2]",
+        ),
+    ] {
+        let (_, m) = load_error(d, keys);
+        assert!(
+            m.contains("materials.skin.fit_maps") && m.contains(want),
+            "{m}"
+        );
+    }
+}

@@ -11,8 +11,8 @@ use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 use skin_fit::ModelChoice;
 use skin_fit::maps::{
-    DEFAULT_SMOOTHNESS, EXPOSURE_RANGE, Edit, Eumelanin, Exposure, ExtendedFit, Maps, MapsModel,
-    MapsOptions, Regions, apply_edits,
+    DEFAULT_SMOOTHNESS, Edit, Eumelanin, Exposure, ExtendedFit, Maps, MapsModel, MapsOptions,
+    Regions, apply_edits,
 };
 use skin_plot::{HeatMap, Panel};
 use std::path::{Path, PathBuf};
@@ -157,33 +157,7 @@ pub fn parse_thin_epidermis(s: &str) -> Result<ThinEpidermisArg, String> {
 
 /// Parse `--exposure` (clap value parser).
 pub fn parse_exposure(s: &str) -> Result<Exposure, String> {
-    match s.trim().to_ascii_lowercase().as_str() {
-        "auto" => return Ok(Exposure::Auto),
-        "auto-rgb" => return Ok(Exposure::WhiteBalance),
-        _ => {}
-    }
-    let [lo, hi] = EXPOSURE_RANGE;
-    let fields: Vec<&str> = s.split(',').collect();
-    if fields.len() != 1 && fields.len() != 3 {
-        return Err(format!(
-            "'{s}' is not G, R,G,B, auto or auto-rgb (gains in [0.125, 2])"
-        ));
-    }
-    let mut gains = [0.0; 3];
-    for (k, f) in fields.iter().enumerate() {
-        let g = crate::args::parse_number(f, "[0.125, 2]")?;
-        if !(lo..=hi).contains(&g) {
-            return Err(format!(
-                "gain {} outside [0.125, 2] (or auto, auto-rgb)",
-                skin_optics::echo::Num(g)
-            ));
-        }
-        gains[k] = g;
-    }
-    if fields.len() == 1 {
-        gains = [gains[0]; 3];
-    }
-    Ok(Exposure::Fixed(gains))
+    s.parse()
 }
 
 /// Luminance (Rec.709 Y) of the sRGB-encoded value of a linear texel, in [0, 1]: how a mask

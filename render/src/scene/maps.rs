@@ -2,6 +2,7 @@
 //! `hemoglobin_map`, the edits and `edit_mask`, `profile_blend`, `map_profile_error`): each file
 //! read through the guarded reader and decoded by `material::maps`, every error naming its key.
 
+use super::fitted_maps;
 use super::load::Loader;
 use crate::error::RenderError;
 use crate::fidelity::grid::DEFAULT_GRID_ERROR;
@@ -11,12 +12,17 @@ use crate::material::maps::{
     read_value_image,
 };
 use crate::material::{SkinBuildError, SkinKnobs, SkinMaterial};
+use crate::texture::Texture;
 use std::path::PathBuf;
 
 /// The map keys of one skin material, as parsed.
 #[derive(Debug, Clone, Copy)]
 pub(super) struct MapKeys<'a> {
     pub maps: &'a Option<String>,
+    /// `fit_maps`: the exposure under which the maps are fitted to the albedo texture.
+    pub fit_maps: &'a Option<String>,
+    /// The material's albedo texture and its file name, if it has one.
+    pub albedo: Option<(&'a Texture, Option<&'a str>)>,
     /// `melanin_map`, `eumelanin_map`, `hemoglobin_map`.
     pub per_parameter: [&'a Option<String>; 3],
     /// (scale, offset) of melanin, then of hemoglobin.
@@ -90,9 +96,24 @@ impl Loader<'_> {
             message: e.to_string(),
         };
         let mut from_exr: [Option<ValueImage>; 3] = [None, None, None];
+        // The file the maps came from, and the key that named it.
+        let mut exr_source: Option<(&str, String)> =
+            keys.maps.as_deref().map(|s| ("maps", s.to_string()));
         if let Some(spec) = keys.maps {
             let (bytes, path) = read("maps", spec)?;
             from_exr = read_maps_exr(&bytes, &path).map_err(|e| named("maps", spec, e))?;
+        }
+        if let Some(exposure) = keys.fit_maps {
+            let fit_key = format!("{key}.fit_maps");
+            if keys.maps.is_some() {
+                return Err(self.err(fit_key, "give maps or fit_maps, not both"));
+            }
+            let Some((texture, name)) = keys.albedo else {
+                return Err(self.err(fit_key, "needs an albedo_texture to fit the maps to"));
+            };
+            let fitted = fitted_maps::fit(texture, exposure).map_err(|e| self.err(&fit_key, e))?;
+            from_exr = fitted.map(Some);
+            exr_source = Some(("fit_maps", name.unwrap_or("albedo_texture").to_string()));
         }
         let scalars = [
             skin.params.melanin(),
@@ -111,9 +132,11 @@ impl Loader<'_> {
                     path: PathBuf::from(spec),
                     image,
                 };
-            } else if let (Some(image), Some(spec)) = (from_exr[k].take(), keys.maps) {
+            } else if let (Some(image), Some((source_key, spec))) =
+                (from_exr[k].take(), &exr_source)
+            {
                 sources[k] = Source::Map {
-                    key: format!("{key}.maps"),
+                    key: format!("{key}.{source_key}"),
                     path: PathBuf::from(spec),
                     image,
                 };

@@ -65,6 +65,7 @@ impl Loader<'_> {
                     phase_g,
                     surface,
                     maps,
+                    fit_maps,
                     melanin_map,
                     eumelanin_map,
                     hemoglobin_map,
@@ -93,6 +94,8 @@ impl Loader<'_> {
                         })?;
                     let map_keys = MapKeys {
                         maps,
+                        fit_maps,
+                        albedo: tex.map(|t| (&textures[t.index], albedo_texture.as_deref())),
                         per_parameter: [melanin_map, eumelanin_map, hemoglobin_map],
                         edits: [
                             (melanin_scale, melanin_offset),

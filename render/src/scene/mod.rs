@@ -5,6 +5,7 @@
 //! keys); every error names the file, the key and what was expected, and a missing mesh or
 //! texture names its path.
 
+mod fitted_maps;
 mod load;
 mod maps;
 mod materials;

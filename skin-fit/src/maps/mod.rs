@@ -131,6 +131,48 @@ pub enum Exposure {
     WhiteBalance,
 }
 
+impl std::str::FromStr for Exposure {
+    type Err = String;
+
+    /// `auto`, `auto-rgb`, one gain `G` or three `R,G,B`, each in [`EXPOSURE_RANGE`] (the
+    /// spelling of `skin maps --exposure`); an error says what was wrong and the valid forms.
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "auto" => return Ok(Exposure::Auto),
+            "auto-rgb" => return Ok(Exposure::WhiteBalance),
+            _ => {}
+        }
+        let [lo, hi] = EXPOSURE_RANGE;
+        let fields: Vec<&str> = s.split(',').collect();
+        if fields.len() != 1 && fields.len() != 3 {
+            return Err(format!(
+                "'{}' is not G, R,G,B, auto or auto-rgb (gains in [0.125, 2])",
+                skin_optics::echo::Text(s)
+            ));
+        }
+        let mut gains = [0.0; 3];
+        for (k, f) in fields.iter().enumerate() {
+            let g: f64 = f.trim().parse().map_err(|_| {
+                format!(
+                    "'{}' is not a number (valid range [0.125, 2])",
+                    skin_optics::echo::Text(f)
+                )
+            })?;
+            if !(lo..=hi).contains(&g) {
+                return Err(format!(
+                    "gain {} outside [0.125, 2] (or auto, auto-rgb)",
+                    skin_optics::echo::Num(g)
+                ));
+            }
+            gains[k] = g;
+        }
+        if fields.len() == 1 {
+            gains = [gains[0]; 3];
+        }
+        Ok(Exposure::Fixed(gains))
+    }
+}
+
 /// Gains the exposure fit explores: 1/8 to 2 (three stops down, one up).
 pub const EXPOSURE_RANGE: [f64; 2] = [0.125, 2.0];
 /// Gain candidates of the exposure fit, evenly in log₂ g over [`EXPOSURE_RANGE`] (eighth stops).
