@@ -270,23 +270,7 @@ pub mod hetero {
     /// A 32-bit float OpenEXR of `channels` (name, row-major values) at `width` × `height`.
     #[must_use]
     pub fn exr_bytes(width: usize, height: usize, channels: Vec<(&str, Vec<f32>)>) -> Vec<u8> {
-        use exr::prelude::*;
-        let list: Vec<AnyChannel<FlatSamples>> = channels
-            .into_iter()
-            .map(|(name, data)| AnyChannel::new(name, FlatSamples::F32(data)))
-            .collect();
-        let layer = Layer::new(
-            (width, height),
-            LayerAttributes::default(),
-            Encoding::FAST_LOSSLESS,
-            AnyChannels::sort(list.into()),
-        );
-        let mut out = std::io::Cursor::new(Vec::new());
-        Image::from_layer(layer)
-            .write()
-            .to_buffered(&mut out)
-            .unwrap();
-        out.into_inner()
+        crate::texture::channels_exr_bytes(width, height, channels).expect("an EXR in memory")
     }
 
     /// A `melanin` channel of `side_x` × `side_y` texels over the slab's face, C_m = `f(x, y)` at

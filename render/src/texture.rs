@@ -267,6 +267,32 @@ pub fn luminance(rgb: [f32; 3]) -> f32 {
     0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2]
 }
 
+/// The bytes of a 32-bit float OpenEXR holding `channels` (name, row-major values from the top
+/// row) at `width` × `height`: how chromophore maps are written (`skin maps`, texture exports).
+pub fn channels_exr_bytes(
+    width: usize,
+    height: usize,
+    channels: Vec<(&str, Vec<f32>)>,
+) -> Result<Vec<u8>, String> {
+    use exr::prelude::*;
+    let list: Vec<AnyChannel<FlatSamples>> = channels
+        .into_iter()
+        .map(|(name, data)| AnyChannel::new(name, FlatSamples::F32(data)))
+        .collect();
+    let layer = Layer::new(
+        (width, height),
+        LayerAttributes::default(),
+        Encoding::FAST_LOSSLESS,
+        AnyChannels::sort(list.into()),
+    );
+    let mut out = std::io::Cursor::new(Vec::new());
+    Image::from_layer(layer)
+        .write()
+        .to_buffered(&mut out)
+        .map_err(|e| format!("EXR: {e}"))?;
+    Ok(out.into_inner())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -179,7 +179,6 @@ fn run_textured(
     maps: &std::path::Path,
     out: &std::path::Path,
 ) -> anyhow::Result<()> {
-    use crate::maps::image_file::exr_bytes;
     let bytes = skin_io::input::CHROMOPHORE_MAP
         .read(maps)
         .with_context(|| format!("--maps {}", maps.display()))?;
@@ -224,11 +223,12 @@ fn run_textured(
     let mut staged = vec![skin_io::atomic::stage_bytes(out, exported.text.as_bytes())?];
     for image in &exported.images {
         let channel = |c: usize| image.rgb.iter().map(|t| t[c]).collect::<Vec<f32>>();
-        let bytes = exr_bytes(
+        let bytes = render::texture::channels_exr_bytes(
             width,
             height,
             vec![("R", channel(0)), ("G", channel(1)), ("B", channel(2))],
-        )?;
+        )
+        .map_err(anyhow::Error::msg)?;
         staged.push(skin_io::atomic::stage_bytes(
             &dir.join(image.file_name),
             &bytes,

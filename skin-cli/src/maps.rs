@@ -433,7 +433,7 @@ fn write_outputs(
             t.texels.iter().map(|f| f32::from(u8::from(*f))).collect(),
         ));
     }
-    let exr = image_file::exr_bytes(w, h, channels)?;
+    let exr = render::texture::channels_exr_bytes(w, h, channels).map_err(anyhow::Error::msg)?;
     let encoder = SrgbEncoder::default();
     let rgb: Vec<u8> = albedo
         .par_iter()

@@ -897,25 +897,16 @@ fn materialx_documents_pass_materialx_own_checks_where_it_is_installed() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// The channels of a maps.exr: melanin, eumelanin, hemoglobin per texel (row-major).
+/// The channels of a maps.exr: melanin, eumelanin, hemoglobin per texel (row-major), without
+/// the channel `skip`.
 fn write_maps_exr(path: &std::path::Path, w: usize, h: usize, texels: &[[f32; 3]], skip: &str) {
-    use exr::prelude::*;
-    let list: Vec<AnyChannel<FlatSamples>> = ["melanin", "eumelanin", "hemoglobin"]
+    let channels = ["melanin", "eumelanin", "hemoglobin"]
         .iter()
         .enumerate()
         .filter(|(_, name)| **name != skip)
-        .map(|(c, name)| {
-            let data = texels.iter().map(|t| t[c]).collect();
-            AnyChannel::new(*name, FlatSamples::F32(data))
-        })
+        .map(|(c, name)| (*name, texels.iter().map(|t| t[c]).collect()))
         .collect();
-    let layer = Layer::new(
-        (w, h),
-        LayerAttributes::default(),
-        Encoding::FAST_LOSSLESS,
-        AnyChannels::sort(list.into()),
-    );
-    Image::from_layer(layer).write().to_file(path).unwrap();
+    std::fs::write(path, render::testing::hetero::exr_bytes(w, h, channels)).unwrap();
 }
 
 /// `skin export openpbr --maps`: the document and its two images are written together, the

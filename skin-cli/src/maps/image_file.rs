@@ -208,31 +208,6 @@ pub fn png_bytes(width: usize, height: usize, rgb: &[u8]) -> anyhow::Result<Vec<
     Ok(out)
 }
 
-/// The bytes of a 32-bit float OpenEXR holding `channels` (name, row-major values).
-pub fn exr_bytes(
-    width: usize,
-    height: usize,
-    channels: Vec<(&str, Vec<f32>)>,
-) -> anyhow::Result<Vec<u8>> {
-    use exr::prelude::*;
-    let list: Vec<AnyChannel<FlatSamples>> = channels
-        .into_iter()
-        .map(|(name, data)| AnyChannel::new(name, FlatSamples::F32(data)))
-        .collect();
-    let layer = Layer::new(
-        (width, height),
-        LayerAttributes::default(),
-        Encoding::FAST_LOSSLESS,
-        AnyChannels::sort(list.into()),
-    );
-    let mut out = std::io::Cursor::new(Vec::new());
-    Image::from_layer(layer)
-        .write()
-        .to_buffered(&mut out)
-        .map_err(|e| anyhow::anyhow!("EXR: {e}"))?;
-    Ok(out.into_inner())
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
