@@ -57,16 +57,7 @@ fn main() -> anyhow::Result<()> {
                  [[meshes]]\nfile = \"{}\"\nmaterial = \"skin\"\n[[lights]]\n{light}\n",
                 obj.display()
             );
-            let load = |thin: Option<f64>| {
-                let knobs = SkinKnobs {
-                    fidelity: FidelityKnobs {
-                        thin_walk_r99: thin,
-                        ..FidelityKnobs::default()
-                    },
-                    ..SkinKnobs::default()
-                };
-                Scene::from_toml(&toml, "slab.toml", None, &knobs)
-            };
+            let load = |thin: Option<f64>| load_scene(&toml, "slab.toml", thin);
             let default = load(None)?;
             let alone = load(Some(0.0))?;
             let reference = run(
@@ -156,16 +147,7 @@ fn ear(side: usize, spp: u32, ref_spp: u32) -> anyhow::Result<()> {
         })
         .collect::<Vec<_>>()
         .join("\n");
-    let load = |thin: Option<f64>| {
-        let knobs = SkinKnobs {
-            fidelity: FidelityKnobs {
-                thin_walk_r99: thin,
-                ..FidelityKnobs::default()
-            },
-            ..SkinKnobs::default()
-        };
-        Scene::from_toml(&toml, "ear.toml", None, &knobs)
-    };
+    let load = |thin: Option<f64>| load_scene(&toml, "ear.toml", thin);
     let default = load(None)?;
     let thin_px = thin_pixels(&default, side);
     println!(
@@ -252,6 +234,23 @@ fn thick_under_the_ears_lamp(side: usize, spp: u32, ref_spp: u32) -> anyhow::Res
         println!("{label},{n},{:.5},{:.5},{:.2}", r.y, r.se, r.cpu);
     }
     Ok(())
+}
+
+/// The scene `toml` (named `name` in errors) with the thin-part walk at `thin` r₉₉ (`None`: the
+/// default).
+fn load_scene(
+    toml: &str,
+    name: &str,
+    thin: Option<f64>,
+) -> Result<Scene, render::error::RenderError> {
+    let knobs = SkinKnobs {
+        fidelity: FidelityKnobs {
+            thin_walk_r99: thin,
+            ..FidelityKnobs::default()
+        },
+        ..SkinKnobs::default()
+    };
+    Scene::from_toml(toml, name, None, &knobs)
 }
 
 /// Per pixel (row-major), whether the camera ray through its centre hits skin whose inward

@@ -98,6 +98,20 @@ fn read_maps(dir: &Path) -> std::collections::BTreeMap<String, Vec<f32>> {
         .collect()
 }
 
+/// Run `skin maps --albedo input --out out ARGS`, assert that it succeeds, and return its stderr.
+fn maps_of(input: &Path, out: &Path, args: &[&str]) -> String {
+    let mut all = vec![
+        "--albedo",
+        input.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    all.extend_from_slice(args);
+    let o = skin_maps(&all);
+    assert!(o.status.success(), "{}", stderr(&o));
+    stderr(&o)
+}
+
 fn out_dir(tag: &str) -> (tempfile::TempDir, PathBuf) {
     let t = tempfile::tempdir().unwrap();
     let d = t.path().join(tag);
@@ -109,16 +123,7 @@ fn a_texture_becomes_maps_previews_and_albedo() {
     let (tmp, out) = out_dir("maps");
     let png = tmp.path().join("albedo.png");
     write_png16(&png, 8, 4, &texture());
-    let o = skin_maps(&[
-        "--albedo",
-        png.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-        "--eumelanin",
-        "0.6",
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let err = stderr(&o);
+    let err = maps_of(&png, &out, &["--eumelanin", "0.6"]);
     assert!(err.contains("32 fitted, 16 in gamut"), "{err}");
     assert!(err.contains("eumelanin β_m 0.600 (given)"), "{err}");
     let maps = read_maps(&out);
@@ -174,17 +179,7 @@ fn edits_retone_the_albedo() {
     let png = tmp.path().join("albedo.png");
     write_png16(&png, 8, 4, &texture());
     let run = |edit: &str| {
-        let o = skin_maps(&[
-            "--albedo",
-            png.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-            "--eumelanin",
-            "0.6",
-            "--edit",
-            edit,
-        ]);
-        assert!(o.status.success(), "{}", stderr(&o));
+        maps_of(&png, &out, &["--eumelanin", "0.6", "--edit", edit]);
         image::open(out.join("albedo.png")).unwrap().to_rgb8()
     };
     let same = run("melanin*1");
@@ -225,18 +220,7 @@ fn exposure_scales_a_brighter_photograph_back() {
         .map(|(k, t)| if k % 8 < 4 { t.map(|c| c * 1.25) } else { *t })
         .collect();
     write_png16(&png, 8, 4, &bright);
-    let o = skin_maps(&[
-        "--albedo",
-        png.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-        "--eumelanin",
-        "0.6",
-        "--exposure",
-        "0.8",
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let err = stderr(&o);
+    let err = maps_of(&png, &out, &["--eumelanin", "0.6", "--exposure", "0.8"]);
     assert!(err.contains("32 fitted, 16 in gamut"), "{err}");
     assert!(
         err.contains("gains R 0.800, G 0.800, B 0.800 on every texel (given)"),
@@ -261,16 +245,7 @@ fn eumelanin_per_region_fills_the_channel() {
     let (tmp, out) = out_dir("regions");
     let png = tmp.path().join("albedo.png");
     write_png16(&png, 8, 4, &texture());
-    let o = skin_maps(&[
-        "--albedo",
-        png.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-        "--eumelanin-regions",
-        "4",
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let err = stderr(&o);
+    let err = maps_of(&png, &out, &["--eumelanin-regions", "4"]);
     assert!(
         err.contains("per region of 4×4 texels (2 regions)"),
         "{err}"
@@ -305,8 +280,9 @@ fn bad_exposure_and_model_are_usage_errors() {
         ("--parameters", "gloss", "one of epidermis_blood"),
     ] {
         let o = skin_maps(&["--albedo", "x.png", flag, value]);
-        assert_eq!(o.status.code(), Some(2), "{flag} {value}: {}", stderr(&o));
-        assert!(stderr(&o).contains(want), "{flag} {value}: {}", stderr(&o));
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{flag} {value}: {}", err);
+        assert!(err.contains(want), "{flag} {value}: {}", err);
     }
 }
 
@@ -334,23 +310,22 @@ fn an_extended_parameter_becomes_its_own_channel() {
     let (tmp, out) = out_dir("extended");
     let exr = tmp.path().join("albedo.exr");
     write_exr(&exr, 4, 4, &texels);
-    let o = skin_maps(&[
-        "--albedo",
-        exr.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-        "--eumelanin",
-        "0.6",
-        "--model",
-        "full",
-        "--parameters",
-        "mie_scale",
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    let err = maps_of(
+        &exr,
+        &out,
+        &[
+            "--eumelanin",
+            "0.6",
+            "--model",
+            "full",
+            "--parameters",
+            "mie_scale",
+        ],
+    );
     let maps = read_maps(&out);
     let mie = maps.get("mie_scale").expect("a mie_scale channel");
     assert!(mie.iter().all(|v| (v / 1.5 - 1.0).abs() <= 0.05), "{mie:?}");
-    assert!(maps["in_gamut"].iter().all(|g| *g == 1.0), "{}", stderr(&o));
+    assert!(maps["in_gamut"].iter().all(|g| *g == 1.0), "{}", err);
     assert!(!maps.contains_key("bilirubin_g_per_l"));
 }
 
@@ -363,20 +338,8 @@ fn bad_exr_texels_are_flagged() {
     t[0] = [f32::NAN, 0.2, 0.1];
     t[1] = [-0.5, 0.2, 0.1];
     write_exr(&exr, 8, 4, &t);
-    let o = skin_maps(&[
-        "--albedo",
-        exr.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-        "--eumelanin",
-        "0.6",
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    assert!(
-        stderr(&o).contains("2 bad values replaced"),
-        "{}",
-        stderr(&o)
-    );
+    let err = maps_of(&exr, &out, &["--eumelanin", "0.6"]);
+    assert!(err.contains("2 bad values replaced"), "{}", err);
     let maps = read_maps(&out);
     assert_eq!(&maps["in_gamut"][..3], [0.0, 0.0, 1.0]);
     assert!(maps.values().flatten().all(|v| v.is_finite()));
@@ -478,11 +441,12 @@ fn bad_input_is_one_line_and_leaves_no_maps() {
     // Bad edits are refused by the argument parser (usage error, code 2).
     for edit in ["melanin/2", "eumelanin=2", "blood*2"] {
         let o = skin_maps(&["--albedo", g, "--edit", edit]);
-        assert_eq!(o.status.code(), Some(2), "{edit}: {}", stderr(&o));
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{edit}: {}", err);
         assert!(
-            stderr(&o).contains("melanin*S") || stderr(&o).contains("[0, 1]"),
+            err.contains("melanin*S") || err.contains("[0, 1]"),
             "{}",
-            stderr(&o)
+            err
         );
     }
 }

@@ -465,6 +465,26 @@ mod tests {
     use rand::{Rng, SeedableRng};
     use rand_xoshiro::Xoshiro256PlusPlus;
 
+    /// The triangles of a 1,280-triangle icosphere of radius 10 mm.
+    fn sphere_10mm() -> Vec<[Vec3; 3]> {
+        let mesh = crate::mesh::TriangleMesh::sphere(3);
+        mesh.indices
+            .iter()
+            .map(|t| t.map(|i| mesh.positions[i as usize] * 10.0))
+            .collect()
+    }
+
+    /// A direction from the normalised uniform point of the cube [−1, 1]³ (not uniform on the
+    /// sphere; the tests only need directions of every kind).
+    fn random_unit(rng: &mut Xoshiro256PlusPlus) -> DVec3 {
+        DVec3::new(
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+        )
+        .normalize()
+    }
+
     /// The grid answers as the brute-force minimum over all triangles does, at random points
     /// near a two-triangle square (exact: the same distance function decides both).
     #[test]
@@ -556,23 +576,12 @@ mod tests {
     /// and equal it within the radius.
     #[test]
     fn bounds_enclose_the_distance_to_a_sphere() {
-        let mesh = crate::mesh::TriangleMesh::sphere(3);
-        let tris: Vec<[Vec3; 3]> = mesh
-            .indices
-            .iter()
-            .map(|t| t.map(|i| mesh.positions[i as usize] * 10.0))
-            .collect();
+        let tris = sphere_10mm();
         let grid = SurfaceDistance::new(tris.clone(), 0.25);
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(9);
         let mut within = 0;
         for _ in 0..5_000 {
-            let u = DVec3::new(
-                rng.random_range(-1.0..1.0),
-                rng.random_range(-1.0..1.0),
-                rng.random_range(-1.0..1.0),
-            )
-            .normalize();
-            let p = u * rng.random_range(9.0..10.5);
+            let p = random_unit(&mut rng) * rng.random_range(9.0..10.5);
             let exact = tris
                 .iter()
                 .map(|t| distance_squared(p, t))
@@ -594,12 +603,7 @@ mod tests {
     /// random points 0.05 to 0.5 mm under the surface, of random length up to 0.5 mm.
     #[test]
     fn segment_hits_match_brute_force() {
-        let mesh = crate::mesh::TriangleMesh::sphere(3);
-        let tris: Vec<[Vec3; 3]> = mesh
-            .indices
-            .iter()
-            .map(|t| t.map(|i| mesh.positions[i as usize] * 10.0))
-            .collect();
+        let tris = sphere_10mm();
         let grid = SurfaceDistance::new(tris.clone(), 0.25);
         let crossing = |x: DVec3, d: DVec3, t: &[Vec3; 3]| -> Option<f64> {
             let [a, b, c] = t.map(Vec3::as_dvec3);
@@ -614,14 +618,6 @@ mod tests {
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(12);
         let (mut faces, mut clear) = (0, 0);
         for _ in 0..5_000 {
-            let random_unit = |rng: &mut Xoshiro256PlusPlus| {
-                DVec3::new(
-                    rng.random_range(-1.0..1.0),
-                    rng.random_range(-1.0..1.0),
-                    rng.random_range(-1.0..1.0),
-                )
-                .normalize()
-            };
             let x = random_unit(&mut rng) * rng.random_range(9.5..9.95);
             let d = random_unit(&mut rng);
             let reach = rng.random_range(0.0..0.5);
