@@ -178,12 +178,97 @@ impl Layer {
     }
 }
 
+/// What the stack's faces to the ambient media reflect, from either side (docs/physics.md §10.1).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum Surface {
+    /// A smooth dielectric: exact unpolarised Fresnel reflectance (the model's own boundary, [DJ06];
+    /// the renderer's `surface = "smooth"`).
+    #[default]
+    Fresnel,
+    /// The oily Torrance–Sparrow lobe of [DJ06] (docs/physics.md §7) as the boundary: a direction
+    /// that refracts through the face is reflected with the lobe's directional albedo ρ_dr at its
+    /// outside angle and transmitted along Snell's direction otherwise; beyond the critical angle it
+    /// is totally reflected. What the renderer's oily surface does to light in both directions.
+    Lobe {
+        /// Beckmann RMS slope m, (0, 1].
+        roughness_m: f64,
+        /// Oiliness ρ_s, [0, 1].
+        oiliness_rho_s: f64,
+    },
+}
+
+impl Surface {
+    /// The oily lobe of Beckmann RMS slope `roughness_m` in (0, 1] and oiliness `oiliness_rho_s`
+    /// in [0, 1].
+    pub fn lobe(roughness_m: f64, oiliness_rho_s: f64) -> Result<Self, MultipoleError> {
+        if roughness_m.is_nan() || roughness_m <= 0.0 || roughness_m > 1.0 {
+            return Err(MultipoleError::OutOfRange {
+                name: "surface roughness m",
+                value: roughness_m,
+                range: "(0, 1]",
+            });
+        }
+        check_range("oiliness ρ_s", oiliness_rho_s, 0.0, 1.0, "[0, 1]")?;
+        Ok(Self::Lobe {
+            roughness_m,
+            oiliness_rho_s,
+        })
+    }
+
+    /// The face's reflector for a stack of index `n_slab` under an ambient medium of index
+    /// `n_outside`, built once per solve or run.
+    pub(crate) fn reflector(&self, n_slab: f64, n_outside: f64) -> FaceReflector {
+        let lobe = match *self {
+            Surface::Fresnel => None,
+            Surface::Lobe {
+                roughness_m,
+                oiliness_rho_s,
+            } => brdf::TorranceSparrow::new(
+                roughness_m as f32,
+                oiliness_rho_s as f32,
+                (n_slab / n_outside) as f32,
+            )
+            .ok(),
+        };
+        FaceReflector {
+            ratio: n_outside / n_slab,
+            lobe,
+        }
+    }
+}
+
+/// One face's reflectance as a function of the direction's cosine inside the stack.
+#[derive(Debug, Clone)]
+pub(crate) struct FaceReflector {
+    /// n_outside / n_slab.
+    ratio: f64,
+    lobe: Option<brdf::TorranceSparrow>,
+}
+
+impl FaceReflector {
+    /// The probability that light meeting the face at cosine `mu_inside` (or arriving from outside
+    /// along the direction that refracts into it) is reflected: Fresnel, or the lobe's ρ_dr at the
+    /// outside cosine; 1 beyond the critical angle either way.
+    pub(crate) fn reflectance(&self, mu_inside: f64) -> f64 {
+        let fresnel = brdf::fresnel::dielectric_reflectance(mu_inside, self.ratio);
+        match &self.lobe {
+            Some(lobe) if fresnel < 1.0 => {
+                let sin2_out = (1.0 - mu_inside * mu_inside) / (self.ratio * self.ratio);
+                let mu_out = (1.0 - sin2_out).max(0.0).sqrt();
+                f64::from(lobe.directional_albedo(mu_out as f32)).clamp(0.0, 1.0)
+            }
+            _ => fresnel,
+        }
+    }
+}
+
 /// Layers from the top (lit) face down, with the ambient indices above and below.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LayeredMedium {
     layers: Vec<Layer>,
     n_above: f64,
     n_below: f64,
+    surface: Surface,
 }
 
 impl LayeredMedium {
@@ -208,7 +293,22 @@ impl LayeredMedium {
             layers,
             n_above,
             n_below,
+            surface: Surface::Fresnel,
         })
+    }
+
+    /// The same stack with `surface` on its faces to the ambient media (adding-doubling and the
+    /// Monte Carlo honour it; diffusion keeps the paper's Fresnel boundary, docs/physics.md §10.1).
+    #[must_use]
+    pub fn with_surface(mut self, surface: Surface) -> Self {
+        self.surface = surface;
+        self
+    }
+
+    /// What the faces to the ambient media reflect.
+    #[must_use]
+    pub fn surface(&self) -> Surface {
+        self.surface
     }
 
     /// [DJ06] skin at one wavelength: an epidermis of the skin's thickness over a semi-infinite

@@ -9,5 +9,5 @@ pub mod skin;
 
 pub use diffusion::profile::Profile;
 pub use error::MultipoleError;
-pub use layered::{DEFAULT_G, Layer, LayeredMedium};
+pub use layered::{DEFAULT_G, Layer, LayeredMedium, Surface};
 pub use skin::{Method, ProfileOptions, SpectralProfiles};

@@ -5,7 +5,7 @@
 //! transport scale all read these numbers; none rebuilds them.
 
 use crate::spectrum::{LAMBDA_MAX_NM, LAMBDA_MIN_NM, SpectrumTable};
-use multipole::{LayeredMedium, MultipoleError};
+use multipole::{LayeredMedium, MultipoleError, Surface};
 use skin_optics::{SkinParams, Wavelength};
 
 /// One layer's coefficients over the visible range, mm⁻¹.
@@ -49,6 +49,9 @@ pub struct SkinMedia {
     pub phase_g: f64,
     /// The dermis' largest transport mean free path 1/(σa + σs') every 10 nm over 380–780 nm, mm.
     pub largest_transport_mfp_mm: f64,
+    /// What the skin's surface reflects from either side: the boundary of the totals
+    /// (docs/physics.md §10.1; [`Surface::Fresnel`] unless [`Self::with_surface`] says otherwise).
+    pub surface: Surface,
     /// The layered medium at every wavelength of the 5-nm grid, in f64 (what the totals take).
     layered: Vec<LayeredMedium>,
 }
@@ -90,8 +93,22 @@ impl SkinMedia {
             },
             phase_g: g,
             largest_transport_mfp_mm,
+            surface: Surface::Fresnel,
             layered,
         })
+    }
+
+    /// The same layers under `surface`: what every total, gain and slab table built from them
+    /// sees at the skin's faces.
+    #[must_use]
+    pub fn with_surface(mut self, surface: Surface) -> Self {
+        self.layered = self
+            .layered
+            .into_iter()
+            .map(|m| m.with_surface(surface))
+            .collect();
+        self.surface = surface;
+        self
     }
 
     /// The layered medium every 10 nm from 380 to 780 nm, with its wavelength in nm.

@@ -207,6 +207,7 @@ fn profile_grid_error_stays_within_its_measured_bound() {
     let settings = |target: f32| GridSettings {
         params: &params,
         phase_g: multipole::DEFAULT_G,
+        surface: multipole::Surface::Fresnel,
         method: multipole::Method::default(),
         shape_escapes: None,
         fidelity: &fidelity,

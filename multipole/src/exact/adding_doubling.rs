@@ -288,7 +288,7 @@ fn fold(
     let eta = stack_index(medium)?;
     let angles = angles(medium, eta, options.quadrature_points);
     let n = angles.n();
-    let top = layer::interface(&angles, eta, medium.n_above());
+    let top = layer::interface(&angles, &medium.surface().reflector(eta, medium.n_above()));
 
     // Fold from the bottom up: a semi-infinite bottom needs reflection only.
     let mu_c = critical_cosine(medium, eta);
@@ -319,7 +319,7 @@ fn fold(
         }
         Body::SemiInfinite(below)
     } else {
-        let mut acc = layer::interface(&angles, eta, medium.n_below());
+        let mut acc = layer::interface(&angles, &medium.surface().reflector(eta, medium.n_below()));
         while let Some(op) = ops.pop() {
             acc = op
                 .add(&acc)

@@ -94,6 +94,16 @@ pub fn total_reflectance_at_g(
     medium_total_reflectance(&LayeredMedium::skin(skin, lambda, g)?, method)
 }
 
+/// The exact method's medium of `skin` at `lambda`: its layers at `opts.phase_g` under
+/// `opts.surface`.
+pub fn exact_medium(
+    skin: &SkinParams,
+    lambda: Wavelength,
+    opts: &ProfileOptions,
+) -> Result<LayeredMedium, MultipoleError> {
+    Ok(LayeredMedium::skin(skin, lambda, opts.phase_g)?.with_surface(opts.surface))
+}
+
 /// [`total_reflectance`] of a skin whose layers are already built (`LayeredMedium::skin`, at its
 /// layers' own g): adding-doubling of `medium`'s totals per unit flux entering, R_d / (1 − R_spec),
 /// or the multipole stack of its σa and σs' ([DJ06] eq. 9 at q = 0).
@@ -176,7 +186,7 @@ impl SpectralProfiles {
         let lambdas: Vec<Wavelength> = grid.iter().collect();
         let profiles = match (method, opts.exact_shape) {
             (Method::Exact, ExactShape::MonteCarlo { escapes }) => {
-                monte_carlo_rows(skin, grid, escapes, opts.shape_step_nm, opts.phase_g)?
+                monte_carlo_rows(skin, grid, escapes, opts)?
             }
             _ => lambdas
                 .par_iter()
@@ -213,13 +223,18 @@ fn monte_carlo_rows(
     skin: &SkinParams,
     grid: &WavelengthGrid,
     escapes: u64,
-    step_nm: f64,
-    g: f64,
+    opts: &ProfileOptions,
 ) -> Result<Vec<Profile>, MultipoleError> {
     let n = grid.len();
+    let step_nm = opts.shape_step_nm;
     let totals = (0..n)
         .into_par_iter()
-        .map(|i| total_reflectance_at_g(skin, grid.wavelength(i), Method::Exact, g))
+        .map(|i| {
+            medium_total_reflectance(
+                &exact_medium(skin, grid.wavelength(i), opts)?,
+                Method::Exact,
+            )
+        })
         .collect::<Result<Vec<_>, _>>()?;
     let stride = ((step_nm / grid.step_nm()).round() as usize).max(1);
     let mut anchors: Vec<usize> = (0..n).step_by(stride).collect();
@@ -228,7 +243,10 @@ fn monte_carlo_rows(
     }
     let shapes = anchors
         .par_iter()
-        .map(|&i| monte_carlo_shape(skin, grid.wavelength(i), g, escapes, totals[i]))
+        .map(|&i| {
+            let medium = exact_medium(skin, grid.wavelength(i), opts)?;
+            monte_carlo_shape(&medium, escapes, totals[i])
+        })
         .collect::<Result<Vec<_>, _>>()?;
     (0..n)
         .map(|i| {

@@ -1,8 +1,9 @@
 //! The knobs of a skin profile: the diffusion knobs of both methods, and the exact method's shape,
-//! shape spacing and phase function.
+//! shape spacing, phase function and surface.
 
 use crate::diffusion::spatial::DiffusionOptions;
 use crate::error::{MultipoleError, check_option};
+use crate::layered::Surface;
 use crate::skin::ExactShape;
 
 /// Knobs of a skin profile computation ([`crate::skin::profile`], [`crate::SpectralProfiles`]);
@@ -23,6 +24,11 @@ pub struct ProfileOptions {
     /// [`crate::DEFAULT_G`] = 0.9; [0, 0.99], adding-doubling's range): σs = σs'/(1 − g), the
     /// totals and the exact shapes are computed at this g (diffusion sees only σs').
     pub phase_g: f64,
+    /// The skin's surface for `Method::Exact`'s totals and Monte Carlo shapes (default
+    /// [`Surface::Fresnel`], the model's boundary; the renderer's oily surface passes its lobe,
+    /// docs/physics.md §10.1). Diffusion (`Method::Multipole`) keeps the paper's Fresnel boundary,
+    /// and the shape table's white runs are traced under it.
+    pub surface: Surface,
 }
 
 impl Default for ProfileOptions {
@@ -32,6 +38,7 @@ impl Default for ProfileOptions {
             exact_shape: ExactShape::default(),
             shape_step_nm: 10.0,
             phase_g: crate::DEFAULT_G,
+            surface: Surface::Fresnel,
         }
     }
 }

@@ -3,7 +3,7 @@
 //! `shape_table`), else from a run-time layered Monte Carlo (where the table does not apply, or
 //! when asked for) or from diffusion (rescaled as a whole or per layer, for comparison).
 
-use super::{Method, stack, total_reflectance_at_g};
+use super::{Method, stack};
 use crate::diffusion::boundary::observable_reflectance;
 use crate::diffusion::profile::Profile;
 use crate::diffusion::slab::Poles;
@@ -12,7 +12,7 @@ use crate::diffusion::stack::Response;
 use crate::error::MultipoleError;
 use crate::exact::adding_doubling::{AddingDoublingOptions, LayerTotals, skin_layer_totals};
 use crate::exact::montecarlo::{self, McOptions, RadialGrid};
-use crate::layered::LayeredMedium;
+use crate::layered::{LayeredMedium, Surface};
 use crate::skin::ProfileOptions;
 use skin_optics::{SkinParams, Wavelength};
 
@@ -115,30 +115,35 @@ pub fn exact_profile(
     shape: ExactShape,
     opts: &ProfileOptions,
 ) -> Result<Profile, MultipoleError> {
-    let g = opts.phase_g;
+    // One medium for the total and the shape: the coefficients are built once.
+    let medium = super::exact_medium(skin, lambda, opts)?;
+    let total = || super::medium_total_reflectance(&medium, Method::Exact);
     let (table, total) = match shape {
         ExactShape::RescaledTotal => (
             stack_profile(&stack(skin, lambda)?, &opts.diffusion)?,
-            total_reflectance_at_g(skin, lambda, Method::Exact, g)?,
+            total()?,
         ),
         ExactShape::PerLayer => {
             let (scales, exact) = layer_scales(skin, lambda)?;
             let st = stack(skin, lambda)?.with_scales(scales)?;
-            (stack_profile(&st, &opts.diffusion)?, exact.total)
+            let total = if opts.surface == Surface::Fresnel {
+                exact.total
+            } else {
+                total()?
+            };
+            (stack_profile(&st, &opts.diffusion)?, total)
         }
         ExactShape::MonteCarlo { escapes } => {
-            let total = total_reflectance_at_g(skin, lambda, Method::Exact, g)?;
-            return shape_profile(&monte_carlo_shape(skin, lambda, g, escapes, total)?, total);
+            let total = total()?;
+            return shape_profile(&monte_carlo_shape(&medium, escapes, total)?, total);
         }
         ExactShape::Table(table_opts) => {
-            // One medium for the total and the shape: the coefficients are built once.
-            let medium = LayeredMedium::skin(skin, lambda, g)?;
-            let total = super::medium_total_reflectance(&medium, Method::Exact)?;
+            let total = total()?;
             if let Some(p) = medium_table_profile(&medium, &table_opts, total)? {
                 return Ok(p);
             }
             let escapes = DEFAULT_SHAPE_ESCAPES;
-            return shape_profile(&monte_carlo_shape(skin, lambda, g, escapes, total)?, total);
+            return shape_profile(&monte_carlo_shape(&medium, escapes, total)?, total);
         }
     };
     rescale(&table, total)
@@ -169,13 +174,12 @@ pub fn shape_photons(escapes: u64, total: f64, eta: f64) -> u64 {
     ((escapes as f64 / escaping_fraction).ceil() as u64).clamp(escapes, cap)
 }
 
-/// The Monte Carlo R(r) of `skin` at `lambda` with HG anisotropy `g` on the shape grid (one value
-/// per annulus, its mean, mm⁻²), normalised to unit energy in the trapezoid rule of [`Profile`] on
-/// the annuli's representative radii; `total` (exact, per unit flux entering) sets the photon count.
+/// The Monte Carlo R(r) of the skin `medium` (its layers, g and surface) on the shape grid (one
+/// value per annulus, its mean, mm⁻²), normalised to unit energy in the trapezoid rule of
+/// [`Profile`] on the annuli's representative radii; `total` (exact, per unit flux entering) sets
+/// the photon count.
 pub fn monte_carlo_shape(
-    skin: &SkinParams,
-    lambda: Wavelength,
-    g: f64,
+    medium: &LayeredMedium,
     escapes: u64,
     total: f64,
 ) -> Result<Vec<f64>, MultipoleError> {
@@ -186,11 +190,12 @@ pub fn monte_carlo_shape(
             range: "[100, 1e12]",
         });
     }
-    let stack = LayeredMedium::skin(skin, lambda, g)?;
+    let stack = medium;
+    let eta = medium.layers()[0].n();
     let grid = shape_grid()?;
-    let photons = shape_photons(escapes, total, skin.eta());
+    let photons = shape_photons(escapes, total, eta);
     let opts = McOptions::new(photons, 8, SHAPE_SEED)?.with_grid(grid);
-    let values = montecarlo::run(&stack, &opts).radial.reflectance_per_mm2;
+    let values = montecarlo::run(stack, &opts).radial.reflectance_per_mm2;
     let radii = shape_radii()?;
     let integral = Profile::from_table(radii, values.clone(), 1.0)?.table_integral();
     let norm = if integral > 0.0 { 1.0 / integral } else { 0.0 };

@@ -12,7 +12,7 @@ use crate::layered::{Layer, LayeredMedium};
 /// The half-space skin `half_space` (an epidermis slab over a semi-infinite dermis, as
 /// [`LayeredMedium::skin`] builds it) as a slab `thickness_mm` thick: epidermis, dermis
 /// `thickness_mm − 2 d_epi`, epidermis, in air on both sides. A slab no thicker than twice the
-/// epidermis is epidermis throughout. Errors name the thickness and its range (0, 1000] mm, or
+/// epidermis is epidermis throughout; both faces take `half_space`'s surface. Errors name the thickness and its range (0, 1000] mm, or
 /// a `half_space` that is not two layers with a semi-infinite dermis.
 pub fn slab_of(
     half_space: &LayeredMedium,
@@ -45,7 +45,10 @@ pub fn slab_of(
         let e = with_thickness(epi, d_epi)?;
         vec![e, with_thickness(dermis, thickness_mm - 2.0 * d_epi)?, e]
     };
-    LayeredMedium::new(stack, half_space.n_above(), half_space.n_above())
+    Ok(
+        LayeredMedium::new(stack, half_space.n_above(), half_space.n_above())?
+            .with_surface(half_space.surface()),
+    )
 }
 
 /// Exact totals of [`slab_of`]`(half_space, thickness_mm)` for a beam at normal incidence:
@@ -159,6 +162,51 @@ mod tests {
                     "{preset:?} {nm} nm {d} mm {what}: adding-doubling {exact} vs Monte Carlo {} ± {}",
                     est.mean,
                     est.stderr
+                );
+            }
+        }
+    }
+
+    /// The same agreement under the oily surface on both faces (docs/physics.md §10.1; ρ_s 0 and
+    /// 0.25 at m 0.3): adding-doubling's lobe faces against the Monte Carlo's, each photon meeting
+    /// a face reflected with the lobe's ρ_dr at its outside angle. Each case's R must also differ from
+    /// the Fresnel faces' by more than the tolerance, so the check can tell the two surfaces apart.
+    #[test]
+    fn oily_slab_totals_match_the_layered_monte_carlo() {
+        let mc = McOptions::new(40_000, 20, 12).unwrap();
+        for (preset, nm, d, rho_s) in [
+            (Preset::Light, 650.0, 1.0, 0.0),
+            (Preset::Medium, 550.0, 2.0, 0.25),
+        ] {
+            let half = skin(preset, nm);
+            let fresnel = slab_totals(&half, d, &options()).unwrap();
+            let half = half.with_surface(crate::layered::Surface::lobe(0.3, rho_s).unwrap());
+            let ad = slab_totals(&half, d, &options()).unwrap();
+            let run = montecarlo::run(&slab_of(&half, d).unwrap(), &mc);
+            for (what, exact, est, other) in [
+                (
+                    "R",
+                    ad.diffuse_reflectance,
+                    run.diffuse_reflectance,
+                    fresnel.diffuse_reflectance,
+                ),
+                (
+                    "T",
+                    ad.transmittance,
+                    run.transmittance,
+                    fresnel.transmittance,
+                ),
+            ] {
+                let tol = 4.0 * est.stderr + 2e-4;
+                assert!(
+                    (exact - est.mean).abs() <= tol,
+                    "{preset:?} {nm} nm {d} mm {what}: adding-doubling {exact} vs Monte Carlo {} ± {}",
+                    est.mean,
+                    est.stderr
+                );
+                assert!(
+                    what == "T" || (other - est.mean).abs() > tol,
+                    "{preset:?} {nm} nm {d} mm {what}: the Fresnel faces' {other} is as close"
                 );
             }
         }

@@ -41,6 +41,8 @@ pub struct GridSettings<'a> {
     pub params: &'a SkinParams,
     /// Henyey–Greenstein g of both layers.
     pub phase_g: f64,
+    /// The skin's surface, the boundary of the totals (`media::SkinMedia::surface`).
+    pub surface: multipole::Surface,
     /// The profile method.
     pub method: Method,
     /// Monte Carlo shape escapes (`SkinKnobs::shape_escapes`).
@@ -66,7 +68,9 @@ impl GridSettings<'_> {
             .with_melanin(f64::from(p[0]))?
             .with_eumelanin_blend(f64::from(p[1]))?
             .with_hemoglobin(f64::from(p[2]))?;
-        let media = SkinMedia::new(&params, self.phase_g).map_err(|e| e.source)?;
+        let media = SkinMedia::new(&params, self.phase_g)
+            .map_err(|e| e.source)?
+            .with_surface(self.surface);
         let (table, _) = skin_table(
             &params,
             &media,

@@ -16,7 +16,7 @@ use crate::bssrdf::TableOptions;
 use multipole::diffusion::slab::Poles;
 use multipole::diffusion::spatial::DiffusionOptions;
 use multipole::skin::{ExactShape, ShapeTableOptions};
-use multipole::{Method, ProfileOptions};
+use multipole::{Method, ProfileOptions, Surface};
 use skin_optics::SkinParams;
 use skin_optics::physiology::Extension;
 
@@ -145,6 +145,7 @@ fn profile(b: &mut Bytes, p: &ProfileOptions) {
         exact_shape,
         shape_step_nm,
         phase_g,
+        surface,
     } = p;
     match poles {
         Poles::Exact => b.tag(0),
@@ -179,6 +180,13 @@ fn profile(b: &mut Bytes, p: &ProfileOptions) {
         other => b.tag(255).text(&format!("{other:?}")),
     };
     b.f64(*shape_step_nm).f64(*phase_g);
+    match surface {
+        Surface::Fresnel => b.tag(0),
+        Surface::Lobe {
+            roughness_m,
+            oiliness_rho_s,
+        } => b.tag(1).f64(*roughness_m).f64(*oiliness_rho_s),
+    };
 }
 
 #[cfg(test)]

@@ -32,14 +32,20 @@ enum Shapes {
 
 /// The table options of `resolved` with shapes `shapes`, at wavelength step `step_nm` and phase
 /// `phase_g`.
-fn table_options(resolved: &Resolved, shapes: Shapes, phase_g: f64, step_nm: f64) -> TableOptions {
+fn table_options(
+    resolved: &Resolved,
+    shapes: Shapes,
+    media: &SkinMedia,
+    step_nm: f64,
+) -> TableOptions {
     let mut opts = TableOptions {
         step_nm,
         energy_tolerance: resolved.energy_tolerance,
         radial_error: resolved.radial_error,
         ..TableOptions::default()
     };
-    opts.profile.phase_g = phase_g;
+    opts.profile.phase_g = media.phase_g;
+    opts.profile.surface = media.surface;
     match shapes {
         Shapes::Escapes(escapes) => opts.profile.exact_shape = ExactShape::MonteCarlo { escapes },
         Shapes::Table(Some(photons)) => {
@@ -82,7 +88,7 @@ pub fn skin_table(
     })?;
     let get = |shapes: Shapes| {
         // The key holds the options before the wavelength choice (the choice is part of the value).
-        let probe = table_options(&resolved, shapes, phase_g, 10.0);
+        let probe = table_options(&resolved, shapes, media, 10.0);
         let key = table_key(params, method, &probe, resolved.step);
         let (stored, outcome) = cache::load_or_build(dir.as_deref(), max_bytes, &key, || {
             let wavelengths = match resolved.step {
@@ -96,7 +102,7 @@ pub fn skin_table(
                     max_luminance_error,
                 ),
             };
-            let opts = table_options(&resolved, shapes, phase_g, wavelengths.step_nm);
+            let opts = table_options(&resolved, shapes, media, wavelengths.step_nm);
             let table = ProfileTable::build(params, method, &opts)?;
             Ok::<_, MultipoleError>(Stored { table, wavelengths })
         })?;
@@ -201,12 +207,13 @@ mod tests {
             ..FidelityKnobs::default()
         };
         let resolved = knobs.resolve().unwrap();
-        let probe = table_options(&resolved, Shapes::Table(None), multipole::DEFAULT_G, 10.0);
+        let media = SkinMedia::new(params, multipole::DEFAULT_G).unwrap();
+        let probe = table_options(&resolved, Shapes::Table(None), &media, 10.0);
         let k = table_key(params, Method::Exact, &probe, resolved.step);
         let build = || {
             let (t, c) = skin_table(
                 params,
-                &SkinMedia::new(params, multipole::DEFAULT_G).unwrap(),
+                &media,
                 Method::Exact,
                 None,
                 &FidelityKnobs {

@@ -250,6 +250,7 @@ impl super::SkinMaterial {
         let settings = crate::fidelity::grid::GridSettings {
             params: &self.params,
             phase_g: g,
+            surface: self.media.surface,
             method: knobs.method,
             shape_escapes: knobs.shape_escapes,
             fidelity: &fidelity,

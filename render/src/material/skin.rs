@@ -119,7 +119,9 @@ impl SkinMaterial {
         let surface =
             TorranceSparrow::new(roughness_m, params.oiliness() as f32, params.eta() as f32)?;
         let g = knobs.phase_g.unwrap_or(multipole::DEFAULT_G);
-        let media = Arc::new(SkinMedia::new(&params, g)?);
+        let media = Arc::new(
+            SkinMedia::new(&params, g)?.with_surface(boundary_of(knobs.surface, &surface)),
+        );
         let directional = Directional::new(surface.clone(), split_of(knobs.surface));
         let directional = match knobs.incidence {
             Incidence::Normal => directional,
@@ -241,6 +243,19 @@ impl SkinMaterial {
         }
         let m = self.texture_factor(uv, textures);
         self.total_reflectance.eval(wl).map(|r| (r * m).min(1.0))
+    }
+}
+
+/// What surface model `kind` (with the oily lobe `lobe`) reflects from either side, as the
+/// boundary of the body's totals (docs/physics.md §10.1): the same surface the light crossed to
+/// get in, so the BSSRDF's totals and the volumetric walk's boundary are one model.
+fn boundary_of(kind: SurfaceKind, lobe: &TorranceSparrow) -> multipole::Surface {
+    match kind {
+        SurfaceKind::Oily => multipole::Surface::Lobe {
+            roughness_m: f64::from(lobe.roughness()),
+            oiliness_rho_s: f64::from(lobe.oiliness()),
+        },
+        SurfaceKind::Smooth => multipole::Surface::Fresnel,
     }
 }
 

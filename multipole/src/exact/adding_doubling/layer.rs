@@ -10,6 +10,7 @@
 use super::matrix::{Mat, Singular};
 use super::memo::{Memo, memoized};
 use super::quadrature::legendre_with_derivative;
+use crate::layered::FaceReflector;
 use std::sync::{Arc, OnceLock};
 
 /// Quadrature directions inside the slab, shared by every layer of a stack.
@@ -359,16 +360,12 @@ pub(crate) fn doubled(
     Ok(LayerBuild::NotConverged)
 }
 
-/// A smooth interface from an outer medium into the slab: diagonal in flux, reflectance F(μ_i) from
-/// `brdf::fresnel` (1 under total internal reflection) and transmittance 1 − F. Each inner direction
-/// μ_i is paired with the outer direction it refracts to, so flux maps bin to bin, and reciprocity makes
-/// the reflectance the same seen from either side.
-pub(crate) fn interface(angles: &Angles, n_slab: f64, n_outside: f64) -> Operator {
-    let f: Vec<f64> = angles
-        .mu
-        .iter()
-        .map(|&mu| brdf::fresnel::dielectric_reflectance(mu, n_outside / n_slab))
-        .collect();
+/// An interface from an outer medium into the slab: diagonal in flux, reflectance R(μ_i) of `face`
+/// (Fresnel from `brdf::fresnel`, or the oily lobe's ρ_dr; 1 under total internal reflection) and
+/// transmittance 1 − R. Each inner direction μ_i is paired with the outer direction it refracts to,
+/// so flux maps bin to bin, and reciprocity makes the reflectance the same seen from either side.
+pub(crate) fn interface(angles: &Angles, face: &FaceReflector) -> Operator {
+    let f: Vec<f64> = angles.mu.iter().map(|&mu| face.reflectance(mu)).collect();
     let t: Vec<f64> = f.iter().map(|v| 1.0 - v).collect();
     Operator::symmetric(Mat::diagonal(&f), Mat::diagonal(&t))
 }

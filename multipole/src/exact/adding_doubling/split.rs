@@ -46,7 +46,7 @@ pub fn skin_layer_totals(
     let eta = skin.eta();
     let angles = angles(&medium, eta, options.quadrature_points());
     let normal = angles.n() - 1;
-    let top = super::layer::interface(&angles, eta, medium.n_above());
+    let top = super::layer::interface(&angles, &medium.surface().reflector(eta, medium.n_above()));
     let layers = medium.layers();
     let epidermis = build_layer(&angles, &layers[0])?;
     let dermis = build_layer(&angles, &layers[1])?;

@@ -1,6 +1,7 @@
 //! Closed forms, limits and reference values for the adding-doubling solver.
 
 use super::*;
+use crate::layered::Surface;
 
 fn opts(n: usize) -> AddingDoublingOptions {
     AddingDoublingOptions::new(n, DEFAULT_G).expect("valid options")
@@ -451,5 +452,70 @@ fn cached_layers_give_the_uncached_totals_bit_for_bit() {
         // Per wavelength 9 skins of 3 epidermises and 3 dermises: 12 of the first pass's 18 layers
         // were built for an earlier skin, and all 18 of the second pass.
         assert!(layer_cache::hits() - hits >= 3 * (12 + 18), "{n} points");
+    }
+}
+
+/// The oily surface as a boundary (docs/physics.md §10.1): a clear slab between two lobe faces
+/// reflects and transmits the normal beam as between two faces of reflectance ρ = ρ_dr(1), the
+/// lobe's albedo at normal incidence (here from brdf's direct f64 quadrature, not the table the
+/// face reads): T = (1 − ρ)² e^−τ / (1 − ρ² e^−2τ), the bottom face's share ρ (1 − ρ)² e^−2τ /
+/// (1 − ρ² e^−2τ), the specular part ρ. The table's error (1e-4 in ρ) bounds the difference.
+#[test]
+fn pure_absorber_between_oily_faces_matches_closed_form() {
+    for (m, rho_s) in [(0.3, 0.25), (0.35, 1.0)] {
+        let lobe = brdf::TorranceSparrow::new(m as f32, rho_s as f32, 1.4).expect("lobe");
+        let rho = lobe.directional_albedo_quadrature(1.0, 96).expect("albedo");
+        assert!(rho > 0.001 && rho < 0.05, "ρ_dr(1) = {rho}");
+        for tau in [0.1, 1.0, 3.0] {
+            let Slab(medium) = slab(vec![layer(tau, 0.0, 0.9, 1.0)], 1.4);
+            let medium = medium.with_surface(Surface::lobe(m, rho_s).expect("surface"));
+            let t = solve(&medium, &opts(16)).expect("solves");
+            let e = (-tau).exp();
+            let denom = 1.0 - rho * rho * e * e;
+            let tol = 3e-4;
+            assert!((t.transmittance - (1.0 - rho).powi(2) * e / denom).abs() < tol);
+            assert!(
+                (t.diffuse_reflectance - rho * (1.0 - rho).powi(2) * e * e / denom).abs() < tol
+            );
+            assert!((t.specular_reflectance - rho).abs() < 1e-4);
+        }
+    }
+}
+
+/// A lossless slab between lobe faces loses nothing: R + R_spec + T = 1 to rounding, and it
+/// reflects less diffusely than between Fresnel faces (the lobe reflects less of what meets it
+/// from inside within the critical cone, so more light leaves before it crosses the slab).
+#[test]
+fn oily_faces_conserve_energy() {
+    let surface = Surface::lobe(0.3, 0.25).expect("surface");
+    let Slab(medium) = slab(vec![layer(0.0, 10.0, 0.9, 1.0)], 1.4);
+    let fresnel = solve(&medium, &opts(24)).expect("solves");
+    let oily = solve(&medium.with_surface(surface), &opts(24)).expect("solves");
+    let sum = oily.diffuse_reflectance + oily.specular_reflectance + oily.transmittance;
+    assert!((sum - 1.0).abs() < 1e-9, "R + T = {sum}");
+    assert!(oily.specular_reflectance < fresnel.specular_reflectance);
+}
+
+/// A nearly smooth lobe with ρ_s = 1 reflects what a smooth dielectric reflects (its albedo tends
+/// to F(θ) as m → 0), so skin's totals under it tend to the Fresnel face's: within 0.3% at m = 0.02
+/// (the shadowing term and the table's interpolation are what remains).
+#[test]
+fn a_smooth_full_lobe_is_the_fresnel_face() {
+    let lambda = Wavelength::new(550.0).expect("nm");
+    for preset in [skin_optics::Preset::Light, skin_optics::Preset::Dark] {
+        let medium =
+            LayeredMedium::skin(&SkinParams::preset(preset), lambda, DEFAULT_G).expect("skin");
+        let fresnel = solve(&medium, &opts(24)).expect("solves");
+        let lobe = solve(
+            &medium.with_surface(Surface::lobe(0.02, 1.0).expect("surface")),
+            &opts(24),
+        )
+        .expect("solves");
+        assert!(
+            rel(lobe.diffuse_reflectance, fresnel.diffuse_reflectance) < 3e-3,
+            "{preset:?}: {} vs {}",
+            lobe.diffuse_reflectance,
+            fresnel.diffuse_reflectance
+        );
     }
 }

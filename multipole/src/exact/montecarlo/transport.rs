@@ -18,7 +18,7 @@ mod tests;
 pub(crate) mod white;
 
 use super::tally::{BatchTally, RadialGrid};
-use crate::layered::LayeredMedium;
+use crate::layered::{FaceReflector, LayeredMedium, Surface};
 use brdf::fresnel::dielectric_reflectance;
 use rand::RngCore;
 #[cfg(test)]
@@ -33,7 +33,7 @@ pub const ROULETTE_THRESHOLD: f64 = 1.0e-4;
 pub const ROULETTE_SURVIVAL: f64 = 0.1;
 
 /// A layer prepared for the hot loop (all per-layer divisions done once).
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 pub(crate) struct SlabOptics {
     z_top: f64,
     /// `f64::INFINITY` for a semi-infinite layer.
@@ -48,6 +48,10 @@ pub(crate) struct SlabOptics {
     /// Index beyond the top and the bottom face of this layer.
     n_up: f64,
     n_down: f64,
+    /// The stack's surface on this layer's top and bottom face where that face is an outer one and
+    /// the surface is not Fresnel's (`None`: Fresnel, as between layers).
+    face_up: Option<FaceReflector>,
+    face_down: Option<FaceReflector>,
 }
 
 /// The medium as the photon loop sees it.
@@ -59,6 +63,10 @@ pub(crate) struct Medium {
 impl Medium {
     pub fn new(stack: &LayeredMedium) -> Self {
         let layers = stack.layers();
+        let last = layers.len() - 1;
+        let outer = |n_slab: f64, n_out: f64| {
+            (stack.surface() != Surface::Fresnel).then(|| stack.surface().reflector(n_slab, n_out))
+        };
         let mut z = 0.0;
         let mut slabs = Vec::with_capacity(layers.len());
         for (i, l) in layers.iter().enumerate() {
@@ -78,15 +86,29 @@ impl Medium {
                     layers[i - 1].n()
                 },
                 n_down: layers.get(i + 1).map_or(stack.n_below(), |b| b.n()),
+                face_up: if i == 0 {
+                    outer(l.n(), stack.n_above())
+                } else {
+                    None
+                },
+                face_down: if i == last {
+                    outer(l.n(), stack.n_below())
+                } else {
+                    None
+                },
             });
             z = z_bottom;
         }
         Self { slabs }
     }
 
-    /// Specular reflectance of the collimated normal beam at the top face ([WJZ95] eq 3.1).
+    /// Specular reflectance of the collimated normal beam at the top face ([WJZ95] eq 3.1; the
+    /// surface's own at normal incidence).
     pub fn specular(&self, n_above: f64) -> f64 {
-        dielectric_reflectance(1.0, self.slabs[0].n / n_above)
+        match &self.slabs[0].face_up {
+            Some(face) => face.reflectance(1.0),
+            None => dielectric_reflectance(1.0, self.slabs[0].n / n_above),
+        }
     }
 }
 
@@ -248,7 +270,10 @@ impl Lane {
             (false, cos_i)
         } else {
             let eta = n_next / slab.n;
-            let r = dielectric_reflectance(cos_i, eta);
+            let r = match if up { &slab.face_up } else { &slab.face_down } {
+                Some(face) => face.reflectance(cos_i),
+                None => dielectric_reflectance(cos_i, eta),
+            };
             // Fresnel gives 1 under total internal reflection, so no transmission then.
             let reflect = r >= 1.0 || uniform(rng) < r;
             let sin2_t = (1.0 - cos_i * cos_i) / (eta * eta);
