@@ -59,7 +59,7 @@ pub struct DiffusionFailures {
 }
 
 /// Where multipole diffusion misses the exact (adding-doubling) total of the skin `params`, whose
-/// layers at the material's g are `media`, by 2% or more, every 10 nm over 380–780 nm, and which
+/// layers at the material's g are `media`, under the same Fresnel faces, by 2% or more, every 10 nm over 380–780 nm, and which
 /// layers' own totals are off there (`multipole::skin::layer_scales`); `None` where it is accurate
 /// everywhere.
 #[must_use]
@@ -71,9 +71,12 @@ pub fn diffusion_failures(params: &SkinParams, media: &SkinMedia) -> Option<Diff
     };
     for (nm, medium) in media.every_10nm() {
         let Ok(l) = Wavelength::new(nm) else { continue };
+        // Diffusion's boundary is Fresnel's (the paper's A): its transport error is measured
+        // against exact transport under that same face, whatever surface the material renders.
+        let fresnel = medium.clone().with_surface(multipole::Surface::Fresnel);
         let (Ok(m), Ok(e)) = (
             multipole::skin::medium_total_reflectance(medium, Method::Multipole),
-            multipole::skin::medium_total_reflectance(medium, Method::Exact),
+            multipole::skin::medium_total_reflectance(&fresnel, Method::Exact),
         ) else {
             continue;
         };
