@@ -18,8 +18,21 @@ pub const THREE_HEADS_FAR: &str = include_str!("../assets/scenes/three_heads_far
 /// melanin shifted to medium and dark skin on the second and third head.
 pub const THREE_HEADS_MAPS: &str = include_str!("../assets/scenes/three_heads_maps.toml");
 
+/// A close-up of one face with chromophore maps fitted at load (lips, cheeks, stubble).
+pub const FACE_MAPS: &str = include_str!("../assets/scenes/face_maps.toml");
+
+/// The same close-up with uniform skin (one chromophore set, the texture scaling its brightness).
+pub const FACE: &str = include_str!("../assets/scenes/face.toml");
+
 /// Built-in scene names, the first is the default.
-pub const SCENES: [&str; 4] = ["three-heads", "ear", "three-heads-far", "three-heads-maps"];
+pub const SCENES: [&str; 6] = [
+    "three-heads",
+    "ear",
+    "three-heads-far",
+    "three-heads-maps",
+    "face-maps",
+    "face",
+];
 
 /// The text of a built-in scene by name.
 #[must_use]
@@ -29,6 +42,8 @@ pub fn scene(name: &str) -> Option<&'static str> {
         "ear" => Some(EAR),
         "three-heads-far" => Some(THREE_HEADS_FAR),
         "three-heads-maps" => Some(THREE_HEADS_MAPS),
+        "face-maps" => Some(FACE_MAPS),
+        "face" => Some(FACE),
         _ => None,
     }
 }

@@ -18,7 +18,7 @@ use std::time::{Duration, Instant};
 #[derive(Args, Debug, Clone)]
 pub struct RenderArgs {
     /// Scene file (TOML), or a built-in scene: builtin:three-heads (default), builtin:ear,
-    /// builtin:three-heads-far.
+    /// builtin:three-heads-far, builtin:three-heads-maps, builtin:face-maps, builtin:face.
     #[arg(long, value_name = "FILE", default_value = "builtin:three-heads")]
     pub scene: String,
     /// Output folder for render.exr and render.png.
