@@ -5,7 +5,7 @@ use crate::error::{Bad, Checked, on_threads};
 use crate::params::{WIDTH, skin_of, wavelength};
 use multipole::exact::montecarlo::{self, McOptions, RadialGrid};
 use multipole::skin::{ExactShape, ShapeTableOptions};
-use multipole::{LayeredMedium, Method, ProfileOptions};
+use multipole::{LayeredMedium, Method, ProfileOptions, Surface};
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -99,9 +99,17 @@ pub fn diffuse_reflectance<'py>(
     Ok(out1(py, out))
 }
 
+/// The skin's surface as the boundary of exact transport: Fresnel faces without a roughness, the
+/// oily lobe of Beckmann slope `roughness` and the skin's own ρ_s with one (docs/physics.md §10.1).
+fn surface_of(roughness: Option<f64>, oiliness: f64) -> Checked<Surface> {
+    roughness.map_or(Ok(Surface::Fresnel), |m| {
+        Surface::lobe(m, oiliness).map_err(|e| Bad::new("roughness", e))
+    })
+}
+
 /// R(r) in mm⁻² (per unit flux entering) of one skin at each wavelength (rows) and radius (columns).
 #[pyfunction]
-#[pyo3(signature = (r_mm, lambda_nm, params, method, shape, escapes, threads=None))]
+#[pyo3(signature = (r_mm, lambda_nm, params, method, shape, escapes, threads=None, roughness=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn profile<'py>(
     py: Python<'py>,
@@ -112,6 +120,7 @@ pub fn profile<'py>(
     shape: &str,
     escapes: u64,
     threads: Option<usize>,
+    roughness: Option<f64>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let method = method_of(method)?;
     let exact_shape = match shape {
@@ -134,6 +143,7 @@ pub fn profile<'py>(
     let skin = skin_of(&vec1(&params))?;
     let opts = ProfileOptions {
         exact_shape,
+        surface: surface_of(roughness, skin.oiliness())?,
         ..ProfileOptions::default()
     };
     opts.validate().map_err(|e| Bad::new("escapes", e))?;
@@ -153,9 +163,9 @@ pub fn profile<'py>(
 }
 
 /// The layered Monte Carlo of one skin at one wavelength ([WJZ95]): totals with standard errors and
-/// R(r) on `bins` uniform annuli out to `r_max_mm`.
+/// R(r) on `bins` uniform annuli out to `r_max_mm`, under Fresnel faces or the oily lobe's.
 #[pyfunction]
-#[pyo3(signature = (lambda_nm, params, photons, batches, seed, r_max_mm, bins, threads=None))]
+#[pyo3(signature = (lambda_nm, params, photons, batches, seed, r_max_mm, bins, threads=None, roughness=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn monte_carlo<'py>(
     py: Python<'py>,
@@ -167,11 +177,13 @@ pub fn monte_carlo<'py>(
     r_max_mm: f64,
     bins: usize,
     threads: Option<usize>,
+    roughness: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let skin = skin_of(&vec1(&params))?;
     let lambda = wavelength(lambda_nm)?;
     let medium = LayeredMedium::skin(&skin, lambda, multipole::DEFAULT_G)
-        .map_err(|e| Bad::new("params", e))?;
+        .map_err(|e| Bad::new("params", e))?
+        .with_surface(surface_of(roughness, skin.oiliness())?);
     if !(r_max_mm.is_finite() && r_max_mm > 0.0) {
         return Err(Bad::new("r_max_mm", format!("{r_max_mm} outside (0, inf) mm")).into());
     }

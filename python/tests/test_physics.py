@@ -73,6 +73,27 @@ def test_monte_carlo_agrees_with_adding_doubling():
     assert inside + mc.beyond_grid == pytest.approx(mc.diffuse_reflectance, rel=1e-9)
 
 
+def test_oily_surface_agrees_between_monte_carlo_and_adding_doubling():
+    # The oily lobe as the boundary (docs/physics.md §10.1) in both exact methods: the Monte Carlo's
+    # diffuse reflectance per entering photon against the exact profile's total under the same
+    # surface (4σ plus the quadrature's 1e-3), and both above the Fresnel faces' by more than that.
+    skin = dict(melanin=0.05, eumelanin=0.7, hemoglobin=0.02)
+    mc = ss.monte_carlo(650.0, photons=40_000, surface="oily", **skin)
+    per_entering = mc.diffuse_reflectance / (1.0 - mc.specular_reflectance)
+    r = np.linspace(0.0, 30.0, 30_001)
+    total = {
+        s: float(np.trapezoid(2 * np.pi * r * ss.profile(r, [650.0], surface=s, **skin)[0], r))
+        for s in ("smooth", "oily")
+    }
+    tol = 4 * mc.diffuse_reflectance_stderr + 2e-3
+    assert abs(per_entering - total["oily"]) < tol
+    assert total["oily"] - total["smooth"] > tol
+    with pytest.raises(ss.SkinError, match="surface"):
+        ss.profile([1.0], [560.0], surface="rough", **skin)
+    with pytest.raises(ss.SkinError, match="roughness"):
+        ss.monte_carlo(560.0, photons=1_000, surface="oily", roughness=0.0, **skin)
+
+
 def test_monte_carlo_does_not_depend_on_threads():
     a = ss.monte_carlo(600.0, photons=4_000, seed=7, threads=1, preset="medium")
     b = ss.monte_carlo(600.0, photons=4_000, seed=7, threads=2, preset="medium")

@@ -52,6 +52,7 @@ from ._native import SkinError
 __all__ = [
     "SkinError",
     "SKIN_PARAMETERS",
+    "DEFAULT_ROUGHNESS",
     "Coefficients",
     "MonteCarloResult",
     "SpectrumFit",
@@ -81,6 +82,10 @@ SKIN_PARAMETERS: tuple[str, ...] = tuple(_native.skin_columns())
 
 Method = Literal["exact", "multipole"]
 Geometry = Literal["sce", "sci"]
+Surface = Literal["smooth", "oily"]
+
+#: The oily surface's default Beckmann RMS slope m (the renderer's, [DJ06]).
+DEFAULT_ROUGHNESS: float = 0.3
 ArrayLike = npt.ArrayLike
 Array = npt.NDArray[np.float64]
 
@@ -136,6 +141,15 @@ def _points(
         params = [np.broadcast_to(np.broadcast_to(a, pshape)[..., None], shape) for a in arrays]
     rows = np.stack([p.reshape(-1) for p in params], axis=-1)
     return np.broadcast_to(lam, shape).reshape(-1), rows, shape
+
+
+def _roughness(surface: str, roughness: float) -> float | None:
+    """The native call's surface: ``None`` for Fresnel faces, the lobe's slope for the oily one."""
+    if surface == "smooth":
+        return None
+    if surface != "oily":
+        raise SkinError(f"surface: '{surface}' is not one of smooth, oily")
+    return float(roughness)
 
 
 def _one_skin(preset: str | None, skin: dict[str, Any]) -> Array:
@@ -209,6 +223,8 @@ def profile(
     shape: Literal["table", "monte-carlo"] = "table",
     escapes: int = _native.DEFAULT_SHAPE_ESCAPES,
     threads: int | None = None,
+    surface: Surface = "smooth",
+    roughness: float = DEFAULT_ROUGHNESS,
     **skin: float,
 ) -> Array:
     """Radial diffuse reflectance profile R(r), mm⁻² per unit flux entering, of one skin.
@@ -218,6 +234,9 @@ def profile(
     ``method="exact"`` scales the layered Monte Carlo's shape to the adding-doubling total; its shape
     comes from the cached universal table (``shape="table"``) or a Monte Carlo run per wavelength
     with ``escapes`` escaping photons (``shape="monte-carlo"``, noise ∝ 1/√escapes).
+    ``surface="oily"`` computes the exact total under the oily lobe as the boundary (Beckmann slope
+    ``roughness``, the skin's ``oil`` ρ_s; what the renderer's default surface does, docs/physics.md
+    §10.1); ``"smooth"`` (default) under Fresnel faces, the model's. Diffusion ignores it.
 
     Example:
         >>> p = profile([0.1, 0.5, 1.0], [450, 650], melanin=0.05, method="multipole")
@@ -227,7 +246,8 @@ def profile(
     r = _real(r_mm, "r_mm")
     lam = _real(wavelength_nm, "wavelength_nm")
     row = _one_skin(preset, skin)
-    out = _native.profile(r.reshape(-1), lam.reshape(-1), row, method, shape, int(escapes), threads)
+    m = _roughness(surface, roughness)
+    out = _native.profile(r.reshape(-1), lam.reshape(-1), row, method, shape, int(escapes), threads, m)
     return out.reshape(lam.shape + r.shape)
 
 
@@ -271,13 +291,17 @@ def monte_carlo(
     threads: int | None = None,
     r_max_mm: float = 10.0,
     bins: int = 1000,
+    surface: Surface = "smooth",
+    roughness: float = DEFAULT_ROUGHNESS,
     **skin: float,
 ) -> MonteCarloResult:
     """Layered Monte Carlo ([WJZ95]) of one skin at one wavelength (nm): totals and R(r).
 
     ``photons`` in [1, 1e12] split into ``batches`` in [2, 1e6] (for the standard errors);
     ``seed`` fixes the random streams, so the result does not depend on ``threads``. R(r) is tallied
-    on ``bins`` equal annuli out to ``r_max_mm`` (mm). Skin parameters must be scalars.
+    on ``bins`` equal annuli out to ``r_max_mm`` (mm). Skin parameters must be scalars. ``surface``
+    and ``roughness`` as in :func:`profile`: ``"oily"`` reflects photons meeting the surface with the
+    lobe's albedo, ``"smooth"`` with Fresnel's.
 
     Example:
         >>> mc = monte_carlo(550.0, melanin=0.05, photons=20_000)
@@ -291,7 +315,8 @@ def monte_carlo(
     for name, v, lo in (("photons", photons, 1), ("batches", batches, 2), ("bins", bins, 1), ("seed", seed, 0)):
         if not isinstance(v, (int, np.integer)) or v < lo:
             raise SkinError(f"{name}: {v!r} outside [{lo}, …] (a whole number)")
-    d = _native.monte_carlo(float(lam), row, int(photons), int(batches), int(seed), float(r_max_mm), int(bins), threads)
+    m = _roughness(surface, roughness)
+    d = _native.monte_carlo(float(lam), row, int(photons), int(batches), int(seed), float(r_max_mm), int(bins), threads, m)
     return MonteCarloResult(**d)
 
 

@@ -37,9 +37,16 @@ def diffuse_reflectance(
     """(N,) nm and (N, 10) rows → (N,) diffuse reflectance per incident flux."""
 
 def profile(
-    r_mm: _In, lambda_nm: _In, params: _In, method: str, shape: str, escapes: int, threads: int | None = None
+    r_mm: _In,
+    lambda_nm: _In,
+    params: _In,
+    method: str,
+    shape: str,
+    escapes: int,
+    threads: int | None = None,
+    roughness: float | None = None,
 ) -> _F:
-    """(R,) mm, (L,) nm and one row → (L, R) R(r) in mm⁻²."""
+    """(R,) mm, (L,) nm and one row → (L, R) R(r) in mm⁻²; a roughness puts the oily lobe on the faces."""
 
 def monte_carlo(
     lambda_nm: float,
@@ -50,8 +57,9 @@ def monte_carlo(
     r_max_mm: float,
     bins: int,
     threads: int | None = None,
+    roughness: float | None = None,
 ) -> dict[str, Any]:
-    """Layered Monte Carlo of one skin: totals with standard errors and R(r)."""
+    """Layered Monte Carlo of one skin: totals with standard errors and R(r); a roughness puts the oily lobe on the faces."""
 
 def adding_doubling(slabs: _In, quadrature_points: int, threads: int | None = None) -> _F:
     """(N, 7) slab rows (σa, σs, g, n, d, n_above, n_below) → (N, 3) diffuse R, specular R, T."""
