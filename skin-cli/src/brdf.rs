@@ -42,7 +42,7 @@ fn parse_number(s: &str) -> Result<f32, String> {
 }
 
 /// clap parser for `--roughness`: the range check is brdf's own.
-fn parse_roughness(s: &str) -> Result<f32, String> {
+pub(crate) fn parse_roughness(s: &str) -> Result<f32, String> {
     brdf::check_roughness(parse_number(s)?).map_err(|e| e.to_string())
 }
 

@@ -23,6 +23,16 @@ pub enum ShapeChoice {
     MonteCarlo,
 }
 
+/// The surface the exact total is computed under (`--surface`, docs/physics.md §10.1).
+#[derive(clap::ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SurfaceChoice {
+    /// Fresnel faces: the model's smooth dielectric boundary.
+    Smooth,
+    /// The oily Torrance–Sparrow lobe (Beckmann slope `--roughness`, the skin's ρ_s) as the
+    /// boundary, as the renderer's default surface.
+    Oily,
+}
+
 /// Arguments of `skin profile`.
 #[derive(Args, Debug, Clone)]
 pub struct ProfileArgs {
@@ -65,6 +75,14 @@ pub struct ProfileArgs {
     /// reflectance).
     #[arg(long, value_name = "N", default_value_t = DEFAULT_SHAPE_ESCAPES, value_parser = Checked(parse_escapes), allow_hyphen_values = true)]
     pub escapes: u64,
+    /// Surface of the exact total: `smooth` (the default: Fresnel faces, the model's) or `oily`
+    /// (the oily lobe as the boundary, as the renderer's default surface; docs/physics.md §10.1).
+    /// Diffusion keeps Fresnel's.
+    #[arg(long, value_name = "SURFACE", value_enum, default_value_t = SurfaceChoice::Smooth)]
+    pub surface: SurfaceChoice,
+    /// Beckmann roughness m of the oily surface (`--surface oily`), (0, 1].
+    #[arg(long, value_name = "M", default_value_t = brdf::DEFAULT_ROUGHNESS, allow_hyphen_values = true, value_parser = Checked(crate::brdf::parse_roughness))]
+    pub roughness: f32,
     /// Print to stderr the treatment used and why (layer albedos, epidermis thickness in mean free
     /// paths, diffusion versus exact total, the exact profile's per-layer factors).
     #[arg(long)]
@@ -138,6 +156,13 @@ pub fn run(args: &ProfileArgs) -> anyhow::Result<()> {
                 escapes: args.escapes,
             },
             ShapeChoice::Table => ExactShape::Table(ShapeTableOptions::default()),
+        },
+        surface: match args.surface {
+            SurfaceChoice::Smooth => multipole::Surface::Fresnel,
+            SurfaceChoice::Oily => {
+                multipole::Surface::lobe(f64::from(args.roughness), skin.oiliness())
+                    .context("--roughness")?
+            }
         },
         ..ProfileOptions::default()
     };

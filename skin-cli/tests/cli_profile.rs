@@ -56,6 +56,38 @@ fn prints_csv_with_the_requested_samples() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("R_d = "));
 }
 
+/// `--surface oily` prints the total of adding-doubling under the oily lobe as the boundary
+/// (docs/physics.md §10.1, through the library), and it differs from the smooth surface's.
+#[test]
+fn the_oily_surface_sets_the_exact_total() {
+    let total = |out: std::process::Output| -> f64 {
+        let err = String::from_utf8_lossy(&out.stderr).into_owned();
+        let at = err.find("R_d = ").expect("an R_d line") + 6;
+        err[at..]
+            .split_whitespace()
+            .next()
+            .unwrap()
+            .parse()
+            .unwrap()
+    };
+    let oily = total(skin_ok(
+        "--preset light --lambda 650 --samples 4 --surface oily --roughness 0.35",
+    ));
+    let smooth = total(skin_ok("--preset light --lambda 650 --samples 4"));
+    let skin = skin_optics::SkinParams::preset(skin_optics::Preset::Light);
+    let medium = multipole::LayeredMedium::skin(
+        &skin,
+        skin_optics::Wavelength::new(650.0).unwrap(),
+        multipole::DEFAULT_G,
+    )
+    .unwrap()
+    .with_surface(multipole::Surface::lobe(0.35, skin.oiliness()).unwrap());
+    let want =
+        multipole::skin::medium_total_reflectance(&medium, multipole::Method::Exact).unwrap();
+    assert!((oily - want).abs() <= 1e-5, "{oily} vs {want}");
+    assert!(oily - smooth > 0.005, "oily {oily}, smooth {smooth}");
+}
+
 #[test]
 fn explicit_r_max_and_preset() {
     let out = skin_ok("--preset dark --lambda 650 --r-max 2 --samples 10");
@@ -73,6 +105,12 @@ fn bad_values_name_the_flag_and_range() {
         ("--lambda 500 --r-max -3", "--r-max", "[0.002, 10000]"),
         ("--lambda 500 --melanin 1.5", "--melanin", "[0, 1]"),
         ("--lambda 500 --method mcml", "--method", "multipole"),
+        (
+            "--lambda 500 --surface oily --roughness 0",
+            "--roughness",
+            "(0, 1]",
+        ),
+        ("--lambda 500 --surface rough", "--surface", "oily"),
     ] {
         let args: Vec<&str> = args.split_whitespace().collect();
         let out = skin(&args);
