@@ -435,6 +435,27 @@ mod against_the_walk {
     }
 }
 
+/// A 200 × 200 × 40 mm box of the skin `skin` (scene keys) tilted by `tilt_deg` about x under a
+/// uniform sky of spectral radiance 1, seen from 400 mm on +Z with a 1° field of view.
+fn box_under_a_sky(skin: &str, tilt_deg: f32) -> render::scene::Scene {
+    use render::volumetric::shapes::box_obj;
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("box.obj"), box_obj([200.0, 200.0, 40.0])).unwrap();
+    let text = SceneText::camera([0.0, 0.0, 400.0], 1.0)
+        .with("[environment]\nspectral_radiance = 1")
+        .skin("skin", skin)
+        .with(&format!(
+            "[[meshes]]\nfile = \"box.obj\"\nmaterial = \"skin\"\nrotate_deg = [{tilt_deg}, 0, 0]"
+        ));
+    render::scene::Scene::from_toml(
+        text.text(),
+        "box.toml",
+        Some(dir.path()),
+        &render::material::SkinKnobs::default(),
+    )
+    .unwrap()
+}
+
 /// A flat slab seen at 64° from its normal (tilted under a camera on +Z) under a uniform sky:
 /// by reciprocity each pixel is the slab's albedo for light from the camera's direction,
 /// F(θ) + (1 − F(θ)) R_d(θ), and the BSSRDF with the incidence gain (docs/physics.md §8.1) renders
@@ -443,21 +464,7 @@ mod against_the_walk {
 /// without the gain (`Incidence::Normal`) the BSSRDF was 4.8% ± 0.6% dark at 64°, 3.9% at 50°.
 #[test]
 fn tilted_slab_under_a_sky_matches_the_volumetric_walk() {
-    use render::material::SkinKnobs;
-    use render::volumetric::shapes::box_obj;
-    let dir = tempfile::tempdir().unwrap();
-    std::fs::write(dir.path().join("box.obj"), box_obj([200.0, 200.0, 40.0])).unwrap();
-    let text = SceneText::camera([0.0, 0.0, 400.0], 1.0)
-        .with("[environment]\nspectral_radiance = 1")
-        .skin("skin", against_the_walk::SKIN)
-        .with("[[meshes]]\nfile = \"box.obj\"\nmaterial = \"skin\"\nrotate_deg = [64, 0, 0]");
-    let scene = render::scene::Scene::from_toml(
-        text.text(),
-        "box.toml",
-        Some(dir.path()),
-        &SkinKnobs::default(),
-    )
-    .unwrap();
+    let scene = box_under_a_sky(against_the_walk::SKIN, 64.0);
     let (g, se) = against_the_walk::gap(&scene, 8, (256, 3072), 550.0, |_| true);
     assert!(
         g.abs() <= 0.005 + 3.0 * se,
@@ -473,10 +480,6 @@ fn tilted_slab_under_a_sky_matches_the_volumetric_walk() {
 /// boundary in the totals, the light skin was −3.66% ± 0.23% (the test fails there).
 #[test]
 fn oily_slab_under_a_sky_matches_the_volumetric_walk() {
-    use render::material::SkinKnobs;
-    use render::volumetric::shapes::box_obj;
-    let dir = tempfile::tempdir().unwrap();
-    std::fs::write(dir.path().join("box.obj"), box_obj([200.0, 200.0, 40.0])).unwrap();
     for (skin, nm) in [
         (
             "melanin = 0.02\neumelanin = 0.5\nhemoglobin = 0.01\nphase_g = 0",
@@ -487,17 +490,7 @@ fn oily_slab_under_a_sky_matches_the_volumetric_walk() {
             550.0,
         ),
     ] {
-        let text = SceneText::camera([0.0, 0.0, 400.0], 1.0)
-            .with("[environment]\nspectral_radiance = 1")
-            .skin("skin", skin)
-            .with("[[meshes]]\nfile = \"box.obj\"\nmaterial = \"skin\"");
-        let scene = render::scene::Scene::from_toml(
-            text.text(),
-            "box.toml",
-            Some(dir.path()),
-            &SkinKnobs::default(),
-        )
-        .unwrap();
+        let scene = box_under_a_sky(skin, 0.0);
         let (g, se) = against_the_walk::gap(&scene, 8, (256, 2048), nm, |_| true);
         assert!(
             g.abs() <= 0.005 + 3.0 * se,
