@@ -1,0 +1,120 @@
+//! The BSSRDF against the volumetric walk on thick, flat skin under a small lamp
+//! (docs/accuracy_evidence.md §7): a 60 × 60 × 20 mm box of light skin, seen at 45° from 300 mm,
+//! lit by the ear's back light (a 25-mm blackbody sphere, 230 mm away) at incidence θ_i and at
+//! azimuth φ from the camera's (180°: the lamp opposite the camera, as behind the ear; 0°: beside
+//! it). Per case: the frame's mean luminance of each integrator with its standard error (variance
+//! pass), the BSSRDF's error against the walk, and the CPU seconds.
+//!
+//! `cargo run --release -p render --features studies --example lamp_gap -- SIDE SPP REF_SPP
+//! [THETA_DEG,...] [PHI_DEG,...]`; environment: `SURFACE` (`smooth` (default) or `oily`), `NM` (one
+//! wavelength, nm; default the full spectrum), `PRESET` (default `light`), `LOBE` (the
+//! subsurface's forward lobe: `off` for the separable form alone).
+
+use render::integrator::{BodyIntegrator, IntegratorKind};
+use render::material::SkinKnobs;
+use render::renderer::{RenderOptions, render_with};
+use render::scene::Scene;
+
+fn main() -> anyhow::Result<()> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let num = |i: usize, d: u32| args.get(i).and_then(|s| s.parse().ok()).unwrap_or(d);
+    let (side, spp, ref_spp) = (num(0, 12) as usize, num(1, 256), num(2, 4096));
+    let list = |i: usize, d: &[f32]| -> Vec<f32> {
+        args.get(i).map_or_else(
+            || d.to_vec(),
+            |s| s.split(',').filter_map(|x| x.parse().ok()).collect(),
+        )
+    };
+    let thetas = list(3, &[60.0]);
+    let phis = list(4, &[180.0]);
+    let surface = std::env::var("SURFACE").unwrap_or_else(|_| "smooth".into());
+    let preset = std::env::var("PRESET").unwrap_or_else(|_| "light".into());
+    let nm: Option<f32> = std::env::var("NM").ok().and_then(|s| s.parse().ok());
+    let surface_key = match surface.as_str() {
+        "oily" => String::new(),
+        s => format!("surface = \"{s}\"\n"),
+    };
+    let knobs = SkinKnobs::default();
+    let dir = tempfile::tempdir()?;
+    let obj = dir.path().join("box.obj");
+    std::fs::write(
+        &obj,
+        render::volumetric::shapes::box_obj([60.0, 60.0, 20.0]),
+    )?;
+    println!(
+        "surface,theta_deg,phi_deg,bssrdf_y,bssrdf_se,walk_y,walk_se,error_pct,error_sigma,bssrdf_cpu_s,walk_cpu_s"
+    );
+    for &theta in &thetas {
+        for &phi in &phis {
+            let (t, p) = (theta.to_radians(), phi.to_radians());
+            let d = 230.0f32;
+            let lamp = [
+                d * t.sin() * p.cos(),
+                d * t.sin() * p.sin(),
+                10.0 + d * t.cos(),
+            ];
+            let toml = format!(
+                "[camera]\nposition_mm = [212, 0, 222]\nlook_at_mm = [0, 0, 10]\nfov_deg = 5\n\
+                 [environment]\nspectrum = \"d65\"\nintensity = 0.005\n\
+                 [materials.skin]\ntype = \"skin\"\npreset = \"{preset}\"\n{surface_key}\
+                 [[meshes]]\nfile = \"{}\"\nmaterial = \"skin\"\n[[lights]]\ntype = \"sphere\"\n\
+                 center_mm = [{}, {}, {}]\nradius_mm = 25\nspectrum = \"blackbody\"\n\
+                 temperature_k = 5000\nintensity = 400\n",
+                obj.display(),
+                lamp[0],
+                lamp[1],
+                lamp[2]
+            );
+            let scene = Scene::from_toml(&toml, "lamp.toml", None, &knobs)?;
+            let b = run(&scene, IntegratorKind::Bssrdf, side, spp, 1, nm)?;
+            let w = run(&scene, IntegratorKind::Volumetric, side, ref_spp, 2, nm)?;
+            let diff = b.0 / w.0 - 1.0;
+            let sigma = b.1.hypot(w.1) / w.0;
+            println!(
+                "{surface},{theta},{phi},{:.5},{:.5},{:.5},{:.5},{:+.2},{:+.1},{:.2},{:.2}",
+                b.0,
+                b.1,
+                w.0,
+                w.1,
+                100.0 * diff,
+                diff / sigma,
+                b.2,
+                w.2
+            );
+        }
+    }
+    Ok(())
+}
+
+/// (mean luminance over the frame, its standard error, process CPU seconds).
+fn run(
+    scene: &Scene,
+    kind: IntegratorKind,
+    side: usize,
+    spp: u32,
+    seed: u64,
+    nm: Option<f32>,
+) -> anyhow::Result<(f64, f64, f64)> {
+    let body = BodyIntegrator::build(scene, kind);
+    let opts = RenderOptions {
+        width: side,
+        height: side,
+        spp,
+        seed,
+        noise: None,
+        wavelength_nm: nm,
+        ..Default::default()
+    };
+    let t0 = cpu_time::ProcessTime::now();
+    let (film, _) = render_with(scene, &body, &opts.validate()?, None)?;
+    let cpu = t0.elapsed().as_secs_f64();
+    let n = (side * side) as f64;
+    let (mut sum, mut var) = (0.0, 0.0);
+    for y in 0..side {
+        for x in 0..side {
+            sum += f64::from(film.xyz(x, y)[1]);
+            var += film.variance(x, y);
+        }
+    }
+    Ok((sum / n, var.sqrt() / n, cpu))
+}
