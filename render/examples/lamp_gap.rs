@@ -11,6 +11,7 @@
 //! subsurface's forward lobe: `off` for the separable form alone).
 
 use render::integrator::{BodyIntegrator, IntegratorKind};
+use render::bssrdf::Azimuth;
 use render::material::SkinKnobs;
 use render::renderer::{RenderOptions, render_with};
 use render::scene::Scene;
@@ -25,6 +26,9 @@ fn main() -> anyhow::Result<()> {
             |s| s.split(',').filter_map(|x| x.parse().ok()).collect(),
         )
     };
+    if args.get(3).is_some_and(|s| s == "harmonics") {
+        return harmonics(&args);
+    }
     let thetas = list(3, &[60.0]);
     let phis = list(4, &[180.0]);
     let surface = std::env::var("SURFACE").unwrap_or_else(|_| "smooth".into());
@@ -41,8 +45,12 @@ fn main() -> anyhow::Result<()> {
         &obj,
         render::volumetric::shapes::box_obj([60.0, 60.0, 20.0]),
     )?;
+    let separable = SkinKnobs {
+        azimuth: Azimuth::Separable,
+        ..SkinKnobs::default()
+    };
     println!(
-        "surface,theta_deg,phi_deg,bssrdf_y,bssrdf_se,walk_y,walk_se,error_pct,error_sigma,bssrdf_cpu_s,walk_cpu_s"
+        "surface,theta_deg,phi_deg,separable_y,separable_se,lobe_y,lobe_se,walk_y,walk_se,separable_error_pct,separable_sigma,lobe_error_pct,lobe_sigma,bssrdf_cpu_s,walk_cpu_s"
     );
     for &theta in &thetas {
         for &phi in &phis {
@@ -66,20 +74,23 @@ fn main() -> anyhow::Result<()> {
                 lamp[2]
             );
             let scene = Scene::from_toml(&toml, "lamp.toml", None, &knobs)?;
+            let plain = Scene::from_toml(&toml, "lamp.toml", None, &separable)?;
+            let s = run(&plain, IntegratorKind::Bssrdf, side, spp, 1, nm)?;
             let b = run(&scene, IntegratorKind::Bssrdf, side, spp, 1, nm)?;
-            let w = run(&scene, IntegratorKind::Volumetric, side, ref_spp, 2, nm)?;
-            let diff = b.0 / w.0 - 1.0;
-            let sigma = b.1.hypot(w.1) / w.0;
+            let w = if ref_spp > 0 {
+                run(&scene, IntegratorKind::Volumetric, side, ref_spp, 2, nm)?
+            } else {
+                (f64::NAN, f64::NAN, 0.0)
+            };
+            let err = |r: (f64, f64, f64)| {
+                let diff = r.0 / w.0 - 1.0;
+                (100.0 * diff, diff / (r.1.hypot(w.1) / w.0))
+            };
+            let (es, ss) = err(s);
+            let (eb, sb) = err(b);
             println!(
-                "{surface},{theta},{phi},{:.5},{:.5},{:.5},{:.5},{:+.2},{:+.1},{:.2},{:.2}",
-                b.0,
-                b.1,
-                w.0,
-                w.1,
-                100.0 * diff,
-                diff / sigma,
-                b.2,
-                w.2
+                "{surface},{theta},{phi},{:.5},{:.5},{:.5},{:.5},{:.5},{:.5},{es:+.2},{ss:+.1},{eb:+.2},{sb:+.1},{:.2},{:.2}",
+                s.0, s.1, b.0, b.1, w.0, w.1, b.2, w.2
             );
         }
     }
@@ -117,4 +128,48 @@ fn run(
         }
     }
     Ok((sum / n, var.sqrt() / n, cpu))
+}
+
+/// `harmonics NM MU_I PHOTONS MAX_COLLISIONS`: the Monte Carlo's azimuthal harmonics of light
+/// skin at one wavelength and incidence against the separable form's value (smooth surface).
+fn harmonics(args: &[String]) -> anyhow::Result<()> {
+    use multipole::exact::montecarlo::{ObliqueOptions, azimuthal_harmonics};
+    let f = |i: usize, d: f64| args.get(i).and_then(|s| s.parse().ok()).unwrap_or(d);
+    let (nm, mu_i, photons, cap) = (f(4, 550.0), f(5, 0.5), f(6, 1e5) as u64, f(7, 64.0) as u32);
+    let toml = "[camera]\nposition_mm = [0, 0, 300]\nlook_at_mm = [0, 0, 0]\nfov_deg = 10\n\
+        [materials.skin]\ntype = \"skin\"\npreset = \"light\"\nsurface = \"smooth\"\n\
+        [[meshes]]\nshape = \"quad\"\nmaterial = \"skin\"\n";
+    let scene = Scene::from_toml(toml, "h.toml", None, &SkinKnobs::default())?;
+    let render::material::Material::Skin(skin) = &scene.materials[0] else {
+        anyhow::bail!("no skin");
+    };
+    let ss = skin.subsurface.as_ref().expect("BSSRDF");
+    let medium = skin
+        .media
+        .every_10nm()
+        .find(|(l, _)| (l - nm).abs() < 1e-6)
+        .map(|(_, m)| m.clone())
+        .expect("a 10-nm row");
+    let opts = ObliqueOptions::new(photons, cap, 4, 8, 7)?;
+    let t0 = cpu_time::ProcessTime::now();
+    let h = azimuthal_harmonics(&medium, mu_i, &opts)?;
+    let cpu = t0.elapsed().as_secs_f64();
+    let d = &ss.directional;
+    let nmf = nm as f32;
+    let a_i = d.incidence().map_or(1.0, |g| g.gain(mu_i as f32, nmf));
+    let r_tot = ss.table.total(nmf);
+    println!("escaped {:.4} (R_tot {r_tot:.4}), {cpu:.2} CPU-s", h.escaped);
+    println!("mu_o,F0/fsep,c1,c2,c3,c4,se_c1,M(0),M(90),M(180)");
+    for k in 0..opts.bins() {
+        let mu_o = opts.bin_mu(k) as f32;
+        let fsep = f64::from(a_i * r_tot * d.factor(mu_o, nmf) / (d.normalisation_at(nmf) * std::f32::consts::PI));
+        let c: Vec<f64> = (0..=4).map(|m| h.f[m][k] / fsep).collect();
+        let m_at = |phi: f64| 1.0 + 2.0 * (1..=4).map(|m| c[m] * (m as f64 * phi).cos()).sum::<f64>();
+        println!(
+            "{mu_o:.3},{:.4},{:+.4},{:+.4},{:+.4},{:+.4},{:.4},{:.4},{:.4},{:.4}",
+            c[0], c[1], c[2], c[3], c[4], h.se[1][k] / fsep,
+            m_at(0.0), m_at(std::f64::consts::FRAC_PI_2), m_at(std::f64::consts::PI)
+        );
+    }
+    Ok(())
 }

@@ -8,6 +8,8 @@
 //! - [`separable`]: S = T(θ_o) R(r) S_ω(ω_i), the energy split with the specular layer, the texture.
 //! - [`incidence`]: the gain a(θ, λ) of the total at oblique incidence that multiplies T.
 //! - [`curvature`]: the first-order term 1 + κ(λ) h of a curved surface that multiplies R(r).
+//! - [`azimuth`]: the lobe M(μ_i, μ_o, φ) of light leaving forward, away from an oblique light,
+//!   that multiplies S_ω.
 //!
 //! [`Subsurface`] ties them together for a path tracer in the manner of pbrt-v4's `SampleSp` →
 //! intersect → `ProbeIntersectionToSample`: [`Subsurface::sample_probe`] says which segment to
@@ -42,6 +44,7 @@
 //! ([`curvature`]) multiplies each found exit by 1 + κ h on top. Thin geometry needs nothing special: the normal probe
 //! crosses it and finds the far side, so backlit ears transmit (red) light.
 
+pub mod azimuth;
 pub mod curvature;
 pub mod extent;
 pub mod grid;
@@ -50,6 +53,7 @@ pub mod sampling;
 pub mod separable;
 pub mod table;
 
+pub use azimuth::{Azimuth, AzimuthOptions, AzimuthalLobe};
 pub use curvature::{Curvature, CurvatureGain};
 pub use grid::{Corners, ProfileGrid};
 pub use incidence::{Incidence, IncidenceGain};
@@ -83,6 +87,8 @@ pub struct Subsurface {
     pub directional: Directional,
     /// The curvature term's κ(λ) (`None`: the planar profile, [`Curvature::Planar`]).
     pub curvature: Option<CurvatureGain>,
+    /// The azimuthal lobe (`None`: the separable form alone, [`Azimuth::Separable`]).
+    pub azimuth: Option<Arc<AzimuthalLobe>>,
 }
 
 /// Where a subsurface path leaves the skin toward the entry point.
@@ -149,7 +155,15 @@ impl Subsurface {
             table,
             directional,
             curvature: None,
+            azimuth: None,
         }
+    }
+
+    /// The same model with the azimuthal lobe `lobe` (docs/physics.md §8.3).
+    #[must_use]
+    pub fn with_azimuth(mut self, lobe: Arc<AzimuthalLobe>) -> Self {
+        self.azimuth = Some(lobe);
+        self
     }
 
     /// The same model with the first-order curvature term of `gain` (docs/physics.md §8.2).

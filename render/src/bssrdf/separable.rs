@@ -101,6 +101,12 @@ impl Directional {
         self.incidence.as_ref().map(|(g, _)| g.as_ref())
     }
 
+    /// The incidence gain, shared (to build another split with the same gain).
+    #[must_use]
+    pub fn incidence_arc(&self) -> Option<Arc<IncidenceGain>> {
+        self.incidence.as_ref().map(|(g, _)| Arc::clone(g))
+    }
+
     /// The energy split in use.
     #[must_use]
     pub fn split(&self) -> EnergySplit {

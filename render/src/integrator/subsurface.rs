@@ -14,7 +14,50 @@ use crate::sampler::PathSampler;
 use crate::sampling::cosine_hemisphere;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use brdf::Frame;
+use glam::Vec3;
 use std::f32::consts::FRAC_1_PI;
+
+/// Where the light a BSSRDF sample carries leaves toward the viewer, for the azimuthal lobe
+/// (`bssrdf::azimuth`): the cosine at the point it leaves from and its horizontal direction of
+/// travel (unit, in that point's tangent plane). On curved skin the lobe compares it with the
+/// incident light's horizontal direction in the entry point's tangent plane: the two planes are
+/// taken as parallel, as the profile takes the surface between them as flat.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Outgoing {
+    mu: f32,
+    along: Vec3,
+}
+
+impl Outgoing {
+    /// The direction `wo` leaving a point of outward shading normal `n` (None along the normal,
+    /// where the lobe is 1, or below the surface).
+    pub(super) fn new(wo: Vec3, n: Vec3) -> Option<Self> {
+        let mu = wo.dot(n);
+        let h = wo - mu * n;
+        let len = h.length();
+        (mu > 0.0 && len > 1e-6).then(|| Self {
+            mu: mu.min(1.0),
+            along: h / len,
+        })
+    }
+
+    /// M at the incident direction `wi` (toward the light) at a point of normal `n`, cosine
+    /// `cos_i` there, per lane (1 without a lobe or along the normal).
+    fn lobe(
+        self,
+        ss: &Subsurface,
+        wi: Vec3,
+        n: Vec3,
+        cos_i: f32,
+        wl: &SampledWavelengths,
+    ) -> Option<SampledSpectrum> {
+        let lobe = ss.azimuth.as_ref()?;
+        // The incident light travels along −wi: its horizontal direction of travel.
+        let h = cos_i * n - wi;
+        let len = h.length();
+        (len > 1e-6).then(|| lobe.modulations(cos_i, self.mu, h.dot(self.along) / len, wl))
+    }
+}
 
 impl PathTracer<'_> {
     /// The BSSRDF branch at `hit` (a skin with a BSSRDF): the first probe's exit, the light at
@@ -34,6 +77,7 @@ impl PathTracer<'_> {
             return Step::Surface;
         };
         let found = self.subsurface_exit(skin, ss, hit, wl, (&mut *sampler, &mut *rays));
+        let outgoing = Outgoing::new(hit.wo, hit.ns);
         // Further probes at the same skin hit (splitting): each gathers the light at its own exit
         // point from its own scrambled sequence; the mean over the probes is the estimate, and
         // the continuation keeps the first probe's exit.
@@ -59,6 +103,7 @@ impl PathTracer<'_> {
                         wl,
                         (&mut fork, &mut *rays),
                         &mut path.exit_pick,
+                        outgoing,
                     );
                     path.l += path.beta * w * direct * light_scale;
                 }
@@ -79,12 +124,21 @@ impl PathTracer<'_> {
             wl,
             (&mut *sampler, &mut *rays),
             &mut path.exit_pick,
+            outgoing,
         );
         path.l += beta_exit * direct * light_scale;
         if !hit.take_sss {
             return Step::Surface;
         }
-        self.continue_from_exit(path, hit, ss, &exit, (beta_exit, lit_exit), (wl, sampler))
+        self.continue_from_exit(
+            path,
+            hit,
+            ss,
+            &exit,
+            (beta_exit, lit_exit),
+            (wl, sampler),
+            outgoing,
+        )
     }
 
     /// The subsurface branch was taken: continue from `exit` in a cosine-weighted direction
@@ -98,6 +152,7 @@ impl PathTracer<'_> {
         exit: &Exit,
         (beta_exit, lit_exit): (SampledSpectrum, bool),
         (wl, sampler): (&SampledWavelengths, &mut PathSampler),
+        outgoing: Option<Outgoing>,
     ) -> Step {
         let (eng, ens) = (exit.ng, exit.ns);
         sampler.seek(dims::EXIT_CONTINUATION);
@@ -106,7 +161,11 @@ impl PathTracer<'_> {
         if local.z <= 0.0 || wi.dot(eng) <= 0.0 {
             return Step::Stop;
         }
-        path.beta = beta_exit * ss.directional.cosine_sample_weights(local.z, wl) / hit.q_sss;
+        let mut w = ss.directional.cosine_sample_weights(local.z, wl);
+        if let Some(m) = outgoing.and_then(|o| o.lobe(ss, wi, ens, local.z, wl)) {
+            w *= m;
+        }
+        path.beta = beta_exit * w / hit.q_sss;
         let vertex = (exit.p, ens, local.z * FRAC_1_PI);
         PrevVertex::record(
             &mut path.prev,
@@ -193,6 +252,7 @@ impl PathTracer<'_> {
         wl: &SampledWavelengths,
         (sampler, rays): (&mut PathSampler, &mut u64),
         pick: &mut Vec<f32>,
+        outgoing: Option<Outgoing>,
     ) -> (SampledSpectrum, bool) {
         let scene = self.scene;
         let n_lights = scene.lights.len() + usize::from(scene.environment.is_some());
@@ -230,10 +290,11 @@ impl PathTracer<'_> {
                 (&mut *sampler, &mut *rays),
                 |wi| {
                     let c = wi.dot(ens);
-                    (
-                        ss.directional.s_omegas(c, wl) * c.max(0.0),
-                        c.max(0.0) * FRAC_1_PI,
-                    )
+                    let mut f = ss.directional.s_omegas(c, wl) * c.max(0.0);
+                    if let Some(m) = outgoing.and_then(|o| o.lobe(ss, wi, ens, c, wl)) {
+                        f *= m;
+                    }
+                    (f, c.max(0.0) * FRAC_1_PI)
                 },
             );
         }

@@ -65,9 +65,18 @@ impl PathTracer<'_> {
                 wl,
                 (&mut *sampler, &mut *rays),
                 &mut path.exit_pick,
+                None,
             );
             path.l += beta_exit * direct / hit.q_sss;
-            return self.continue_from_exit(path, hit, ss, &at, (beta_exit, lit), (wl, sampler));
+            return self.continue_from_exit(
+                path,
+                hit,
+                ss,
+                &at,
+                (beta_exit, lit),
+                (wl, sampler),
+                None,
+            );
         }
         path.beta = beta_exit / hit.q_sss;
         // No light was sampled at the exit: emission found next takes MIS weight 1.

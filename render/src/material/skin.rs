@@ -9,7 +9,8 @@
 //! on the same 10-nm grid.
 
 use crate::bssrdf::{
-    Curvature, CurvatureGain, Directional, EnergySplit, Incidence, IncidenceGain, Subsurface,
+    Azimuth, AzimuthOptions, AzimuthalLobe, Curvature, CurvatureGain, Directional, EnergySplit,
+    Incidence, IncidenceGain, Subsurface,
 };
 use crate::fidelity::SKIN_TABLE_STEP_NM;
 use crate::fidelity::wavelengths::FROM_NM;
@@ -51,6 +52,9 @@ pub struct SkinKnobs {
     /// Whether the BSSRDF's profile carries the first-order curvature term (default on,
     /// docs/physics.md §8.2).
     pub curvature: Curvature,
+    /// Whether the BSSRDF carries the azimuthal lobe of oblique light (default on,
+    /// docs/physics.md §8.3).
+    pub azimuth: Azimuth,
 }
 
 /// Why a skin material could not be built.
@@ -156,6 +160,14 @@ impl SkinMaterial {
             Curvature::Planar => subsurface,
             Curvature::FirstOrder => subsurface.with_curvature(CurvatureGain::new(&media)),
         };
+        let subsurface = match knobs.azimuth {
+            Azimuth::Separable => subsurface,
+            Azimuth::Harmonics => {
+                let lobe = azimuthal_lobe(&media, &directional, surface.clone(), &subsurface)
+                    .map_err(SkinBuildError::Profiles)?;
+                subsurface.with_azimuth(Arc::new(lobe))
+            }
+        };
         let mut skin = Self::new(params, surface, totals, albedo_texture, media)
             .with_surface_kind(knobs.surface)
             .with_directional(directional)
@@ -257,6 +269,34 @@ fn boundary_of(kind: SurfaceKind, lobe: &TorranceSparrow) -> multipole::Surface 
         },
         SurfaceKind::Smooth => multipole::Surface::Fresnel,
     }
+}
+
+/// The azimuthal lobe of the skin layers `media` (docs/physics.md §8.3), fitted against the
+/// separable form with the Fresnel split and the incidence gain of `directional`, and the
+/// totals of `subsurface`'s table.
+fn azimuthal_lobe(
+    media: &SkinMedia,
+    directional: &Directional,
+    surface: TorranceSparrow,
+    subsurface: &Subsurface,
+) -> Result<AzimuthalLobe, multipole::MultipoleError> {
+    let rows: Vec<(f64, &multipole::LayeredMedium)> = media.every_10nm().collect();
+    let fresnel = Directional::new(surface, EnergySplit::Fresnel);
+    let fresnel = match directional.incidence_arc() {
+        Some(g) => fresnel.with_incidence(g),
+        None => fresnel,
+    };
+    AzimuthalLobe::build(
+        |nm| {
+            rows.iter()
+                .min_by(|a, b| (a.0 - nm).abs().total_cmp(&(b.0 - nm).abs()))
+                .map(|r| r.1)
+                .expect("the 10-nm rows are never empty")
+        },
+        &fresnel,
+        |nm| subsurface.table.total(nm),
+        AzimuthOptions::default(),
+    )
 }
 
 /// The energy split of surface model `kind`: the oily lobe's own, or Fresnel's.

@@ -26,10 +26,12 @@
 //! instruction set) and `rayon`: it lives in `multipole` because `Method::Exact` profiles use it;
 //! `validation` compares with it.
 
+mod oblique;
 mod tally;
 mod transport;
 
 pub use crate::layered::{DEFAULT_G, Layer, LayeredMedium};
+pub use oblique::{Harmonics, ObliqueOptions, azimuthal_harmonics};
 pub use tally::{Estimate, McResult, RadialGrid, RadialProfile};
 pub(crate) use transport::white::{WhiteMedium, trace_white};
 pub use transport::{HgSampler, ROULETTE_SURVIVAL, ROULETTE_THRESHOLD, scatter_direction};
