@@ -29,6 +29,9 @@ fn main() -> anyhow::Result<()> {
     if args.get(3).is_some_and(|s| s == "harmonics") {
         return harmonics(&args);
     }
+    if args.get(3).is_some_and(|s| s == "ear") {
+        return ear(side, spp, ref_spp);
+    }
     let thetas = list(3, &[60.0]);
     let phis = list(4, &[180.0]);
     let surface = std::env::var("SURFACE").unwrap_or_else(|_| "smooth".into());
@@ -95,6 +98,136 @@ fn main() -> anyhow::Result<()> {
         }
     }
     Ok(())
+}
+
+/// The ear close-up of `thin_slabs ear` (light skin, `SURFACE`, no albedo texture, 9° field on
+/// the ear), its pixels split by the centre ray's hit: "thin" (the inward normal meets skin again
+/// within 10 mm), "lit" (thick, the back light's centre in view above the surface) and "shade"
+/// (the rest); per region the mean of the walk, the separable BSSRDF and the lobe.
+fn ear(side: usize, spp: u32, ref_spp: u32) -> anyhow::Result<()> {
+    use glam::Vec2;
+    use render::geometry::offset_origin;
+    use render::scene::Hit;
+    let surface = std::env::var("SURFACE").unwrap_or_else(|_| "smooth".into());
+    let toml: String = render::builtin::EAR
+        .lines()
+        .filter(|l| !l.trim_start().starts_with("albedo_texture"))
+        .map(|l| match l.trim() {
+            "type = \"skin\"" if surface != "oily" => format!("{l}\nsurface = \"{surface}\""),
+            "look_at_mm = [-70, 35, -10]" => "look_at_mm = [-65, 57, 3]".to_string(),
+            "fov_deg = 22" => "fov_deg = 9".to_string(),
+            _ => l.to_string(),
+        })
+        .collect::<Vec<_>>()
+        .join("\n");
+    let knobs = SkinKnobs::default();
+    let separable = SkinKnobs {
+        azimuth: Azimuth::Separable,
+        ..SkinKnobs::default()
+    };
+    let scene = Scene::from_toml(&toml, "ear.toml", None, &knobs)?;
+    let plain = Scene::from_toml(&toml, "ear.toml", None, &separable)?;
+    let lamp = glam::Vec3::new(-110.0, 60.0, -220.0);
+    let mut class = Vec::with_capacity(side * side);
+    let mut cosines = (0.0f64, 0.0f64, 0.0f64);
+    for y in 0..side {
+        for x in 0..side {
+            let ndc = Vec2::new((x as f32 + 0.5) / side as f32, (y as f32 + 0.5) / side as f32);
+            let (o, d) = scene.camera.generate_ray(ndc, 1.0, Vec2::ZERO);
+            let c = match scene.intersect(o, d, 0.0, f32::INFINITY) {
+                Some(Hit::Surface(si))
+                    if matches!(
+                        scene.materials[si.material as usize],
+                        render::material::Material::Skin(_)
+                    ) =>
+                {
+                    let ng = if si.ng.dot(d) > 0.0 { -si.ng } else { si.ng };
+                    let thin = scene
+                        .geometry
+                        .intersect(offset_origin(si.p, ng, -ng), -ng, 0.0, 10.0)
+                        .is_some_and(|f| f.material == si.material);
+                    let to = lamp - si.p;
+                    let dist = to.length();
+                    let l = to / dist;
+                    let lit = l.dot(ng) > 0.0
+                        && !scene
+                            .geometry
+                            .occluded(offset_origin(si.p, ng, l), l, dist - 30.0);
+                    if lit && !thin {
+                        let ns = if si.ns.dot(ng) < 0.0 { -si.ns } else { si.ns };
+                        cosines.0 += f64::from(l.dot(ng));
+                        cosines.1 += f64::from(l.dot(ns).max(0.0));
+                        cosines.2 += 1.0;
+                    }
+                    if thin { 0 } else if lit { 1 } else { 2 }
+                }
+                _ => 3,
+            };
+            class.push(c);
+        }
+    }
+    let region = |film: &(Vec<(f64, f64)>, f64), c: usize| {
+        let (mut n, mut sum, mut var) = (0.0, 0.0, 0.0);
+        for (p, &k) in film.0.iter().zip(&class) {
+            if k == c {
+                n += 1.0;
+                sum += p.0;
+                var += p.1;
+            }
+        }
+        (sum / f64::max(n, 1.0), var.sqrt() / f64::max(n, 1.0), n)
+    };
+    println!(
+        "# lit pixels: mean cos to the lamp, face normal {:.4}, shading normal {:.4}",
+        cosines.0 / cosines.2,
+        cosines.1 / cosines.2
+    );
+    println!("configuration,spp,region,pixels,mean_y,se,cpu_s");
+    let rows: Vec<(&str, &Scene, IntegratorKind, u32, u64)> = vec![
+        ("walk", &scene, IntegratorKind::Volumetric, ref_spp, 2),
+        ("separable", &plain, IntegratorKind::Bssrdf, spp, 1),
+        ("lobe", &scene, IntegratorKind::Bssrdf, spp, 1),
+    ];
+    for (label, sc, kind, n, seed) in rows {
+        if n == 0 {
+            continue;
+        }
+        let film = pixels(sc, kind, side, n, seed)?;
+        for (c, name) in ["thin", "lit", "shade", "other"].iter().enumerate() {
+            let (m, se, px) = region(&film, c);
+            println!("{label},{n},{name},{px},{m:.5},{se:.5},{:.2}", film.1);
+        }
+    }
+    Ok(())
+}
+
+/// Each pixel's (luminance, variance of its mean) and the process CPU seconds.
+fn pixels(
+    scene: &Scene,
+    kind: IntegratorKind,
+    side: usize,
+    spp: u32,
+    seed: u64,
+) -> anyhow::Result<(Vec<(f64, f64)>, f64)> {
+    let body = BodyIntegrator::build(scene, kind);
+    let opts = RenderOptions {
+        width: side,
+        height: side,
+        spp,
+        seed,
+        noise: None,
+        ..Default::default()
+    };
+    let t0 = cpu_time::ProcessTime::now();
+    let (film, _) = render_with(scene, &body, &opts.validate()?, None)?;
+    let cpu = t0.elapsed().as_secs_f64();
+    let mut px = Vec::with_capacity(side * side);
+    for y in 0..side {
+        for x in 0..side {
+            px.push((f64::from(film.xyz(x, y)[1]), film.variance(x, y)));
+        }
+    }
+    Ok((px, cpu))
 }
 
 /// (mean luminance over the frame, its standard error, process CPU seconds).
