@@ -10,8 +10,8 @@
 //! wavelength, nm; default the full spectrum), `PRESET` (default `light`), `LOBE` (the
 //! subsurface's forward lobe: `off` for the separable form alone).
 
-use render::integrator::{BodyIntegrator, IntegratorKind};
 use render::bssrdf::Azimuth;
+use render::integrator::{BodyIntegrator, IntegratorKind};
 use render::material::SkinKnobs;
 use render::renderer::{RenderOptions, render_with};
 use render::scene::Scene;
@@ -29,6 +29,9 @@ fn main() -> anyhow::Result<()> {
     if args.get(3).is_some_and(|s| s == "harmonics") {
         return harmonics(&args);
     }
+    if args.get(3).is_some_and(|s| s == "coefficients") {
+        return coefficients(&args);
+    }
     if args.get(3).is_some_and(|s| s == "ear") {
         return ear(side, spp, ref_spp);
     }
@@ -44,10 +47,19 @@ fn main() -> anyhow::Result<()> {
     let knobs = SkinKnobs::default();
     let dir = tempfile::tempdir()?;
     let obj = dir.path().join("box.obj");
-    std::fs::write(
-        &obj,
-        render::volumetric::shapes::box_obj([60.0, 60.0, 20.0]),
-    )?;
+    // SPHERE=R: an icosphere of radius R mm with its top where the box's is (z = 10 mm).
+    let sphere: Option<f32> = std::env::var("SPHERE").ok().and_then(|s| s.parse().ok());
+    let (mesh, place) = match sphere {
+        Some(r) => (
+            render::volumetric::shapes::sphere_obj(6, r),
+            format!("translate_mm = [0, 0, {}]\n", 10.0 - r),
+        ),
+        None => (
+            render::volumetric::shapes::box_obj([60.0, 60.0, 20.0]),
+            String::new(),
+        ),
+    };
+    std::fs::write(&obj, mesh)?;
     let separable = SkinKnobs {
         azimuth: Azimuth::Separable,
         ..SkinKnobs::default()
@@ -68,7 +80,7 @@ fn main() -> anyhow::Result<()> {
                 "[camera]\nposition_mm = [212, 0, 222]\nlook_at_mm = [0, 0, 10]\nfov_deg = 5\n\
                  [environment]\nspectrum = \"d65\"\nintensity = 0.005\n\
                  [materials.skin]\ntype = \"skin\"\npreset = \"{preset}\"\n{surface_key}\
-                 [[meshes]]\nfile = \"{}\"\nmaterial = \"skin\"\n[[lights]]\ntype = \"sphere\"\n\
+                 [[meshes]]\nfile = \"{}\"\nmaterial = \"skin\"\n{place}[[lights]]\ntype = \"sphere\"\n\
                  center_mm = [{}, {}, {}]\nradius_mm = 25\nspectrum = \"blackbody\"\n\
                  temperature_k = 5000\nintensity = 400\n",
                 obj.display(),
@@ -128,11 +140,39 @@ fn ear(side: usize, spp: u32, ref_spp: u32) -> anyhow::Result<()> {
     let scene = Scene::from_toml(&toml, "ear.toml", None, &knobs)?;
     let plain = Scene::from_toml(&toml, "ear.toml", None, &separable)?;
     let lamp = glam::Vec3::new(-110.0, 60.0, -220.0);
+    {
+        // Open edges of the skin's mesh (vertices welded by their bits): the walk needs it closed.
+        let skin_id = scene
+            .materials
+            .iter()
+            .position(|m| matches!(m, render::material::Material::Skin(_)))
+            .unwrap_or(0) as u32;
+        let tris = scene.geometry.triangles_of(skin_id);
+        let key = |v: glam::Vec3| (v.x.to_bits(), v.y.to_bits(), v.z.to_bits());
+        let mut edges = std::collections::HashMap::new();
+        for t in &tris {
+            for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
+                let (ka, kb) = (key(a), key(b));
+                let e = if ka < kb { (ka, kb) } else { (kb, ka) };
+                *edges.entry(e).or_insert(0u32) += 1;
+            }
+        }
+        let open = edges.values().filter(|&&c| c == 1).count();
+        let many = edges.values().filter(|&&c| c > 2).count();
+        println!(
+            "# skin mesh: {} triangles, {} edges, {open} open, {many} shared by more than two",
+            tris.len(),
+            edges.len()
+        );
+    }
     let mut class = Vec::with_capacity(side * side);
     let mut cosines = (0.0f64, 0.0f64, 0.0f64);
     for y in 0..side {
         for x in 0..side {
-            let ndc = Vec2::new((x as f32 + 0.5) / side as f32, (y as f32 + 0.5) / side as f32);
+            let ndc = Vec2::new(
+                (x as f32 + 0.5) / side as f32,
+                (y as f32 + 0.5) / side as f32,
+            );
             let (o, d) = scene.camera.generate_ray(ndc, 1.0, Vec2::ZERO);
             let c = match scene.intersect(o, d, 0.0, f32::INFINITY) {
                 Some(Hit::Surface(si))
@@ -159,7 +199,13 @@ fn ear(side: usize, spp: u32, ref_spp: u32) -> anyhow::Result<()> {
                         cosines.1 += f64::from(l.dot(ns).max(0.0));
                         cosines.2 += 1.0;
                     }
-                    if thin { 0 } else if lit { 1 } else { 2 }
+                    if thin {
+                        0
+                    } else if lit {
+                        1
+                    } else {
+                        2
+                    }
                 }
                 _ => 3,
             };
@@ -291,18 +337,83 @@ fn harmonics(args: &[String]) -> anyhow::Result<()> {
     let nmf = nm as f32;
     let a_i = d.incidence().map_or(1.0, |g| g.gain(mu_i as f32, nmf));
     let r_tot = ss.table.total(nmf);
-    println!("escaped {:.4} (R_tot {r_tot:.4}), {cpu:.2} CPU-s", h.escaped);
+    println!(
+        "escaped {:.4} (R_tot {r_tot:.4}), {cpu:.2} CPU-s",
+        h.escaped
+    );
     println!("mu_o,F0/fsep,c1,c2,c3,c4,se_c1,M(0),M(90),M(180)");
     for k in 0..opts.bins() {
         let mu_o = opts.bin_mu(k) as f32;
-        let fsep = f64::from(a_i * r_tot * d.factor(mu_o, nmf) / (d.normalisation_at(nmf) * std::f32::consts::PI));
+        let fsep = f64::from(
+            a_i * r_tot * d.factor(mu_o, nmf) / (d.normalisation_at(nmf) * std::f32::consts::PI),
+        );
         let c: Vec<f64> = (0..=4).map(|m| h.f[m][k] / fsep).collect();
-        let m_at = |phi: f64| 1.0 + 2.0 * (1..=4).map(|m| c[m] * (m as f64 * phi).cos()).sum::<f64>();
+        let m_at =
+            |phi: f64| 1.0 + 2.0 * (1..=4).map(|m| c[m] * (m as f64 * phi).cos()).sum::<f64>();
         println!(
             "{mu_o:.3},{:.4},{:+.4},{:+.4},{:+.4},{:+.4},{:.4},{:.4},{:.4},{:.4}",
-            c[0], c[1], c[2], c[3], c[4], h.se[1][k] / fsep,
-            m_at(0.0), m_at(std::f64::consts::FRAC_PI_2), m_at(std::f64::consts::PI)
+            c[0],
+            c[1],
+            c[2],
+            c[3],
+            c[4],
+            h.se[1][k] / fsep,
+            m_at(0.0),
+            m_at(std::f64::consts::FRAC_PI_2),
+            m_at(std::f64::consts::PI)
         );
+    }
+    Ok(())
+}
+
+/// `coefficients PHOTONS MAX_COLLISIONS [PRESET]`: the lobe's fitted A₁, A₂ per row for those
+/// Monte Carlo settings (smooth surface), and the CPU seconds of the fit.
+fn coefficients(args: &[String]) -> anyhow::Result<()> {
+    use render::bssrdf::azimuth::AZIMUTH_ROWS_NM;
+    use render::bssrdf::{AzimuthOptions, AzimuthalLobe, Directional, EnergySplit};
+    let f = |i: usize, d: f64| args.get(i).and_then(|s| s.parse().ok()).unwrap_or(d);
+    let (photons, cap) = (f(4, 2e4) as u64, f(5, 128.0) as u32);
+    let preset = args.get(6).map_or("light", String::as_str);
+    let toml = format!(
+        "[camera]\nposition_mm = [0, 0, 300]\nlook_at_mm = [0, 0, 0]\nfov_deg = 10\n\
+         [materials.skin]\ntype = \"skin\"\npreset = \"{preset}\"\nsurface = \"smooth\"\n\
+         [[meshes]]\nshape = \"quad\"\nmaterial = \"skin\"\n"
+    );
+    let knobs = SkinKnobs {
+        azimuth: Azimuth::Separable,
+        ..SkinKnobs::default()
+    };
+    let scene = Scene::from_toml(&toml, "c.toml", None, &knobs)?;
+    let render::material::Material::Skin(skin) = &scene.materials[0] else {
+        anyhow::bail!("no skin");
+    };
+    let ss = skin.subsurface.as_ref().expect("BSSRDF");
+    let fresnel = Directional::new(skin.surface.clone(), EnergySplit::Fresnel);
+    let fresnel = match ss.directional.incidence_arc() {
+        Some(g) => fresnel.with_incidence(g),
+        None => fresnel,
+    };
+    let rows: Vec<(f64, &multipole::LayeredMedium)> = skin.media.every_10nm().collect();
+    let t0 = cpu_time::ProcessTime::now();
+    let lobe = AzimuthalLobe::build(
+        |nm| {
+            rows.iter()
+                .find(|r| (r.0 - nm).abs() < 1e-6)
+                .expect("row")
+                .1
+        },
+        &fresnel,
+        |nm| ss.table.total(nm),
+        AzimuthOptions {
+            photons,
+            max_collisions: cap,
+        },
+    )?;
+    let cpu = t0.elapsed().as_secs_f64();
+    println!("preset,photons,max_collisions,nm,a1,a2,cpu_s");
+    for nm in AZIMUTH_ROWS_NM {
+        let [a1, a2] = lobe.coefficients(nm as f32);
+        println!("{preset},{photons},{cap},{nm},{a1:.4},{a2:.4},{cpu:.2}");
     }
     Ok(())
 }

@@ -52,6 +52,12 @@ fn slab(preset: &str, to_light: Vec3, camera: Vec3) -> render::scene::Scene {
 /// `render::bssrdf::separable`, docs/physics.md §8.1; R_tot and a under the oily boundary, §10.1,
 /// as the scene's tables use).
 fn slab_closed_form(preset: &str, wi: Vec3, wo: Vec3) -> [f64; 3] {
+    slab_closed_form_with(preset, wi, wo, |_| 1.0)
+}
+
+/// [`slab_closed_form`] with the subsurface term multiplied by `lobe(λ)` (the azimuthal lobe M at
+/// the slab's angles, docs/physics.md §8.3).
+fn slab_closed_form_with(preset: &str, wi: Vec3, wo: Vec3, lobe: impl Fn(f32) -> f64) -> [f64; 3] {
     let skin = SkinParams::preset(preset.parse::<Preset>().unwrap());
     let ts = brdf::TorranceSparrow::new(
         brdf::DEFAULT_ROUGHNESS,
@@ -74,7 +80,7 @@ fn slab_closed_form(preset: &str, wi: Vec3, wo: Vec3) -> [f64; 3] {
                 / (std::f32::consts::PI * dir.normalisation_at(l)),
         );
         let rd = oily_total(&skin, nm);
-        d65(nm) / d65_y * cos_i * (specular + split * rd)
+        d65(nm) / d65_y * cos_i * (specular + split * rd * lobe(l))
     })
 }
 
@@ -662,4 +668,46 @@ fn curvature_term_on_a_sphere_renders_its_closed_form() {
         rel.abs() <= 4.0 * se + 3e-3,
         "rendered / closed form − 1 = {rel:+.4} ± {se:.4} (G = {gain:.4})"
     );
+}
+
+/// A light at 60° on the far side of the slab from a camera at 45° (the light travels toward the
+/// camera, as the ear's back light does) and on the camera's side: the slab renders to
+/// E cos θ_i [f_s + T a T a R_tot M / (π c)] with the material's own lobe M(μ_i, μ_o, φ)
+/// (docs/physics.md §8.3; cos φ = +1 far, −1 near) within 2% per channel, two-sided (the tolerance
+/// of the oblique case above), and M moves each case by more than that 2% (about +5% far, −4%
+/// near), so a lobe applied at the wrong azimuth or not at all fails.
+#[test]
+fn flat_slab_under_a_far_side_light_carries_the_azimuthal_lobe() {
+    let (si, ci) = 60f32.to_radians().sin_cos();
+    let (so, co) = 45f32.to_radians().sin_cos();
+    let wo = Vec3::new(so, 0.0, co);
+    for (wi, cos_phi) in [
+        (Vec3::new(-si, 0.0, ci), 1.0),
+        (Vec3::new(si, 0.0, ci), -1.0),
+    ] {
+        let scene = slab("light", wi, wo * 500.0);
+        let Material::Skin(skin) = &scene.materials[0] else {
+            panic!("skin");
+        };
+        let lobe = skin
+            .subsurface
+            .as_ref()
+            .and_then(|s| s.azimuth.clone())
+            .expect("the lobe is on by default");
+        let m = |nm: f32| f64::from(lobe.modulation(wi.z, wo.z, cos_phi, nm));
+        let want = slab_closed_form_with("light", wi, wo, m);
+        let separable = slab_closed_form("light", wi, wo);
+        let got = mean_xyz(&run(&scene, 32, 32, 48, SEED));
+        for c in 0..3 {
+            assert!(
+                (got[c] - want[c]).abs() <= 0.02 * want[c],
+                "cos φ {cos_phi}: channel {c}: {got:?} vs {want:?}"
+            );
+        }
+        let moved = want[1] / separable[1] - 1.0;
+        assert!(
+            moved.abs() > 0.02 && moved.signum() == f64::from(cos_phi),
+            "cos φ {cos_phi}: the lobe moves Y by {moved:+.4}"
+        );
+    }
 }
