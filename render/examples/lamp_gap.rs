@@ -262,6 +262,7 @@ fn pixels(
         spp,
         seed,
         noise: None,
+        wavelength_nm: std::env::var("NM").ok().and_then(|s| s.parse().ok()),
         ..Default::default()
     };
     let t0 = cpu_time::ProcessTime::now();
