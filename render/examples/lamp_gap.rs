@@ -229,6 +229,7 @@ fn ear(side: usize, spp: u32, ref_spp: u32) -> anyhow::Result<()> {
         cosines.1 / cosines.2
     );
     println!("configuration,spp,region,pixels,mean_y,se,cpu_s");
+    let mut films = Vec::new();
     let rows: Vec<(&str, &Scene, IntegratorKind, u32, u64)> = vec![
         ("walk", &scene, IntegratorKind::Volumetric, ref_spp, 2),
         ("separable", &plain, IntegratorKind::Bssrdf, spp, 1),
@@ -242,6 +243,56 @@ fn ear(side: usize, spp: u32, ref_spp: u32) -> anyhow::Result<()> {
         for (c, name) in ["thin", "lit", "shade", "other"].iter().enumerate() {
             let (m, se, px) = region(&film, c);
             println!("{label},{n},{name},{px},{m:.5},{se:.5},{:.2}", film.1);
+        }
+        films.push(film);
+    }
+    // DUMP=1: per pixel class, walk and last BSSRDF, as a map of walk / BSSRDF (digits: ratio ×
+    // 2, '.' not skin).
+    if films.len() == 3 {
+        // The walk's tail: per region, the median of walk / BSSRDF over pixels, and both means
+        // without the pixels of the walk's brightest tenth.
+        for (c, name) in ["thin", "lit", "shade"].iter().enumerate() {
+            let mut px: Vec<usize> = (0..class.len()).filter(|&i| class[i] == c).collect();
+            if px.is_empty() {
+                continue;
+            }
+            let mut r: Vec<f64> = px
+                .iter()
+                .map(|&i| films[0].0[i].0 / films[2].0[i].0.max(1e-9))
+                .collect();
+            r.sort_by(f64::total_cmp);
+            px.sort_by(|&a, &b| films[0].0[a].0.total_cmp(&films[0].0[b].0));
+            let keep = &px[..px.len() * 9 / 10];
+            let mean = |k: usize| keep.iter().map(|&i| films[k].0[i].0).sum::<f64>() / keep.len() as f64;
+            let top: f64 = px[px.len() * 9 / 10..].iter().map(|&i| films[0].0[i].0).sum::<f64>()
+                / px.iter().map(|&i| films[0].0[i].0).sum::<f64>();
+            println!(
+                "# {name}: median walk/lobe {:.3}; without the walk's brightest 10% of pixels: walk {:.5}, lobe {:.5} ({:+.1}%); that 10% holds {:.0}% of the walk's sum",
+                r[r.len() / 2],
+                mean(0),
+                mean(2),
+                100.0 * (mean(2) / mean(0) - 1.0),
+                100.0 * top
+            );
+        }
+    }
+    if std::env::var("DUMP").is_ok() && films.len() == 3 {
+        for y in 0..side {
+            let line: String = (0..side)
+                .map(|x| {
+                    let i = y * side + x;
+                    if class[i] == 3 {
+                        return '.';
+                    }
+                    let r = films[0].0[i].0 / films[2].0[i].0.max(1e-9);
+                    let d = (r * 2.0).round().clamp(0.0, 9.0) as u32;
+                    char::from_digit(d, 10).unwrap_or('?')
+                })
+                .collect();
+            let cls: String = (0..side)
+                .map(|x| ['t', 'L', 's', '.'][class[y * side + x]])
+                .collect();
+            println!("{line}   {cls}");
         }
     }
     Ok(())
