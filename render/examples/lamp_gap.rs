@@ -90,6 +90,16 @@ fn main() -> anyhow::Result<()> {
             );
             let scene = Scene::from_toml(&toml, "lamp.toml", None, &knobs)?;
             let plain = Scene::from_toml(&toml, "lamp.toml", None, &separable)?;
+            if std::env::var("COST").is_ok() {
+                // The lobe's cost per sample: the two BSSRDFs rendered in turn, four times each,
+                // in this one process (the same load for both).
+                let (mut a, mut b) = (0.0, 0.0);
+                for _ in 0..4 {
+                    a += run(&plain, IntegratorKind::Bssrdf, side, spp, 1, nm)?.2;
+                    b += run(&scene, IntegratorKind::Bssrdf, side, spp, 1, nm)?.2;
+                }
+                println!("# CPU-s over 4 renders: separable {a:.2}, lobe {b:.2} ({:+.1}%)", 100.0 * (b / a - 1.0));
+            }
             let s = run(&plain, IntegratorKind::Bssrdf, side, spp, 1, nm)?;
             let b = run(&scene, IntegratorKind::Bssrdf, side, spp, 1, nm)?;
             let w = if ref_spp > 0 {

@@ -52,8 +52,12 @@ impl Default for AzimuthOptions {
     }
 }
 
-/// Wavelengths of the lobe's rows, nm (A_m is smooth in λ; linear between rows, held beyond).
-pub const AZIMUTH_ROWS_NM: [f64; 5] = [400.0, 470.0, 550.0, 620.0, 700.0];
+/// Wavelengths of the lobe's rows, nm: every [`AZIMUTH_STEP_NM`] over the renderer's range (A_m
+/// is smooth in λ, 0.046 to 0.029 from 400 to 700 nm for light skin; linear between rows).
+pub const AZIMUTH_ROWS_NM: [f64; 5] = [380.0, 480.0, 580.0, 680.0, 780.0];
+
+/// Step of [`AZIMUTH_ROWS_NM`], nm.
+pub const AZIMUTH_STEP_NM: f64 = 100.0;
 
 /// Incidences (exit bins) of the fit, even in μ².
 const BINS: usize = 6;
@@ -100,18 +104,11 @@ impl AzimuthalLobe {
     /// [A₁, A₂] at `nm` (linear between rows, held beyond the first and last).
     #[must_use]
     pub fn coefficients(&self, nm: f32) -> [f32; 2] {
-        let rows = &AZIMUTH_ROWS_NM;
-        let x = f64::from(nm);
-        if x <= rows[0] || self.a.len() < 2 {
-            return self.a[0];
-        }
-        let last = rows.len().min(self.a.len()) - 1;
-        if x >= rows[last] {
-            return self.a[last];
-        }
-        let i = rows.partition_point(|&r| r <= x) - 1;
-        let t = ((x - rows[i]) / (rows[i + 1] - rows[i])) as f32;
-        let (p, q) = (self.a[i], self.a[i + 1]);
+        let last = self.a.len() - 1;
+        let x = ((f64::from(nm) - AZIMUTH_ROWS_NM[0]) / AZIMUTH_STEP_NM).clamp(0.0, last as f64);
+        let i = (x as usize).min(last.saturating_sub(1));
+        let t = (x - i as f64) as f32;
+        let (p, q) = (self.a[i], self.a[(i + 1).min(last)]);
         [p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1])]
     }
 
@@ -125,7 +122,7 @@ impl AzimuthalLobe {
         (1.0 + 2.0 * (a1 * s * c + a2 * s * s * (2.0 * c * c - 1.0))).max(0.0)
     }
 
-    /// [`Self::modulation`] at each of the path's wavelengths.
+    /// [`Self::modulation`] at each of the path's wavelengths (the angles' terms found once).
     #[must_use]
     pub fn modulations(
         &self,
@@ -134,8 +131,12 @@ impl AzimuthalLobe {
         cos_phi: f32,
         wl: &SampledWavelengths,
     ) -> SampledSpectrum {
+        let s = sin_product(mu_i, mu_o);
+        let c = cos_phi.clamp(-1.0, 1.0);
+        let (t1, t2) = (2.0 * s * c, 2.0 * s * s * (2.0 * c * c - 1.0));
         SampledSpectrum(std::array::from_fn::<_, N_WAVELENGTHS, _>(|k| {
-            self.modulation(mu_i, mu_o, cos_phi, wl.nm(k))
+            let [a1, a2] = self.coefficients(wl.nm(k));
+            (1.0 + a1 * t1 + a2 * t2).max(0.0)
         }))
     }
 }
