@@ -98,7 +98,10 @@ fn main() -> anyhow::Result<()> {
                     a += run(&plain, IntegratorKind::Bssrdf, side, spp, 1, nm)?.2;
                     b += run(&scene, IntegratorKind::Bssrdf, side, spp, 1, nm)?.2;
                 }
-                println!("# CPU-s over 4 renders: separable {a:.2}, lobe {b:.2} ({:+.1}%)", 100.0 * (b / a - 1.0));
+                println!(
+                    "# CPU-s over 4 renders: separable {a:.2}, lobe {b:.2} ({:+.1}%)",
+                    100.0 * (b / a - 1.0)
+                );
             }
             let s = run(&plain, IntegratorKind::Bssrdf, side, spp, 1, nm)?;
             let b = run(&scene, IntegratorKind::Bssrdf, side, spp, 1, nm)?;
@@ -273,8 +276,12 @@ fn ear(side: usize, spp: u32, ref_spp: u32) -> anyhow::Result<()> {
             r.sort_by(f64::total_cmp);
             px.sort_by(|&a, &b| films[0].0[a].0.total_cmp(&films[0].0[b].0));
             let keep = &px[..px.len() * 9 / 10];
-            let mean = |k: usize| keep.iter().map(|&i| films[k].0[i].0).sum::<f64>() / keep.len() as f64;
-            let top: f64 = px[px.len() * 9 / 10..].iter().map(|&i| films[0].0[i].0).sum::<f64>()
+            let mean =
+                |k: usize| keep.iter().map(|&i| films[k].0[i].0).sum::<f64>() / keep.len() as f64;
+            let top: f64 = px[px.len() * 9 / 10..]
+                .iter()
+                .map(|&i| films[0].0[i].0)
+                .sum::<f64>()
                 / px.iter().map(|&i| films[0].0[i].0).sum::<f64>();
             println!(
                 "# {name}: median walk/lobe {:.3}; without the walk's brightest 10% of pixels: walk {:.5}, lobe {:.5} ({:+.1}%); that 10% holds {:.0}% of the walk's sum",
@@ -377,10 +384,13 @@ fn harmonics(args: &[String]) -> anyhow::Result<()> {
     use multipole::exact::montecarlo::{ObliqueOptions, azimuthal_harmonics};
     let f = |i: usize, d: f64| args.get(i).and_then(|s| s.parse().ok()).unwrap_or(d);
     let (nm, mu_i, photons, cap) = (f(4, 550.0), f(5, 0.5), f(6, 1e5) as u64, f(7, 64.0) as u32);
-    let toml = "[camera]\nposition_mm = [0, 0, 300]\nlook_at_mm = [0, 0, 0]\nfov_deg = 10\n\
-        [materials.skin]\ntype = \"skin\"\npreset = \"light\"\nsurface = \"smooth\"\n\
-        [[meshes]]\nshape = \"quad\"\nmaterial = \"skin\"\n";
-    let scene = Scene::from_toml(toml, "h.toml", None, &SkinKnobs::default())?;
+    let preset = std::env::var("PRESET").unwrap_or_else(|_| "light".into());
+    let toml = format!(
+        "[camera]\nposition_mm = [0, 0, 300]\nlook_at_mm = [0, 0, 0]\nfov_deg = 10\n\
+         [materials.skin]\ntype = \"skin\"\npreset = \"{preset}\"\nsurface = \"smooth\"\n\
+         [[meshes]]\nshape = \"quad\"\nmaterial = \"skin\"\n"
+    );
+    let scene = Scene::from_toml(&toml, "h.toml", None, &SkinKnobs::default())?;
     let render::material::Material::Skin(skin) = &scene.materials[0] else {
         anyhow::bail!("no skin");
     };
@@ -472,10 +482,10 @@ fn coefficients(args: &[String]) -> anyhow::Result<()> {
         },
     )?;
     let cpu = t0.elapsed().as_secs_f64();
-    println!("preset,photons,max_collisions,nm,a1,a2,cpu_s");
+    println!("preset,photons,max_collisions,nm,a1,cpu_s");
     for nm in AZIMUTH_ROWS_NM {
-        let [a1, a2] = lobe.coefficients(nm as f32);
-        println!("{preset},{photons},{cap},{nm},{a1:.4},{a2:.4},{cpu:.2}");
+        let a1 = lobe.coefficient(nm as f32);
+        println!("{preset},{photons},{cap},{nm},{a1:.4},{cpu:.2}");
     }
     Ok(())
 }

@@ -3,16 +3,18 @@
 //! scatterings, so more of it leaves forward (away from the light) than back toward it. The
 //! separable form has no azimuth; its product with
 //!
-//! M(μ_i, μ_o, φ, λ) = 1 + 2 Σ_{m=1,2} A_m(λ) (s_i s_o)^m cos(mφ),   s = √(1 − μ²),
+//! M(μ_i, μ_o, φ, λ) = 1 + 2 A₁(λ) s_i s_o cos φ,   s = √(1 − μ²),
 //!
 //! φ the angle between the incident light's and the leaving light's horizontal directions of
-//! travel (0 forward), has the exact harmonics m = 1, 2 of the layered Monte Carlo
+//! travel (0 forward), has the first harmonic of the layered Monte Carlo
 //! (`multipole::exact::montecarlo::azimuthal_harmonics`) while keeping the separable form's
 //! azimuthal mean: ∫ M dφ = 2π, so every total, the sky's radiance and the walk's normal-incidence
-//! results are unchanged. The (s_i s_o)^m factor is the regularity of the m-th harmonic at the pole
+//! results are unchanged. The s_i s_o factor is the regularity of the first harmonic at the pole
 //! (and what the Monte Carlo shows at every incidence); M is symmetric in (μ_i, μ_o), so S stays
-//! reciprocal. A_m is fitted per tabulated wavelength to the Monte Carlo's harmonics divided by
-//! the separable form (smooth-surface Fresnel split) by weighted least squares.
+//! reciprocal. A₁ is fitted per tabulated wavelength to the Monte Carlo's first harmonic divided
+//! by the separable form (smooth-surface Fresnel split) by least squares. The second harmonic is
+//! left out: light skin's is below 0.005 (under 1% of M at grazing angles), and at the default
+//! photons its estimate is noise of ±0.01.
 
 use super::separable::Directional;
 use crate::spectrum::{N_WAVELENGTHS, SampledSpectrum, SampledWavelengths};
@@ -26,7 +28,7 @@ pub enum Azimuth {
     /// No azimuth: the separable form alone ([JMLH01]); on thick skin under a lamp opposite the
     /// camera at 60° it renders about 5% dark, beside the camera about 5% bright.
     Separable,
-    /// The separable form times M with the Monte Carlo's first two harmonics (default).
+    /// The separable form times M with the Monte Carlo's first harmonic (default).
     #[default]
     Harmonics,
 }
@@ -41,9 +43,8 @@ pub struct AzimuthOptions {
 }
 
 impl Default for AzimuthOptions {
-    /// 20,000 photons, 64 interactions: A₁ 0.002–0.003 and A₂ 0.002 above 10⁵ photons with
-    /// 2,000 interactions, M within 0.5% of it at 60°/45° and 1.1% at grazing angles
-    /// (docs/physics.md §8.3).
+    /// 20,000 photons, 64 interactions: A₁ within 0.002 of 10⁵ photons with 2,000 interactions
+    /// (light skin), M within 0.4% of it (docs/physics.md §8.3).
     fn default() -> Self {
         Self {
             photons: 20_000,
@@ -62,11 +63,11 @@ pub const AZIMUTH_STEP_NM: f64 = 100.0;
 /// Incidences (exit bins) of the fit, even in μ².
 const BINS: usize = 6;
 
-/// A_m(λ) of one skin, m = 1, 2.
+/// A₁(λ) of one skin.
 #[derive(Debug, Clone, PartialEq)]
 pub struct AzimuthalLobe {
-    /// `a[row] = [A₁, A₂]` at [`AZIMUTH_ROWS_NM`].
-    a: Vec<[f32; 2]>,
+    /// A₁ at [`AZIMUTH_ROWS_NM`].
+    a: Vec<f32>,
 }
 
 impl AzimuthalLobe {
@@ -95,31 +96,29 @@ impl AzimuthalLobe {
         Ok(Self { a })
     }
 
-    /// A lobe of given coefficients per row ([`AZIMUTH_ROWS_NM`]), for tests.
+    /// A lobe of given A₁ per row ([`AZIMUTH_ROWS_NM`]), for tests.
     #[must_use]
-    pub fn from_rows(a: Vec<[f32; 2]>) -> Self {
+    pub fn from_rows(a: Vec<f32>) -> Self {
         Self { a }
     }
 
-    /// [A₁, A₂] at `nm` (linear between rows, held beyond the first and last).
+    /// A₁ at `nm` (linear between rows, held beyond the first and last).
     #[must_use]
-    pub fn coefficients(&self, nm: f32) -> [f32; 2] {
+    pub fn coefficient(&self, nm: f32) -> f32 {
         let last = self.a.len() - 1;
         let x = ((f64::from(nm) - AZIMUTH_ROWS_NM[0]) / AZIMUTH_STEP_NM).clamp(0.0, last as f64);
         let i = (x as usize).min(last.saturating_sub(1));
         let t = (x - i as f64) as f32;
         let (p, q) = (self.a[i], self.a[(i + 1).min(last)]);
-        [p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1])]
+        p + t * (q - p)
     }
 
     /// M at incidence cosine `mu_i`, exit cosine `mu_o` and cos φ `cos_phi` (φ between the
     /// directions of travel, 0 forward), at `nm`; never negative.
     #[must_use]
     pub fn modulation(&self, mu_i: f32, mu_o: f32, cos_phi: f32, nm: f32) -> f32 {
-        let s = sin_product(mu_i, mu_o);
-        let [a1, a2] = self.coefficients(nm);
-        let c = cos_phi.clamp(-1.0, 1.0);
-        (1.0 + 2.0 * (a1 * s * c + a2 * s * s * (2.0 * c * c - 1.0))).max(0.0)
+        let t = 2.0 * sin_product(mu_i, mu_o) * cos_phi.clamp(-1.0, 1.0);
+        (1.0 + self.coefficient(nm) * t).max(0.0)
     }
 
     /// [`Self::modulation`] at each of the path's wavelengths (the angles' terms found once).
@@ -131,12 +130,9 @@ impl AzimuthalLobe {
         cos_phi: f32,
         wl: &SampledWavelengths,
     ) -> SampledSpectrum {
-        let s = sin_product(mu_i, mu_o);
-        let c = cos_phi.clamp(-1.0, 1.0);
-        let (t1, t2) = (2.0 * s * c, 2.0 * s * s * (2.0 * c * c - 1.0));
+        let t = 2.0 * sin_product(mu_i, mu_o) * cos_phi.clamp(-1.0, 1.0);
         SampledSpectrum(std::array::from_fn::<_, N_WAVELENGTHS, _>(|k| {
-            let [a1, a2] = self.coefficients(wl.nm(k));
-            (1.0 + a1 * t1 + a2 * t2).max(0.0)
+            (1.0 + self.coefficient(wl.nm(k)) * t).max(0.0)
         }))
     }
 }
@@ -147,41 +143,36 @@ fn sin_product(mu_i: f32, mu_o: f32) -> f32 {
     ((1.0 - a * a) * (1.0 - b * b)).max(0.0).sqrt()
 }
 
-/// A₁ and A₂ of one row: c_m = F_m / f_sep at every (incidence, exit bin), fitted by
-/// c_m = A_m (s_i s_o)^m (one-parameter least squares, every cell alike: weights from the
-/// cells' own estimated variances favour the cells whose few photons happened to agree).
+/// A₁ of one row: c₁ = F₁ / f_sep at every (incidence, exit bin), fitted by c₁ = A₁ s_i s_o
+/// (one-parameter least squares, every cell alike: weights from the cells' own estimated
+/// variances favour the cells whose few photons happened to agree).
 fn fit_row(
     runs: &[multipole::exact::montecarlo::Harmonics],
     opts: &ObliqueOptions,
     fresnel: &Directional,
     r_tot: f32,
     nm: f32,
-) -> [f32; 2] {
+) -> f32 {
     let c = fresnel.normalisation_at(nm);
     let gain = |mu: f32| fresnel.incidence().map_or(1.0, |g| g.gain(mu, nm));
-    let mut out = [0.0f32; 2];
-    for (m, slot) in out.iter_mut().enumerate().map(|(i, s)| (i + 1, s)) {
-        let (mut num, mut den) = (0.0f64, 0.0f64);
-        for (j, h) in runs.iter().enumerate() {
-            let mu_i = opts.bin_mu(j) as f32;
-            for k in 0..opts.bins() {
-                let mu_o = opts.bin_mu(k) as f32;
-                // The separable form per unit flux entering at μ_i (Fresnel split).
-                let f_sep = f64::from(
-                    gain(mu_i) * r_tot * fresnel.factor(mu_o, nm) / (c * std::f32::consts::PI),
-                );
-                if f_sep <= 0.0 {
-                    continue;
-                }
-                let y = h.f[m][k] / f_sep;
-                let x = f64::from(sin_product(mu_i, mu_o)).powi(m as i32);
-                num += x * y;
-                den += x * x;
+    let (mut num, mut den) = (0.0f64, 0.0f64);
+    for (j, h) in runs.iter().enumerate() {
+        let mu_i = opts.bin_mu(j) as f32;
+        for k in 0..opts.bins() {
+            let mu_o = opts.bin_mu(k) as f32;
+            // The separable form per unit flux entering at μ_i (Fresnel split).
+            let f_sep = f64::from(
+                gain(mu_i) * r_tot * fresnel.factor(mu_o, nm) / (c * std::f32::consts::PI),
+            );
+            if f_sep <= 0.0 {
+                continue;
             }
+            let x = f64::from(sin_product(mu_i, mu_o));
+            num += x * h.f[1][k] / f_sep;
+            den += x * x;
         }
-        *slot = if den > 0.0 { (num / den) as f32 } else { 0.0 };
     }
-    out
+    if den > 0.0 { (num / den) as f32 } else { 0.0 }
 }
 
 #[cfg(test)]
@@ -193,7 +184,7 @@ mod tests {
     /// trigonometric polynomials of degree < nodes), 1e-6 for f32.
     #[test]
     fn the_lobe_keeps_the_azimuthal_mean_and_is_reciprocal() {
-        let lobe = AzimuthalLobe::from_rows(vec![[0.05, 0.01]; AZIMUTH_ROWS_NM.len()]);
+        let lobe = AzimuthalLobe::from_rows(vec![0.05; AZIMUTH_ROWS_NM.len()]);
         for (mu_i, mu_o) in [(0.2, 0.7), (0.5, 0.5), (0.9, 0.3)] {
             let n = 64;
             let mean: f32 = (0..n)
