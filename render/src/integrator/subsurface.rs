@@ -135,24 +135,23 @@ impl PathTracer<'_> {
             hit,
             ss,
             &exit,
-            (beta_exit, lit_exit),
+            (beta_exit, lit_exit, outgoing),
             (wl, sampler),
-            outgoing,
         )
     }
 
     /// The subsurface branch was taken: continue from `exit` in a cosine-weighted direction
-    /// (weight S_ω cos / (cos / π) = T / c, times `beta_exit` / q); `lit_exit` tells whether a
-    /// light could reach the exit (its probabilities are in `Path::exit_pick`).
+    /// (weight S_ω cos / (cos / π) = T / c, times `beta_exit` / q, times the azimuthal lobe toward
+    /// `outgoing`); `lit_exit` tells whether a light could reach the exit (its probabilities are
+    /// in `Path::exit_pick`).
     pub(super) fn continue_from_exit(
         &self,
         path: &mut Path,
         hit: &Shading<'_>,
         ss: &Subsurface,
         exit: &Exit,
-        (beta_exit, lit_exit): (SampledSpectrum, bool),
+        (beta_exit, lit_exit, outgoing): (SampledSpectrum, bool, Option<Outgoing>),
         (wl, sampler): (&SampledWavelengths, &mut PathSampler),
-        outgoing: Option<Outgoing>,
     ) -> Step {
         let (eng, ens) = (exit.ng, exit.ns);
         sampler.seek(dims::EXIT_CONTINUATION);

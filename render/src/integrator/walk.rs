@@ -73,9 +73,8 @@ impl PathTracer<'_> {
                 hit,
                 ss,
                 &at,
-                (beta_exit, lit),
+                (beta_exit, lit, None),
                 (wl, sampler),
-                None,
             );
         }
         path.beta = beta_exit / hit.q_sss;
