@@ -38,12 +38,16 @@ fn oily_total(skin: &SkinParams, nm: f64) -> f64 {
 /// wavelength choice trades up to ΔE2000 0.5 of the flat colour (docs/physics.md §16.2; for the
 /// dark preset's 100-nm rows up to 3% in X here).
 fn slab(preset: &str, to_light: Vec3, camera: Vec3) -> render::scene::Scene {
+    slab_text(preset, to_light, camera).load()
+}
+
+/// The scene text of [`slab`].
+fn slab_text(preset: &str, to_light: Vec3, camera: Vec3) -> SceneText {
     SceneText::camera(camera.to_array(), 2.0)
         .skin("skin", &format!("preset = \"{preset}\""))
         .mesh("quad", "skin", 1000.0)
         .distant(to_light.to_array(), 1.0)
         .with("[fidelity]\nfidelity = \"full\"")
-        .load()
 }
 
 /// The closed-form XYZ of that slab seen from `wo` and lit from `wi` (unit vectors, z the normal):
@@ -707,7 +711,13 @@ fn flat_slab_under_a_far_side_light_carries_the_azimuthal_lobe() {
         (Vec3::new(-si, 0.0, ci), 1.0),
         (Vec3::new(si, 0.0, ci), -1.0),
     ] {
-        let scene = slab("light", wi, wo * 500.0);
+        let knobs = render::material::SkinKnobs {
+            azimuth: render::bssrdf::Azimuth::Harmonics,
+            ..render::material::SkinKnobs::default()
+        };
+        let text = slab_text("light", wi, wo * 500.0);
+        let scene =
+            render::scene::Scene::from_toml(text.text(), "slab.toml", None, &knobs).unwrap();
         let Material::Skin(skin) = &scene.materials[0] else {
             panic!("skin");
         };
@@ -715,7 +725,7 @@ fn flat_slab_under_a_far_side_light_carries_the_azimuthal_lobe() {
             .subsurface
             .as_ref()
             .and_then(|s| s.azimuth.clone())
-            .expect("the lobe is on by default");
+            .expect("the lobe is asked for");
         let m = |nm: f32| f64::from(lobe.modulation(wi.z, wo.z, cos_phi, nm));
         let want = slab_closed_form_with("light", wi, wo, m);
         let separable = slab_closed_form("light", wi, wo);

@@ -25,11 +25,12 @@ use rayon::prelude::*;
 /// Whether the BSSRDF carries the azimuthal lobe (the knob of docs/physics.md §8.3).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Azimuth {
-    /// No azimuth: the separable form alone ([JMLH01]); on thick skin under a lamp opposite the
-    /// camera at 60° it renders about 5% dark, beside the camera about 5% bright.
-    Separable,
-    /// The separable form times M with the Monte Carlo's first harmonic (default).
+    /// No azimuth: the separable form alone ([JMLH01]; default); on thick skin under a lamp
+    /// opposite the camera at 60° it renders about 5% dark, beside the camera about 5% bright.
     #[default]
+    Separable,
+    /// The separable form times M with the Monte Carlo's first harmonic: light skin under that
+    /// lamp within 1.5%, for 0.56 CPU-s per skin at load and 3% more CPU per sample.
     Harmonics,
 }
 

@@ -52,7 +52,7 @@ pub struct SkinKnobs {
     /// Whether the BSSRDF's profile carries the first-order curvature term (default on,
     /// docs/physics.md §8.2).
     pub curvature: Curvature,
-    /// Whether the BSSRDF carries the azimuthal lobe of oblique light (default on,
+    /// Whether the BSSRDF carries the azimuthal lobe of oblique light (default off,
     /// docs/physics.md §8.3).
     pub azimuth: Azimuth,
 }
