@@ -183,6 +183,37 @@ impl Texture {
         (0..4).map(|k| self.luminance[idx[k]] * wt[k]).sum()
     }
 
+    /// [lo, hi] of each channel over every value [`Texture::lookup`] returns at uv in the box
+    /// [u₀, u₁] × [v₀, v₁]: the texels of their bilinear footprints, with one texel of margin on
+    /// each side for the f32 rounding of uv and of the footprint.
+    #[must_use]
+    pub fn range_over(&self, u: [f32; 2], v: [f32; 2]) -> [[f32; 2]; 3] {
+        let (w, h) = (self.width as i64, self.height as i64);
+        let first = |t: f32, n: i64| (t * n as f32 - 0.5).floor() as i64 - 1;
+        let last = |t: f32, n: i64| (t * n as f32 - 0.5).floor() as i64 + 2;
+        let (x0, x1) = (first(u[0], w), last(u[1], w));
+        // u wraps: a span of the width or more holds every column.
+        let (x0, x1) = if x1.saturating_sub(x0) + 1 >= w || x1 < x0 {
+            (0, w - 1)
+        } else {
+            (x0, x1)
+        };
+        let (y0, y1) = (
+            first(v[0], h).clamp(0, h - 1),
+            last(v[1], h).clamp(0, h - 1),
+        );
+        let mut out = [[f32::INFINITY, f32::NEG_INFINITY]; 3];
+        for y in y0..=y1 {
+            for x in x0..=x1 {
+                let t = self.texels[self.index(x, y)];
+                for c in 0..3 {
+                    out[c] = [out[c][0].min(t[c]), out[c][1].max(t[c])];
+                }
+            }
+        }
+        out
+    }
+
     /// Mean of each channel over all texels.
     #[must_use]
     pub fn mean(&self) -> [f32; 3] {

@@ -247,6 +247,13 @@ impl ChromophoreMaps {
         self.texels.lookup(uv)
     }
 
+    /// [lo, hi] of each parameter over every value [`ChromophoreMaps::at`] returns at uv in
+    /// [u₀, u₁] × [v₀, v₁] (their bilinear footprints, a texel of margin).
+    #[must_use]
+    pub fn range_over(&self, u: [f32; 2], v: [f32; 2]) -> [[f32; 2]; 3] {
+        self.texels.range_over(u, v)
+    }
+
     /// [lo, hi] of each parameter (C_m, β_m, C_h) over the texels.
     #[must_use]
     pub fn range(&self) -> [[f32; 2]; 3] {

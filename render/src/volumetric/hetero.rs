@@ -1,8 +1,10 @@
 //! The absorption of a heterogeneous skin inside its volume (docs/physics.md §19.1): a point's
 //! chromophores are those of the texel of its nearest surface point, in the epidermis and in the
 //! dermis alike; σs does not depend on them ([DJ06] eq. 6), so only σa varies, and the walk's
-//! majorant takes the largest σa over the maps' parameter box.
+//! majorant takes the largest σa over the maps' parameter box, or over the box of the cell it
+//! is in ([`super::majorant`]).
 
+use super::majorant::{CellMajorant, MajorantGrid};
 use super::nearest::NearestSurface;
 use crate::material::hetero::{CornersAt, SkinMaps};
 use glam::DVec3;
@@ -16,6 +18,8 @@ pub struct MapMedium {
     pub maps: Arc<SkinMaps>,
     /// The material's triangles with their texture coordinates.
     pub nearest: NearestSurface,
+    /// The local majorant's cells.
+    pub grid: MajorantGrid,
 }
 
 /// [`MapMedium`] at one wavelength, for one walk (it remembers the last nearest triangle, which
@@ -30,6 +34,26 @@ pub struct MapAbsorption<'a> {
 }
 
 impl MapMedium {
+    /// The medium of `maps` over the `triangles` (world mm) with their texture coordinates, an
+    /// epidermis `d_epi_mm` thick, the local majorant's cells of `cell_mm`
+    /// ([`super::majorant::DEFAULT_CELL_MM`] by default).
+    #[must_use]
+    pub fn new(
+        maps: Arc<SkinMaps>,
+        triangles: &[([glam::Vec3; 3], [glam::Vec2; 3])],
+        d_epi_mm: f64,
+        cell_mm: f64,
+    ) -> Self {
+        let nearest = NearestSurface::new(triangles);
+        let positions: Vec<[glam::Vec3; 3]> = triangles.iter().map(|t| t.0).collect();
+        let grid = MajorantGrid::new(&nearest, &positions, &maps.maps, d_epi_mm, cell_mm);
+        Self {
+            maps,
+            nearest,
+            grid,
+        }
+    }
+
     /// The absorption at wavelength `nm`.
     #[must_use]
     pub fn at_nm(&self, nm: f32) -> MapAbsorption<'_> {
@@ -58,5 +82,24 @@ impl MapAbsorption<'_> {
         self.hint.set(hint);
         self.corners
             .sigma_a(epidermis, self.medium.maps.maps.at(uv))
+    }
+
+    /// The local majorant's cell holding `x`, with both layers' σs `sigma_s` (mm⁻¹).
+    #[must_use]
+    pub fn cell_at(&self, x: DVec3, sigma_s: (f32, f32)) -> CellMajorant {
+        self.medium.grid.cell_at(x, &self.corners, sigma_s)
+    }
+
+    /// The distance from `x` in `cell` along unit `d` to the next cell (mm), and that cell's key.
+    #[must_use]
+    #[inline]
+    pub fn exit(&self, cell: &CellMajorant, x: DVec3, d: DVec3) -> (f64, [i32; 3]) {
+        self.medium.grid.exit(cell, x, d)
+    }
+
+    /// The local majorant's cell `key` (from [`MapAbsorption::exit`]).
+    #[must_use]
+    pub fn cell(&self, key: [i32; 3], sigma_s: (f32, f32)) -> CellMajorant {
+        self.medium.grid.cell(key, &self.corners, sigma_s)
     }
 }

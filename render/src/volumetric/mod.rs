@@ -10,6 +10,7 @@
 pub mod distance;
 pub mod guide;
 pub mod hetero;
+pub mod majorant;
 pub mod nearest;
 pub mod shapes;
 pub mod slab_table;
@@ -52,6 +53,9 @@ pub struct SkinVolume {
     pub epidermis_region: SurfaceDistance,
     /// Per-texel absorption of a skin with chromophore maps (`None`: the layers are uniform).
     pub maps: Option<hetero::MapMedium>,
+    /// The majorant of delta tracking with maps ([`majorant`]; the guided walk keeps the global
+    /// one).
+    pub majorant: majorant::Majorant,
 }
 
 impl SkinVolume {
@@ -84,6 +88,7 @@ impl SkinVolume {
             eta,
             epidermis_region: SurfaceDistance::new(triangles, d_epi_mm),
             maps: None,
+            majorant: majorant::Majorant::default(),
         }
     }
 
@@ -102,6 +107,13 @@ impl SkinVolume {
         }
         self.guided_fraction = fraction;
         Ok(self)
+    }
+
+    /// The same medium with delta tracking against `majorant`.
+    #[must_use]
+    pub fn with_majorant(mut self, majorant: majorant::Majorant) -> Self {
+        self.majorant = majorant;
+        self
     }
 
     /// The same medium with the walk's Russian roulette below weight `weight`, in (0, 1]: the walk
@@ -148,11 +160,13 @@ impl Volumetric {
                 skin.params.epidermis_thickness_mm() as f32,
                 triangles,
             );
-            volume.maps = skin.maps.as_ref().map(|maps| hetero::MapMedium {
-                maps: maps.clone(),
-                nearest: nearest::NearestSurface::new(
+            volume.maps = skin.maps.as_ref().map(|maps| {
+                hetero::MapMedium::new(
+                    maps.clone(),
                     &scene.geometry.triangles_with_uvs_of(index as u32),
-                ),
+                    skin.params.epidermis_thickness_mm(),
+                    majorant::DEFAULT_CELL_MM,
+                )
             });
             media.push(Some(volume));
         }

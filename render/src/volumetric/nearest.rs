@@ -103,6 +103,21 @@ impl NearestSurface {
     /// the hierarchy is skipped. The answer does not depend on the hint.
     #[must_use]
     pub fn uv_from(&self, p: DVec3, hint: &mut Option<u32>) -> Option<Vec2> {
+        let (_, i, off) = self.nearest(p, hint)?;
+        let t = &self.tris[i];
+        let (v, w) = barycentric(off, t.ab, t.ac);
+        Some(t.uv[0] * (1.0 - v - w) as f32 + t.uv[1] * v as f32 + t.uv[2] * w as f32)
+    }
+
+    /// The distance from `p` to the surface, mm; `None` without triangles.
+    #[must_use]
+    pub fn distance(&self, p: DVec3) -> Option<f64> {
+        self.nearest(p, &mut None).map(|(d2, _, _)| d2.sqrt())
+    }
+
+    /// The squared distance to the nearest triangle, its index and the offset of its nearest
+    /// point from its first vertex; `hint` as in [`NearestSurface::uv_from`].
+    fn nearest(&self, p: DVec3, hint: &mut Option<u32>) -> Option<(f64, usize, DVec3)> {
         let mut best = (f64::INFINITY, None::<(usize, DVec3)>);
         if let Some(i) = hint.map(|i| i as usize).filter(|&i| i < self.tris.len()) {
             let t = &self.tris[i];
@@ -120,7 +135,7 @@ impl NearestSurface {
             if box_distance_squared(p, node.lo, node.hi) >= best.0 {
                 continue;
             }
-            if node.count > 0 || node.start == 0 && self.nodes.len() == 1 {
+            if self.is_leaf(n) {
                 let (s, c) = (node.start as usize, node.count as usize);
                 for (i, t) in self.tris[s..s + c].iter().enumerate() {
                     let off = closest_offset(p - t.a, t.ab, t.ac);
@@ -142,10 +157,92 @@ impl NearestSurface {
         }
         let (i, off) = best.1?;
         *hint = Some(i as u32);
-        let t = &self.tris[i];
-        let (v, w) = barycentric(off, t.ab, t.ac);
-        Some(t.uv[0] * (1.0 - v - w) as f32 + t.uv[1] * v as f32 + t.uv[2] * w as f32)
+        Some((best.0, i, off))
     }
+
+    fn is_leaf(&self, n: usize) -> bool {
+        let node = &self.nodes[n];
+        node.count > 0 || node.start == 0 && self.nodes.len() == 1
+    }
+
+    /// A value per triangle, `of` its texture coordinates, and per node the `merge` of its
+    /// triangles' (from `empty`), for [`NearestSurface::merge_within`].
+    #[must_use]
+    pub fn node_values<T: Copy>(
+        &self,
+        empty: T,
+        of: impl Fn(&[Vec2; 3]) -> T,
+        merge: impl Fn(T, T) -> T,
+    ) -> NodeValues<T> {
+        let tris: Vec<T> = self.tris.iter().map(|t| of(&t.uv)).collect();
+        let mut nodes = vec![empty; self.nodes.len()];
+        // Children follow their parent in `nodes`: from the last node back, every child is
+        // done before its parent.
+        for n in (0..self.nodes.len()).rev() {
+            let node = self.nodes[n];
+            nodes[n] = if self.is_leaf(n) {
+                let (s, c) = (node.start as usize, node.count as usize);
+                tris[s..s + c].iter().fold(empty, |acc, &v| merge(acc, v))
+            } else {
+                merge(nodes[node.start as usize], nodes[node.start as usize + 1])
+            };
+        }
+        NodeValues { tris, nodes }
+    }
+
+    /// The `merge` into `acc` of the values of every triangle within `radius_mm` of `p` (and
+    /// of some farther ones: a node lying wholly within the radius adds its own value, which
+    /// holds its triangles'), stopping early once `done(acc)`.
+    pub fn merge_within<T: Copy>(
+        &self,
+        values: &NodeValues<T>,
+        p: DVec3,
+        radius_mm: f64,
+        acc: &mut T,
+        merge: impl Fn(T, T) -> T,
+        done: impl Fn(&T) -> bool,
+    ) {
+        if self.tris.is_empty() {
+            return;
+        }
+        let r2 = radius_mm * radius_mm;
+        let mut stack = [0usize; 64];
+        let mut top = 1;
+        while top > 0 && !done(acc) {
+            top -= 1;
+            let n = stack[top];
+            let node = self.nodes[n];
+            if box_distance_squared(p, node.lo, node.hi) > r2 {
+                continue;
+            }
+            let far = (node.lo - p).abs().max((node.hi - p).abs());
+            if far.length_squared() <= r2 {
+                *acc = merge(*acc, values.nodes[n]);
+                continue;
+            }
+            if self.is_leaf(n) {
+                let (s, c) = (node.start as usize, node.count as usize);
+                for (i, t) in self.tris[s..s + c].iter().enumerate() {
+                    let off = closest_offset(p - t.a, t.ab, t.ac);
+                    if (p - t.a - off).length_squared() <= r2 {
+                        *acc = merge(*acc, values.tris[s + i]);
+                    }
+                }
+                continue;
+            }
+            stack[top] = node.start as usize;
+            stack[top + 1] = node.start as usize + 1;
+            top += 2;
+        }
+    }
+}
+
+/// Values per triangle and per node of a [`NearestSurface`]'s hierarchy
+/// ([`NearestSurface::node_values`]).
+#[derive(Debug, Clone)]
+pub struct NodeValues<T> {
+    tris: Vec<T>,
+    nodes: Vec<T>,
 }
 
 /// (v, w) with `off` = v·ab + w·ac (off lies in the triangle's plane); (0, 0) for a degenerate

@@ -32,7 +32,6 @@
 //! level of detail (`crate::fidelity::lod`) keeps no profile the footprint cannot resolve.
 
 use super::hetero::MapMedium;
-use super::nearest::NearestSurface;
 use super::slab_table::SlabTable;
 use super::{LayerTables, SkinVolume};
 use crate::geometry::{SurfaceHit, offset_origin};
@@ -176,9 +175,13 @@ impl ThinParts {
                 part.d_epi_mm,
                 geometry.triangles_of(si.material),
             );
-            volume.maps = part.maps.as_ref().map(|maps| MapMedium {
-                maps: maps.clone(),
-                nearest: NearestSurface::new(&geometry.triangles_with_uvs_of(si.material)),
+            volume.maps = part.maps.as_ref().map(|maps| {
+                MapMedium::new(
+                    maps.clone(),
+                    &geometry.triangles_with_uvs_of(si.material),
+                    f64::from(part.d_epi_mm),
+                    super::majorant::DEFAULT_CELL_MM,
+                )
             });
             volume
         }))

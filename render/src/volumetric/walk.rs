@@ -33,6 +33,7 @@
 use super::SkinVolume;
 use super::distance::{SegmentHit, SurfaceDistance};
 use super::guide::{Guide, Layer, Segment};
+use super::majorant::Majorant;
 use crate::accel::BVH_MIN_T_MM;
 use crate::bssrdf::Directional;
 use crate::geometry::{Geometry, SurfaceHit};
@@ -153,22 +154,39 @@ pub fn walk<R: RngCore>(
         Some(guide) => guide.along(d, normal, rng),
         None => Segment::classic(majorant),
     };
+    // With maps and no guide, each cell of the local majorant's grid is tracked with its own σ̄
+    // ([`super::majorant`]); the guide's weights assume one σ̄ along a segment.
+    let sigma_s = (epidermis.1, dermis.1);
+    let local = match (&maps, vol.majorant, &guide) {
+        (Some(m), Majorant::Local, None) => Some(m),
+        _ => None,
+    };
+    let mut cell = local.map(|m| m.cell_at(x, sigma_s));
     while out.collisions < MAX_COLLISIONS {
+        let rate = cell.map_or(segment.rate, |c| f64::from(c.sigma_t));
         // A clear medium (σ̄ = 0) flies straight to the surface.
-        let s = if majorant > 0.0 {
-            -(1.0 - rng.random::<f64>()).ln() / segment.rate
+        let s = if rate > 0.0 {
+            -(1.0 - rng.random::<f64>()).ln() / rate
         } else {
             f64::INFINITY
         };
+        // The flight ends at the cell's face when it would pass it.
+        let exit = local.zip(cell.as_ref()).map(|(m, c)| m.exit(c, x, d));
+        let flight = exit.map_or(s, |(t, _)| s.min(t));
         if ahead.is_none() {
-            let flight = Flight { x, d, s, on_face };
-            match look_ahead(geometry, material, region, &mut anchor, flight, rays) {
+            let f = Flight {
+                x,
+                d,
+                s: flight,
+                on_face,
+            };
+            match look_ahead(geometry, material, region, &mut anchor, f, rays) {
                 Ahead::Surface(b) => ahead = Some(b),
                 Ahead::Clear => {}
                 Ahead::Lost => return out,
             }
         }
-        if let Some(b) = ahead.filter(|b| s >= b.t) {
+        if let Some(b) = ahead.filter(|b| flight >= b.t) {
             if let Some(guide) = &guide {
                 segment.reach(b.t);
                 w *= guide.weight(&segment);
@@ -183,6 +201,7 @@ pub fn walk<R: RngCore>(
                     normal = n_out;
                 }
             }
+            // The surface point lies in the cell (b.t ≤ the flight to its face).
             x = b.p;
             on_face = Some(b.face);
             anchor = Anchor::surface(x);
@@ -190,6 +209,19 @@ pub fn walk<R: RngCore>(
             if let Some(guide) = &guide {
                 segment = guide.along(d, normal, rng);
             }
+            continue;
+        }
+        if let (Some(m), Some((t, key))) = (local, exit)
+            && s >= t
+        {
+            // Into the next cell, no collision: the rest of the flight is drawn afresh there
+            // (the exponential forgets the distance flown).
+            x += d * t;
+            on_face = None;
+            if let Some(b) = &mut ahead {
+                b.t -= t;
+            }
+            cell = Some(m.cell(key, sigma_s));
             continue;
         }
         x += d * s;
@@ -208,10 +240,22 @@ pub fn walk<R: RngCore>(
             Layer::Epidermis => epidermis,
             Layer::Dermis => dermis,
         };
+        let xi = rng.random::<f32>() * cell.map_or(majorant as f32, |c| c.sigma_t);
+        // Above the layer's largest σt in the cell the collision is null whatever the texel:
+        // no nearest-point query.
+        if let Some(c) = &cell {
+            let largest = match layer {
+                Layer::Epidermis => c.sigma_a.0,
+                Layer::Dermis => c.sigma_a.1,
+            };
+            if xi >= largest + ss {
+                continue;
+            }
+        }
         let sa = maps
             .as_ref()
             .map_or(sa, |m| m.sigma_a(layer == Layer::Epidermis, x));
-        if rng.random::<f32>() * majorant as f32 >= sa + ss {
+        if xi >= sa + ss {
             continue; // null collision
         }
         out.collisions += 1;

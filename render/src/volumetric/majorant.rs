@@ -1,0 +1,295 @@
+//! The local majorant of a skin with chromophore maps (docs/physics.md §19.1): a sparse grid of
+//! cubic cells over the surface, each holding the box of parameters (C_m, β_m, C_h) that the
+//! nearest surface point of any point of the cell can read, and which layers the cell can hold.
+//! At one wavelength a cell's majorant is the largest σt over that box and those layers; the walk
+//! tracks each cell with its own majorant and carries the remainder of a flight into the next
+//! cell (regular tracking of a piecewise-constant majorant, [NGHJ18] §4.2), so delta tracking
+//! stays unbiased and light skin's flights are no longer bounded by the lips' absorption.
+//!
+//! The bound: for x in a cell of centre c and half-diagonal r, the distance D to the surface
+//! obeys D(x) ≤ D(c) + r (D is 1-Lipschitz), so the nearest surface point q of x lies within
+//! D(x) + r ≤ D(c) + 2r of c. Every triangle within that radius of c is merged, each by the
+//! texels its texture coordinates' box can read (bilinear footprint and a texel of margin). The
+//! grid covers the cells within [`SHELL_MM`] of the surface; deeper points lie in the dermis
+//! alone and take its largest σa over the whole maps.
+
+use super::nearest::{NearestSurface, NodeValues};
+use crate::material::hetero::CornersAt;
+use crate::material::maps::ChromophoreMaps;
+use glam::{DVec3, Vec2};
+use rayon::prelude::*;
+use rustc_hash::FxHashMap;
+use std::fmt;
+use std::str::FromStr;
+
+/// Which majorant the walk's delta tracking uses in a skin with chromophore maps.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Majorant {
+    /// The largest σt over the maps' whole parameter box, both layers.
+    Global,
+    /// Per cell of a [`MajorantGrid`], the largest σt its points can have.
+    #[default]
+    Local,
+}
+
+impl fmt::Display for Majorant {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Self::Global => "global",
+            Self::Local => "local",
+        })
+    }
+}
+
+/// A majorant name that is neither `global` nor `local`.
+#[derive(Debug, Clone, thiserror::Error)]
+#[error("unknown majorant '{0}' (valid: global, local)")]
+pub struct UnknownMajorant(pub String);
+
+impl FromStr for Majorant {
+    type Err = UnknownMajorant;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        [Self::Global, Self::Local]
+            .into_iter()
+            .find(|m| m.to_string().eq_ignore_ascii_case(s))
+            .ok_or_else(|| UnknownMajorant(s.to_string()))
+    }
+}
+
+/// Default edge of the grid's cells, mm (BENCHMARKS.md, "Heterogeneous skin": the walk's cost
+/// per cell size).
+pub const DEFAULT_CELL_MM: f64 = 2.0;
+
+/// Depth under the surface the grid covers, mm: deeper cells (a tenth of a percent of the
+/// walk's collisions on the head) take the dermis' largest σa over the whole maps.
+pub const SHELL_MM: f64 = 4.0;
+
+/// Most cells the grid holds (about 40 bytes each); the cells grow until it fits.
+const MAX_CELLS: f64 = 2.0e6;
+
+/// A box of parameters (C_m, β_m, C_h), [lo, hi] each.
+type ParamBox = [[f32; 2]; 3];
+
+const EMPTY: ParamBox = [[f32::INFINITY, f32::NEG_INFINITY]; 3];
+
+fn union(a: ParamBox, b: ParamBox) -> ParamBox {
+    std::array::from_fn(|k| [a[k][0].min(b[k][0]), a[k][1].max(b[k][1])])
+}
+
+/// What one cell's points can be: their parameters' box and their layers.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Cell {
+    range: ParamBox,
+    epidermis: bool,
+    dermis: bool,
+}
+
+/// The grid of cells over a skin's surface with the parameter box of each.
+#[derive(Debug, Clone)]
+pub struct MajorantGrid {
+    cell_mm: f64,
+    cells: FxHashMap<[i32; 3], Cell>,
+    /// Cells off the grid: deeper than the shell, the dermis over the maps' whole box.
+    deep: Cell,
+}
+
+/// One cell of the grid at one wavelength, for the walk.
+#[derive(Debug, Clone, Copy)]
+pub struct CellMajorant {
+    key: [i32; 3],
+    lo: DVec3,
+    hi: DVec3,
+    /// The cell's majorant σ̄, mm⁻¹.
+    pub sigma_t: f32,
+    /// Each layer's largest σa in the cell (epidermis, dermis; 0 where the layer is absent), mm⁻¹.
+    pub sigma_a: (f32, f32),
+}
+
+impl MajorantGrid {
+    /// The grid over the surface of `nearest` with the parameters of `maps`, an epidermis
+    /// `d_epi_mm` thick, cells of `cell_mm` (grown until at most `MAX_CELLS` cover the shell).
+    #[must_use]
+    pub fn new(
+        nearest: &NearestSurface,
+        triangles: &[[glam::Vec3; 3]],
+        maps: &ChromophoreMaps,
+        d_epi_mm: f64,
+        cell_mm: f64,
+    ) -> Self {
+        let deep = Cell {
+            range: maps.range(),
+            epidermis: false,
+            dermis: true,
+        };
+        let shell = SHELL_MM.max(d_epi_mm);
+        let area: f64 = triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(glam::Vec3::as_dvec3);
+                0.5 * (b - a).cross(c - a).length()
+            })
+            .sum();
+        let mut cell_mm = cell_mm;
+        // The shell's cells number about 2A·(shell + h)/h³ (both sides of the surface).
+        while 2.0 * area * (shell + cell_mm) / cell_mm.powi(3) > MAX_CELLS {
+            cell_mm *= 1.25;
+        }
+        let half_diagonal = 0.5 * 3f64.sqrt() * cell_mm;
+        // Every cell whose centre can lie within the shell of a triangle: a cell off this set
+        // has D(c) > shell, so its points have D > shell − r, deeper than the epidermis when
+        // the shell is at least d_epi + r.
+        let reach = shell + half_diagonal;
+        let mut keys: Vec<[i32; 3]> = Vec::new();
+        {
+            let mut seen = rustc_hash::FxHashSet::default();
+            for t in triangles {
+                let lo = t[0].min(t[1]).min(t[2]).as_dvec3() - DVec3::splat(reach);
+                let hi = t[0].max(t[1]).max(t[2]).as_dvec3() + DVec3::splat(reach);
+                let (a, b) = (key_of(lo, cell_mm), key_of(hi, cell_mm));
+                for i in a[0]..=b[0] {
+                    for j in a[1]..=b[1] {
+                        for k in a[2]..=b[2] {
+                            if seen.insert([i, j, k]) {
+                                keys.push([i, j, k]);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        let values: NodeValues<ParamBox> =
+            nearest.node_values(EMPTY, |uv| texels_of(maps, uv), union);
+        let full = maps.range();
+        let covers_all =
+            |b: &ParamBox| (0..3).all(|k| b[k][0] <= full[k][0] && b[k][1] >= full[k][1]);
+        // The rounding of a walk's position past its cell's faces, mm.
+        let slack = |c: DVec3| 1e-9 * (1.0 + c.abs().max_element());
+        let cells: FxHashMap<[i32; 3], Cell> = keys
+            .par_iter()
+            .filter_map(|&key| {
+                let c = centre_of(key, cell_mm);
+                let dist = nearest.distance(c)?;
+                let r = half_diagonal + slack(c);
+                if dist - r > reach {
+                    return None;
+                }
+                let mut range = EMPTY;
+                nearest.merge_within(&values, c, dist + 2.0 * r, &mut range, union, covers_all);
+                Some((
+                    key,
+                    Cell {
+                        range,
+                        epidermis: dist - r <= d_epi_mm,
+                        dermis: dist + r > d_epi_mm,
+                    },
+                ))
+            })
+            .collect();
+        Self {
+            cell_mm,
+            cells,
+            deep,
+        }
+    }
+
+    /// Edge of the cells, mm.
+    #[must_use]
+    pub fn cell_mm(&self) -> f64 {
+        self.cell_mm
+    }
+
+    /// Cells held (the shell's).
+    #[must_use]
+    pub fn len(&self) -> usize {
+        self.cells.len()
+    }
+
+    /// Whether the grid holds no cell.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.cells.is_empty()
+    }
+
+    /// The cell holding `x` at wavelength absorption `corners`, both layers' σs `sigma_s`
+    /// (epidermis, dermis; mm⁻¹).
+    #[must_use]
+    pub fn cell_at(&self, x: DVec3, corners: &CornersAt, sigma_s: (f32, f32)) -> CellMajorant {
+        self.cell(key_of(x, self.cell_mm), corners, sigma_s)
+    }
+
+    /// The cell `key` at wavelength absorption `corners`, both layers' σs `sigma_s`.
+    #[must_use]
+    pub fn cell(&self, key: [i32; 3], corners: &CornersAt, sigma_s: (f32, f32)) -> CellMajorant {
+        let cell = self.cells.get(&key).unwrap_or(&self.deep);
+        let (e, d) = corners.largest(cell.range);
+        let sigma_a = (
+            if cell.epidermis { e } else { 0.0 },
+            if cell.dermis { d } else { 0.0 },
+        );
+        let mut sigma_t = 0.0f32;
+        if cell.epidermis {
+            sigma_t = sigma_t.max(e + sigma_s.0);
+        }
+        if cell.dermis {
+            sigma_t = sigma_t.max(d + sigma_s.1);
+        }
+        let lo = DVec3::new(key[0] as f64, key[1] as f64, key[2] as f64) * self.cell_mm;
+        CellMajorant {
+            key,
+            lo,
+            hi: lo + DVec3::splat(self.cell_mm),
+            // σa at a point is the corners' trilinear interpolation in f32, which may pass the
+            // largest corner by its rounding.
+            sigma_t: sigma_t * (1.0 + 4.0 * f32::EPSILON),
+            sigma_a,
+        }
+    }
+
+    /// The distance from `x` (in `cell`) along unit `d` to the next cell, mm, and its key.
+    #[must_use]
+    #[inline]
+    pub fn exit(&self, cell: &CellMajorant, x: DVec3, d: DVec3) -> (f64, [i32; 3]) {
+        let mut best = (f64::INFINITY, 0usize);
+        for axis in 0..3 {
+            let t = if d[axis] > 0.0 {
+                (cell.hi[axis] - x[axis]) / d[axis]
+            } else if d[axis] < 0.0 {
+                (cell.lo[axis] - x[axis]) / d[axis]
+            } else {
+                continue;
+            };
+            if t < best.0 {
+                best = (t, axis);
+            }
+        }
+        let mut key = cell.key;
+        key[best.1] += if d[best.1] > 0.0 { 1 } else { -1 };
+        (best.0.max(0.0), key)
+    }
+
+    /// The parameter box and layers of the cell holding `x` (for tests of the bound).
+    #[must_use]
+    pub fn bound_at(&self, x: DVec3) -> ([[f32; 2]; 3], bool, bool) {
+        let c = self
+            .cells
+            .get(&key_of(x, self.cell_mm))
+            .unwrap_or(&self.deep);
+        (c.range, c.epidermis, c.dermis)
+    }
+}
+
+/// The texels a triangle of texture coordinates `uv` can read.
+fn texels_of(maps: &ChromophoreMaps, uv: &[Vec2; 3]) -> ParamBox {
+    let lo = uv[0].min(uv[1]).min(uv[2]);
+    let hi = uv[0].max(uv[1]).max(uv[2]);
+    maps.range_over([lo.x, hi.x], [lo.y, hi.y])
+}
+
+fn key_of(p: DVec3, cell_mm: f64) -> [i32; 3] {
+    let q = (p / cell_mm).floor();
+    [q.x as i32, q.y as i32, q.z as i32]
+}
+
+fn centre_of(key: [i32; 3], cell_mm: f64) -> DVec3 {
+    (DVec3::new(key[0] as f64, key[1] as f64, key[2] as f64) + 0.5) * cell_mm
+}
