@@ -5,6 +5,7 @@ use crate::args::{Checked, parse_number, parse_whole};
 use ::render::fidelity::explain::{diffusion_warning, explain_table};
 use ::render::fidelity::{Fidelity, FidelityKnobs, LodBand, LodSetting};
 use ::render::integrator::{BodyIntegrator, IntegratorKind};
+use ::render::volumetric::majorant::Majorant;
 use ::render::material::SkinKnobs;
 use ::render::renderer::{Progress, RenderOptions, SettingError, render_with};
 use ::render::scene::Scene;
@@ -126,6 +127,11 @@ pub struct RenderArgs {
     /// unbiased random walk through the two layers inside each closed skin mesh: the reference).
     #[arg(long, value_name = "KIND", value_enum, default_value_t = Integrator::Bssrdf)]
     pub integrator: Integrator,
+    /// Majorant of the volumetric walk in skin with chromophore maps: local (per 2-mm cell over
+    /// the surface, the largest σt its points can read) or global (the maps' darkest texel
+    /// everywhere); both are unbiased, local is faster.
+    #[arg(long, value_name = "KIND", value_enum, default_value_t = MajorantArg::Local)]
+    pub majorant: MajorantArg,
     /// Render one wavelength, nm, in [380, 780]: the EXR holds the spectral radiance there as a
     /// grey (R = G = B), in the scene's emission units.
     #[arg(long, value_name = "NM", value_parser = Checked(parse_wavelength), allow_hyphen_values = true)]
@@ -139,6 +145,15 @@ pub enum Integrator {
     Bssrdf,
     /// The volumetric random walk (`render::volumetric`).
     Volumetric,
+}
+
+/// The volumetric walk's majorant with maps (`--majorant`).
+#[derive(clap::ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MajorantArg {
+    /// Per cell of a grid over the surface.
+    Local,
+    /// The maps' darkest texel everywhere.
+    Global,
 }
 
 fn parse_wavelength(s: &str) -> Result<f32, String> {
@@ -214,7 +229,16 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
             ..SkinKnobs::default()
         },
     )?;
-    let body = BodyIntegrator::build(&scene, options.integrator);
+    let mut body = BodyIntegrator::build(&scene, options.integrator);
+    if let BodyIntegrator::Volumetric(walk) = &mut body {
+        let majorant = match args.majorant {
+            MajorantArg::Local => Majorant::Local,
+            MajorantArg::Global => Majorant::Global,
+        };
+        for medium in walk.media.iter_mut().flatten() {
+            medium.majorant = majorant;
+        }
+    }
     let load = t0.elapsed();
     let skins = scene.skin_choices();
     if args.explain {

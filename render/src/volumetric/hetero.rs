@@ -5,7 +5,7 @@
 //! is in ([`super::majorant`]).
 
 use super::majorant::{CellMajorant, MajorantGrid};
-use super::nearest::NearestSurface;
+use super::nearest::{NearestAnchor, NearestSurface};
 use crate::material::hetero::{CornersAt, SkinMaps};
 use glam::DVec3;
 use std::cell::Cell;
@@ -22,15 +22,15 @@ pub struct MapMedium {
     pub grid: MajorantGrid,
 }
 
-/// [`MapMedium`] at one wavelength, for one walk (it remembers the last nearest triangle, which
-/// starts the next query).
+/// [`MapMedium`] at one wavelength, for one walk (it remembers the last nearest triangle and how
+/// far the walk may go before another can be nearer, [`NearestSurface::uv_anchored`]).
 #[derive(Debug, Clone)]
 pub struct MapAbsorption<'a> {
     corners: CornersAt,
     /// The largest σa over the maps of the epidermis and of the dermis, mm⁻¹.
     pub largest: (f32, f32),
     medium: &'a MapMedium,
-    hint: Cell<Option<u32>>,
+    anchor: Cell<Option<NearestAnchor>>,
 }
 
 impl MapMedium {
@@ -62,7 +62,7 @@ impl MapMedium {
             corners,
             largest: corners.largest(self.maps.maps.range()),
             medium: self,
-            hint: Cell::new(None),
+            anchor: Cell::new(None),
         }
     }
 }
@@ -73,13 +73,13 @@ impl MapAbsorption<'_> {
     #[must_use]
     #[inline]
     pub fn sigma_a(&self, epidermis: bool, x: DVec3) -> f32 {
-        let mut hint = self.hint.get();
+        let mut anchor = self.anchor.get();
         let uv = self
             .medium
             .nearest
-            .uv_from(x, &mut hint)
+            .uv_anchored(x, &mut anchor)
             .unwrap_or_default();
-        self.hint.set(hint);
+        self.anchor.set(anchor);
         self.corners
             .sigma_a(epidermis, self.medium.maps.maps.at(uv))
     }

@@ -18,6 +18,24 @@ struct Tri {
     uv: [Vec2; 3],
 }
 
+impl Tri {
+    /// The texture coordinates at the point `off` from the first vertex (on the triangle).
+    #[inline]
+    fn uv_at(&self, off: DVec3) -> Vec2 {
+        let (v, w) = barycentric(off, self.ab, self.ac);
+        self.uv[0] * (1.0 - v - w) as f32 + self.uv[1] * v as f32 + self.uv[2] * w as f32
+    }
+}
+
+/// A point x₀, its nearest triangle and the distance d₂ from x₀ to every other triangle, mm
+/// ([`NearestSurface::uv_anchored`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NearestAnchor {
+    x0: DVec3,
+    tri: u32,
+    other_mm: f64,
+}
+
 #[derive(Debug, Clone, Copy)]
 struct Node {
     lo: DVec3,
@@ -104,9 +122,84 @@ impl NearestSurface {
     #[must_use]
     pub fn uv_from(&self, p: DVec3, hint: &mut Option<u32>) -> Option<Vec2> {
         let (_, i, off) = self.nearest(p, hint)?;
-        let t = &self.tris[i];
-        let (v, w) = barycentric(off, t.ab, t.ac);
-        Some(t.uv[0] * (1.0 - v - w) as f32 + t.uv[1] * v as f32 + t.uv[2] * w as f32)
+        Some(self.tris[i].uv_at(off))
+    }
+
+    /// [`NearestSurface::uv`], reusing `anchor` (from an earlier query near `p`) when it proves
+    /// its triangle is still the nearest: at x₀ every other triangle lay at least d₂ away, so
+    /// at p each lies at least d₂ − |p − x₀| away (the distance to a set is 1-Lipschitz), and
+    /// the anchor's triangle, at distance d from p, is the nearest when d < d₂ − |p − x₀|.
+    /// Otherwise a full search at p renews the anchor. The answer is that of
+    /// [`NearestSurface::uv`]; a walk's next collision a few hundredths of a mm away mostly
+    /// costs one point–triangle distance.
+    #[must_use]
+    #[inline]
+    pub fn uv_anchored(&self, p: DVec3, anchor: &mut Option<NearestAnchor>) -> Option<Vec2> {
+        if let Some(a) = *anchor {
+            let t = &self.tris[a.tri as usize];
+            let off = closest_offset(p - t.a, t.ab, t.ac);
+            if (p - t.a - off).length() + p.distance(a.x0) < a.other_mm {
+                return Some(t.uv_at(off));
+            }
+        }
+        let (i, off, other2) = self.nearest_two(p, anchor.map(|a| a.tri))?;
+        *anchor = Some(NearestAnchor {
+            x0: p,
+            tri: i as u32,
+            other_mm: other2.sqrt(),
+        });
+        Some(self.tris[i].uv_at(off))
+    }
+
+    /// The nearest triangle to `p`, the offset of its nearest point from its first vertex, and
+    /// the squared distance to the nearest of the other triangles (∞ with one triangle),
+    /// starting from triangle `hint`.
+    fn nearest_two(&self, p: DVec3, hint: Option<u32>) -> Option<(usize, DVec3, f64)> {
+        // (squared distance, triangle, offset) of the nearest; squared distance of the next.
+        let mut best = (f64::INFINITY, usize::MAX, DVec3::ZERO);
+        let mut second = f64::INFINITY;
+        let hint = hint.map(|i| i as usize).filter(|&i| i < self.tris.len());
+        if let Some(i) = hint {
+            let t = &self.tris[i];
+            let off = closest_offset(p - t.a, t.ab, t.ac);
+            best = ((p - t.a - off).length_squared(), i, off);
+        }
+        let mut stack = [0usize; 64];
+        let mut top = 1;
+        while top > 0 {
+            top -= 1;
+            let n = stack[top];
+            let node = self.nodes[n];
+            // A node farther than the second nearest changes neither.
+            if box_distance_squared(p, node.lo, node.hi) >= second {
+                continue;
+            }
+            if self.is_leaf(n) {
+                let (s, c) = (node.start as usize, node.count as usize);
+                for (i, t) in self.tris[s..s + c].iter().enumerate() {
+                    if Some(s + i) == hint {
+                        continue;
+                    }
+                    let off = closest_offset(p - t.a, t.ab, t.ac);
+                    let d2 = (p - t.a - off).length_squared();
+                    if d2 < best.0 {
+                        second = best.0;
+                        best = (d2, s + i, off);
+                    } else if d2 < second {
+                        second = d2;
+                    }
+                }
+                continue;
+            }
+            let (a, b) = (node.start as usize, node.start as usize + 1);
+            let da = box_distance_squared(p, self.nodes[a].lo, self.nodes[a].hi);
+            let db = box_distance_squared(p, self.nodes[b].lo, self.nodes[b].hi);
+            let (far, near) = if da <= db { (b, a) } else { (a, b) };
+            stack[top] = far;
+            stack[top + 1] = near;
+            top += 2;
+        }
+        (best.1 != usize::MAX).then_some((best.1, best.2, second))
     }
 
     /// The distance from `p` to the surface, mm; `None` without triangles.
