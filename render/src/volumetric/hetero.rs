@@ -76,8 +76,8 @@ impl MapAbsorption<'_> {
         let mut anchor = self.anchor.get();
         let uv = self
             .medium
-            .nearest
-            .uv_anchored(x, &mut anchor)
+            .grid
+            .uv(&self.medium.nearest, x, &mut anchor)
             .unwrap_or_default();
         self.anchor.set(anchor);
         self.corners
@@ -87,7 +87,9 @@ impl MapAbsorption<'_> {
     /// The local majorant's cell holding `x`, with both layers' σs `sigma_s` (mm⁻¹).
     #[must_use]
     pub fn cell_at(&self, x: DVec3, sigma_s: (f32, f32)) -> CellMajorant {
-        self.medium.grid.cell_at(x, &self.corners, sigma_s)
+        self.medium
+            .grid
+            .cell_at(&self.medium.nearest, x, &self.corners, sigma_s)
     }
 
     /// The distance from `x` in `cell` along unit `d` to the next cell (mm), and that cell's key.
@@ -100,6 +102,8 @@ impl MapAbsorption<'_> {
     /// The local majorant's cell `key` (from [`MapAbsorption::exit`]).
     #[must_use]
     pub fn cell(&self, key: [i32; 3], sigma_s: (f32, f32)) -> CellMajorant {
-        self.medium.grid.cell(key, &self.corners, sigma_s)
+        self.medium
+            .grid
+            .cell(&self.medium.nearest, key, &self.corners, sigma_s)
     }
 }

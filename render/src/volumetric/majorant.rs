@@ -13,14 +13,14 @@
 //! grid covers the cells within [`SHELL_MM`] of the surface; deeper points lie in the dermis
 //! alone and take its largest σa over the whole maps.
 
-use super::nearest::{NearestSurface, NodeValues};
+use super::nearest::{NearestAnchor, NearestSurface};
 use crate::material::hetero::CornersAt;
 use crate::material::maps::ChromophoreMaps;
 use glam::{DVec3, Vec2};
-use rayon::prelude::*;
 use rustc_hash::FxHashMap;
 use std::fmt;
 use std::str::FromStr;
+use std::sync::OnceLock;
 
 /// Which majorant the walk's delta tracking uses in a skin with chromophore maps.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -76,19 +76,31 @@ fn union(a: ParamBox, b: ParamBox) -> ParamBox {
     std::array::from_fn(|k| [a[k][0].min(b[k][0]), a[k][1].max(b[k][1])])
 }
 
-/// What one cell's points can be: their parameters' box and their layers.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// What one cell's points can be: their parameters' box and their layers; and the triangles
+/// that can be nearest to them.
+#[derive(Debug, Clone, PartialEq)]
 struct Cell {
     range: ParamBox,
     epidermis: bool,
     dermis: bool,
+    /// Every triangle not listed lies farther than this from the centre, mm.
+    reach_mm: f64,
+    /// (distance of the triangle from the centre in mm, rounded down; triangle), nearest first.
+    list: Box<[(f32, u32)]>,
 }
 
-/// The grid of cells over a skin's surface with the parameter box of each.
+/// The grid of cells over a skin's surface, each built when a walk first enters it.
 #[derive(Debug, Clone)]
 pub struct MajorantGrid {
     cell_mm: f64,
-    cells: FxHashMap<[i32; 3], Cell>,
+    /// Half-diagonal of a cell with a margin for the rounding of positions, mm.
+    half_diagonal_mm: f64,
+    d_epi_mm: f64,
+    /// The cells within the shell (by key), indices into `slots`.
+    index: FxHashMap<[i32; 3], u32>,
+    slots: Vec<OnceLock<Box<Cell>>>,
+    /// Per triangle (as `NearestSurface` numbers them), the parameters it can read.
+    boxes: Vec<ParamBox>,
     /// Cells off the grid: deeper than the shell, the dermis over the maps' whole box.
     deep: Cell,
 }
@@ -106,8 +118,9 @@ pub struct CellMajorant {
 }
 
 impl MajorantGrid {
-    /// The grid over the surface of `nearest` with the parameters of `maps`, an epidermis
-    /// `d_epi_mm` thick, cells of `cell_mm` (grown until at most `MAX_CELLS` cover the shell).
+    /// The grid over the surface of `nearest` (the `triangles`, world mm) with the parameters of
+    /// `maps`, an epidermis `d_epi_mm` thick, cells of `cell_mm` (grown until at most
+    /// `MAX_CELLS` cover the shell). Cells are keyed here and built when first asked for.
     #[must_use]
     pub fn new(
         nearest: &NearestSurface,
@@ -120,8 +133,9 @@ impl MajorantGrid {
             range: maps.range(),
             epidermis: false,
             dermis: true,
+            reach_mm: 0.0,
+            list: Box::new([]),
         };
-        let shell = SHELL_MM.max(d_epi_mm);
         let area: f64 = triangles
             .iter()
             .map(|t| {
@@ -131,65 +145,101 @@ impl MajorantGrid {
             .sum();
         let mut cell_mm = cell_mm;
         // The shell's cells number about 2A·(shell + h)/h³ (both sides of the surface).
-        while 2.0 * area * (shell + cell_mm) / cell_mm.powi(3) > MAX_CELLS {
+        while 2.0 * area * (SHELL_MM.max(d_epi_mm) + cell_mm) / cell_mm.powi(3) > MAX_CELLS {
             cell_mm *= 1.25;
         }
         let half_diagonal = 0.5 * 3f64.sqrt() * cell_mm;
-        // Every cell whose centre can lie within the shell of a triangle: a cell off this set
-        // has D(c) > shell, so its points have D > shell − r, deeper than the epidermis when
-        // the shell is at least d_epi + r.
-        let reach = shell + half_diagonal;
-        let mut keys: Vec<[i32; 3]> = Vec::new();
-        {
-            let mut seen = rustc_hash::FxHashSet::default();
-            for t in triangles {
-                let lo = t[0].min(t[1]).min(t[2]).as_dvec3() - DVec3::splat(reach);
-                let hi = t[0].max(t[1]).max(t[2]).as_dvec3() + DVec3::splat(reach);
-                let (a, b) = (key_of(lo, cell_mm), key_of(hi, cell_mm));
-                for i in a[0]..=b[0] {
-                    for j in a[1]..=b[1] {
-                        for k in a[2]..=b[2] {
-                            if seen.insert([i, j, k]) {
-                                keys.push([i, j, k]);
-                            }
-                        }
+        // Every cell whose centre can lie within the shell of a triangle (the shell at least
+        // d_epi + r): a cell off this set has D(c) > shell, so its points have D > shell − r,
+        // in the dermis.
+        let reach = SHELL_MM.max(d_epi_mm + half_diagonal) + half_diagonal;
+        let mut index = FxHashMap::default();
+        for t in triangles {
+            let lo = t[0].min(t[1]).min(t[2]).as_dvec3() - DVec3::splat(reach);
+            let hi = t[0].max(t[1]).max(t[2]).as_dvec3() + DVec3::splat(reach);
+            let (a, b) = (key_of(lo, cell_mm), key_of(hi, cell_mm));
+            for i in a[0]..=b[0] {
+                for j in a[1]..=b[1] {
+                    for k in a[2]..=b[2] {
+                        let next = index.len() as u32;
+                        index.entry([i, j, k]).or_insert(next);
                     }
                 }
             }
         }
-        let values: NodeValues<ParamBox> =
-            nearest.node_values(EMPTY, |uv| texels_of(maps, uv), union);
-        let full = maps.range();
-        let covers_all =
-            |b: &ParamBox| (0..3).all(|k| b[k][0] <= full[k][0] && b[k][1] >= full[k][1]);
-        // The rounding of a walk's position past its cell's faces, mm.
-        let slack = |c: DVec3| 1e-9 * (1.0 + c.abs().max_element());
-        let cells: FxHashMap<[i32; 3], Cell> = keys
-            .par_iter()
-            .filter_map(|&key| {
-                let c = centre_of(key, cell_mm);
-                let dist = nearest.distance(c)?;
-                let r = half_diagonal + slack(c);
-                if dist - r > reach {
-                    return None;
-                }
-                let mut range = EMPTY;
-                nearest.merge_within(&values, c, dist + 2.0 * r, &mut range, union, covers_all);
-                Some((
-                    key,
-                    Cell {
-                        range,
-                        epidermis: dist - r <= d_epi_mm,
-                        dermis: dist + r > d_epi_mm,
-                    },
-                ))
-            })
+        let boxes: Vec<ParamBox> = (0..triangles.len() as u32)
+            .map(|i| texels_of(maps, &nearest.triangle_uvs(i)))
             .collect();
+        let slots = (0..index.len()).map(|_| OnceLock::new()).collect();
+        // The rounding of a walk's position past its cell's faces, mm.
+        let extent = triangles
+            .iter()
+            .flatten()
+            .fold(0.0f64, |m, p| m.max(f64::from(p.abs().max_element())));
         Self {
             cell_mm,
-            cells,
+            half_diagonal_mm: half_diagonal + 1e-9 * (1.0 + extent + reach),
+            d_epi_mm,
+            index,
+            slots,
+            boxes,
             deep,
         }
+    }
+
+    /// The cell `key`, built on first use from the surface `nearest`.
+    fn get(&self, nearest: &NearestSurface, key: [i32; 3]) -> &Cell {
+        let Some(&slot) = self.index.get(&key) else {
+            return &self.deep;
+        };
+        self.slots[slot as usize].get_or_init(|| Box::new(self.build(nearest, key)))
+    }
+
+    /// Cell `key`: the triangles within D(c) + 2r of its centre c, the parameters they can
+    /// read, and its layers by D(c) ± r.
+    fn build(&self, nearest: &NearestSurface, key: [i32; 3]) -> Cell {
+        let c = centre_of(key, self.cell_mm);
+        let r = self.half_diagonal_mm;
+        let Some(dist) = nearest.distance(c) else {
+            return self.deep.clone();
+        };
+        let reach_mm = dist + 2.0 * r;
+        let mut list = Vec::new();
+        nearest.triangles_within(c, reach_mm, &mut list);
+        list.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let range = list
+            .iter()
+            .fold(EMPTY, |acc, &(_, t)| union(acc, self.boxes[t as usize]));
+        Cell {
+            range,
+            epidermis: dist - r <= self.d_epi_mm,
+            dermis: dist + r > self.d_epi_mm,
+            reach_mm,
+            list: list.into_boxed_slice(),
+        }
+    }
+
+    /// The texture coordinates of the surface point of `nearest` (the grid's surface) nearest
+    /// `x`: from the triangles listed in x's cell (every one that can be nearest), or from the
+    /// whole surface off the grid; `anchor` as in [`NearestSurface::uv_anchored`].
+    #[must_use]
+    #[inline]
+    pub fn uv(
+        &self,
+        nearest: &NearestSurface,
+        x: DVec3,
+        anchor: &mut Option<NearestAnchor>,
+    ) -> Option<Vec2> {
+        if let Some(uv) = nearest.uv_if_anchored(x, anchor.as_ref()) {
+            return Some(uv);
+        }
+        let key = key_of(x, self.cell_mm);
+        let cell = self.get(nearest, key);
+        if cell.list.is_empty() {
+            return nearest.uv_anchored(x, anchor);
+        }
+        let off_centre = x.distance(centre_of(key, self.cell_mm));
+        nearest.uv_listed(x, &cell.list, off_centre, cell.reach_mm - off_centre, anchor)
     }
 
     /// Edge of the cells, mm.
@@ -198,29 +248,47 @@ impl MajorantGrid {
         self.cell_mm
     }
 
-    /// Cells held (the shell's).
+    /// Cells keyed (the shell's; built or not).
     #[must_use]
     pub fn len(&self) -> usize {
-        self.cells.len()
+        self.slots.len()
     }
 
-    /// Whether the grid holds no cell.
+    /// Whether the grid keys no cell.
     #[must_use]
     pub fn is_empty(&self) -> bool {
-        self.cells.is_empty()
+        self.slots.is_empty()
+    }
+
+    /// Cells built so far.
+    #[must_use]
+    pub fn built(&self) -> usize {
+        self.slots.iter().filter(|s| s.get().is_some()).count()
     }
 
     /// The cell holding `x` at wavelength absorption `corners`, both layers' σs `sigma_s`
     /// (epidermis, dermis; mm⁻¹).
     #[must_use]
-    pub fn cell_at(&self, x: DVec3, corners: &CornersAt, sigma_s: (f32, f32)) -> CellMajorant {
-        self.cell(key_of(x, self.cell_mm), corners, sigma_s)
+    pub fn cell_at(
+        &self,
+        nearest: &NearestSurface,
+        x: DVec3,
+        corners: &CornersAt,
+        sigma_s: (f32, f32),
+    ) -> CellMajorant {
+        self.cell(nearest, key_of(x, self.cell_mm), corners, sigma_s)
     }
 
     /// The cell `key` at wavelength absorption `corners`, both layers' σs `sigma_s`.
     #[must_use]
-    pub fn cell(&self, key: [i32; 3], corners: &CornersAt, sigma_s: (f32, f32)) -> CellMajorant {
-        let cell = self.cells.get(&key).unwrap_or(&self.deep);
+    pub fn cell(
+        &self,
+        nearest: &NearestSurface,
+        key: [i32; 3],
+        corners: &CornersAt,
+        sigma_s: (f32, f32),
+    ) -> CellMajorant {
+        let cell = self.get(nearest, key);
         let (e, d) = corners.largest(cell.range);
         let sigma_a = (
             if cell.epidermis { e } else { 0.0 },
@@ -233,7 +301,7 @@ impl MajorantGrid {
         if cell.dermis {
             sigma_t = sigma_t.max(d + sigma_s.1);
         }
-        let lo = DVec3::new(key[0] as f64, key[1] as f64, key[2] as f64) * self.cell_mm;
+        let lo = DVec3::new(f64::from(key[0]), f64::from(key[1]), f64::from(key[2])) * self.cell_mm;
         CellMajorant {
             key,
             lo,
@@ -267,13 +335,10 @@ impl MajorantGrid {
         (best.0.max(0.0), key)
     }
 
-    /// The parameter box and layers of the cell holding `x` (for tests of the bound).
+    /// The parameter box and layers (epidermis, dermis) of the cell holding `x`.
     #[must_use]
-    pub fn bound_at(&self, x: DVec3) -> ([[f32; 2]; 3], bool, bool) {
-        let c = self
-            .cells
-            .get(&key_of(x, self.cell_mm))
-            .unwrap_or(&self.deep);
+    pub fn bound_at(&self, nearest: &NearestSurface, x: DVec3) -> ([[f32; 2]; 3], bool, bool) {
+        let c = self.get(nearest, key_of(x, self.cell_mm));
         (c.range, c.epidermis, c.dermis)
     }
 }
@@ -291,5 +356,5 @@ fn key_of(p: DVec3, cell_mm: f64) -> [i32; 3] {
 }
 
 fn centre_of(key: [i32; 3], cell_mm: f64) -> DVec3 {
-    (DVec3::new(key[0] as f64, key[1] as f64, key[2] as f64) + 0.5) * cell_mm
+    (DVec3::new(f64::from(key[0]), f64::from(key[1]), f64::from(key[2])) + 0.5) * cell_mm
 }

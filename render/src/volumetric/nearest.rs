@@ -135,12 +135,8 @@ impl NearestSurface {
     #[must_use]
     #[inline]
     pub fn uv_anchored(&self, p: DVec3, anchor: &mut Option<NearestAnchor>) -> Option<Vec2> {
-        if let Some(a) = *anchor {
-            let t = &self.tris[a.tri as usize];
-            let off = closest_offset(p - t.a, t.ab, t.ac);
-            if (p - t.a - off).length() + p.distance(a.x0) < a.other_mm {
-                return Some(t.uv_at(off));
-            }
+        if let Some(uv) = self.uv_if_anchored(p, anchor.as_ref()) {
+            return Some(uv);
         }
         let (i, off, other2) = self.nearest_two(p, anchor.map(|a| a.tri))?;
         *anchor = Some(NearestAnchor {
@@ -149,6 +145,17 @@ impl NearestSurface {
             other_mm: other2.sqrt(),
         });
         Some(self.tris[i].uv_at(off))
+    }
+
+    /// The texture coordinates of the surface point nearest `p` when `anchor` proves its
+    /// triangle is the nearest ([`NearestSurface::uv_anchored`]).
+    #[must_use]
+    #[inline]
+    pub fn uv_if_anchored(&self, p: DVec3, anchor: Option<&NearestAnchor>) -> Option<Vec2> {
+        let a = anchor?;
+        let t = &self.tris[a.tri as usize];
+        let off = closest_offset(p - t.a, t.ab, t.ac);
+        ((p - t.a - off).length() + p.distance(a.x0) < a.other_mm).then(|| t.uv_at(off))
     }
 
     /// The nearest triangle to `p`, the offset of its nearest point from its first vertex, and
@@ -258,67 +265,29 @@ impl NearestSurface {
         node.count > 0 || node.start == 0 && self.nodes.len() == 1
     }
 
-    /// A value per triangle, `of` its texture coordinates, and per node the `merge` of its
-    /// triangles' (from `empty`), for [`NearestSurface::merge_within`].
-    #[must_use]
-    pub fn node_values<T: Copy>(
-        &self,
-        empty: T,
-        of: impl Fn(&[Vec2; 3]) -> T,
-        merge: impl Fn(T, T) -> T,
-    ) -> NodeValues<T> {
-        let tris: Vec<T> = self.tris.iter().map(|t| of(&t.uv)).collect();
-        let mut nodes = vec![empty; self.nodes.len()];
-        // Children follow their parent in `nodes`: from the last node back, every child is
-        // done before its parent.
-        for n in (0..self.nodes.len()).rev() {
-            let node = self.nodes[n];
-            nodes[n] = if self.is_leaf(n) {
-                let (s, c) = (node.start as usize, node.count as usize);
-                tris[s..s + c].iter().fold(empty, |acc, &v| merge(acc, v))
-            } else {
-                merge(nodes[node.start as usize], nodes[node.start as usize + 1])
-            };
-        }
-        NodeValues { tris, nodes }
-    }
-
-    /// The `merge` into `acc` of the values of every triangle within `radius_mm` of `p` (and
-    /// of some farther ones: a node lying wholly within the radius adds its own value, which
-    /// holds its triangles'), stopping early once `done(acc)`.
-    pub fn merge_within<T: Copy>(
-        &self,
-        values: &NodeValues<T>,
-        p: DVec3,
-        radius_mm: f64,
-        acc: &mut T,
-        merge: impl Fn(T, T) -> T,
-        done: impl Fn(&T) -> bool,
-    ) {
+    /// Every triangle within `radius_mm` of `p`: (its distance from `p` in mm, rounded down to
+    /// f32, and its index), appended to `out`.
+    pub fn triangles_within(&self, p: DVec3, radius_mm: f64, out: &mut Vec<(f32, u32)>) {
         if self.tris.is_empty() {
             return;
         }
         let r2 = radius_mm * radius_mm;
         let mut stack = [0usize; 64];
         let mut top = 1;
-        while top > 0 && !done(acc) {
+        while top > 0 {
             top -= 1;
             let n = stack[top];
             let node = self.nodes[n];
             if box_distance_squared(p, node.lo, node.hi) > r2 {
                 continue;
             }
-            let far = (node.lo - p).abs().max((node.hi - p).abs());
-            if far.length_squared() <= r2 {
-                *acc = merge(*acc, values.nodes[n]);
-                continue;
-            }
             if self.is_leaf(n) {
                 let (s, c) = (node.start as usize, node.count as usize);
                 for (i, t) in self.tris[s..s + c].iter().enumerate() {
                     let off = closest_offset(p - t.a, t.ab, t.ac);
-                    if (p - t.a - off).length_squared() <= r2 {
-                        *acc = merge(*acc, values.tris[s + i]);
+                    let d2 = (p - t.a - off).length_squared();
+                    if d2 <= r2 {
+                        out.push((round_down(d2.sqrt()), (s + i) as u32));
                     }
                 }
                 continue;
@@ -328,14 +297,65 @@ impl NearestSurface {
             top += 2;
         }
     }
+
+    /// The texture coordinates of the triangle `index` (as [`NearestSurface::triangles_within`]
+    /// numbers them).
+    #[must_use]
+    pub fn triangle_uvs(&self, index: u32) -> [Vec2; 3] {
+        self.tris[index as usize].uv
+    }
+
+    /// [`NearestSurface::uv`] for a point `p` whose nearest triangle is among `list` ((distance
+    /// from a centre c, triangle), nearest c first; `p` lies `off_centre_mm` from c, and every
+    /// triangle not listed lies farther than `unlisted_mm` from `p`), searched nearest first
+    /// (|p − q| ≥ |c − q| − |p − c| stops it); the search renews `anchor`.
+    #[must_use]
+    #[inline]
+    pub fn uv_listed(
+        &self,
+        p: DVec3,
+        list: &[(f32, u32)],
+        off_centre_mm: f64,
+        unlisted_mm: f64,
+        anchor: &mut Option<NearestAnchor>,
+    ) -> Option<Vec2> {
+        let mut best = (f64::INFINITY, usize::MAX, DVec3::ZERO);
+        let mut second = unlisted_mm.max(0.0).powi(2);
+        for &(from_centre, i) in list {
+            let bound = f64::from(from_centre) - off_centre_mm;
+            if bound > 0.0 && bound * bound >= second {
+                break;
+            }
+            let t = &self.tris[i as usize];
+            let off = closest_offset(p - t.a, t.ab, t.ac);
+            let d2 = (p - t.a - off).length_squared();
+            if d2 < best.0 {
+                second = second.min(best.0);
+                best = (d2, i as usize, off);
+            } else if d2 < second {
+                second = d2;
+            }
+        }
+        if best.1 == usize::MAX {
+            return self.uv_anchored(p, anchor);
+        }
+        *anchor = Some(NearestAnchor {
+            x0: p,
+            tri: best.1 as u32,
+            other_mm: second.sqrt(),
+        });
+        Some(self.tris[best.1].uv_at(best.2))
+    }
 }
 
-/// Values per triangle and per node of a [`NearestSurface`]'s hierarchy
-/// ([`NearestSurface::node_values`]).
-#[derive(Debug, Clone)]
-pub struct NodeValues<T> {
-    tris: Vec<T>,
-    nodes: Vec<T>,
+/// The largest f32 at most `x`.
+fn round_down(x: f64) -> f32 {
+    let y = x as f32;
+    if f64::from(y) > x {
+        f32::from_bits(y.to_bits() - 1).max(0.0)
+    } else {
+        y
+    }
 }
 
 /// (v, w) with `off` = v·ab + w·ac (off lies in the triangle's plane); (0, 0) for a degenerate
