@@ -4,6 +4,7 @@
 mod adaptive;
 mod fidelity;
 mod hetero;
+mod majorant;
 mod passes;
 mod sampler;
 mod scene_presets;

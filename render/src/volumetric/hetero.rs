@@ -46,7 +46,7 @@ impl MapMedium {
     ) -> Self {
         let nearest = NearestSurface::new(triangles);
         let positions: Vec<[glam::Vec3; 3]> = triangles.iter().map(|t| t.0).collect();
-        let grid = MajorantGrid::new(&nearest, &positions, &maps.maps, d_epi_mm, cell_mm);
+        let grid = MajorantGrid::new(&positions, maps.clone(), d_epi_mm, cell_mm);
         Self {
             maps,
             nearest,

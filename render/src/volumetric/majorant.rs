@@ -14,12 +14,12 @@
 //! alone and take its largest σa over the whole maps.
 
 use super::nearest::{NearestAnchor, NearestSurface};
-use crate::material::hetero::CornersAt;
-use crate::material::maps::ChromophoreMaps;
+use crate::material::hetero::{CornersAt, SkinMaps};
 use glam::{DVec3, Vec2};
 use rustc_hash::FxHashMap;
 use std::fmt;
 use std::str::FromStr;
+use std::sync::Arc;
 use std::sync::OnceLock;
 
 /// Which majorant the walk's delta tracking uses in a skin with chromophore maps.
@@ -99,8 +99,8 @@ pub struct MajorantGrid {
     /// The cells within the shell (by key), indices into `slots`.
     index: FxHashMap<[i32; 3], u32>,
     slots: Vec<OnceLock<Box<Cell>>>,
-    /// Per triangle (as `NearestSurface` numbers them), the parameters it can read.
-    boxes: Vec<ParamBox>,
+    /// The parameters over the surface.
+    maps: Arc<SkinMaps>,
     /// Cells off the grid: deeper than the shell, the dermis over the maps' whole box.
     deep: Cell,
 }
@@ -118,19 +118,17 @@ pub struct CellMajorant {
 }
 
 impl MajorantGrid {
-    /// The grid over the surface of `nearest` (the `triangles`, world mm) with the parameters of
-    /// `maps`, an epidermis `d_epi_mm` thick, cells of `cell_mm` (grown until at most
+    /// The grid over the surface `triangles` (world mm) with the parameters of `maps`, an epidermis `d_epi_mm` thick, cells of `cell_mm` (grown until at most
     /// `MAX_CELLS` cover the shell). Cells are keyed here and built when first asked for.
     #[must_use]
     pub fn new(
-        nearest: &NearestSurface,
         triangles: &[[glam::Vec3; 3]],
-        maps: &ChromophoreMaps,
+        maps: Arc<SkinMaps>,
         d_epi_mm: f64,
         cell_mm: f64,
     ) -> Self {
         let deep = Cell {
-            range: maps.range(),
+            range: maps.maps.range(),
             epidermis: false,
             dermis: true,
             reach_mm: 0.0,
@@ -167,9 +165,6 @@ impl MajorantGrid {
                 }
             }
         }
-        let boxes: Vec<ParamBox> = (0..triangles.len() as u32)
-            .map(|i| texels_of(maps, &nearest.triangle_uvs(i)))
-            .collect();
         let slots = (0..index.len()).map(|_| OnceLock::new()).collect();
         // The rounding of a walk's position past its cell's faces, mm.
         let extent = triangles
@@ -182,7 +177,7 @@ impl MajorantGrid {
             d_epi_mm,
             index,
             slots,
-            boxes,
+            maps,
             deep,
         }
     }
@@ -200,6 +195,7 @@ impl MajorantGrid {
     fn build(&self, nearest: &NearestSurface, key: [i32; 3]) -> Cell {
         let c = centre_of(key, self.cell_mm);
         let r = self.half_diagonal_mm;
+        let maps = &self.maps.maps;
         let Some(dist) = nearest.distance(c) else {
             return self.deep.clone();
         };
@@ -207,9 +203,10 @@ impl MajorantGrid {
         let mut list = Vec::new();
         nearest.triangles_within(c, reach_mm, &mut list);
         list.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let range = list
-            .iter()
-            .fold(EMPTY, |acc, &(_, t)| union(acc, self.boxes[t as usize]));
+        let range = list.iter().fold(EMPTY, |acc, &(_, t)| {
+            let (u, v) = nearest.uv_box_within(t, c, reach_mm);
+            union(acc, maps.range_over(u, v))
+        });
         Cell {
             range,
             epidermis: dist - r <= self.d_epi_mm,
@@ -239,7 +236,13 @@ impl MajorantGrid {
             return nearest.uv_anchored(x, anchor);
         }
         let off_centre = x.distance(centre_of(key, self.cell_mm));
-        nearest.uv_listed(x, &cell.list, off_centre, cell.reach_mm - off_centre, anchor)
+        nearest.uv_listed(
+            x,
+            &cell.list,
+            off_centre,
+            cell.reach_mm - off_centre,
+            anchor,
+        )
     }
 
     /// Edge of the cells, mm.
@@ -289,7 +292,13 @@ impl MajorantGrid {
         sigma_s: (f32, f32),
     ) -> CellMajorant {
         let cell = self.get(nearest, key);
+        // σa at a point is the corners' trilinear interpolation in f32, which may pass the
+        // largest corner by its rounding.
         let (e, d) = corners.largest(cell.range);
+        let (e, d) = (
+            e * (1.0 + 4.0 * f32::EPSILON),
+            d * (1.0 + 4.0 * f32::EPSILON),
+        );
         let sigma_a = (
             if cell.epidermis { e } else { 0.0 },
             if cell.dermis { d } else { 0.0 },
@@ -306,8 +315,7 @@ impl MajorantGrid {
             key,
             lo,
             hi: lo + DVec3::splat(self.cell_mm),
-            // σa at a point is the corners' trilinear interpolation in f32, which may pass the
-            // largest corner by its rounding.
+            // The sums' rounding likewise.
             sigma_t: sigma_t * (1.0 + 4.0 * f32::EPSILON),
             sigma_a,
         }
@@ -341,13 +349,6 @@ impl MajorantGrid {
         let c = self.get(nearest, key_of(x, self.cell_mm));
         (c.range, c.epidermis, c.dermis)
     }
-}
-
-/// The texels a triangle of texture coordinates `uv` can read.
-fn texels_of(maps: &ChromophoreMaps, uv: &[Vec2; 3]) -> ParamBox {
-    let lo = uv[0].min(uv[1]).min(uv[2]);
-    let hi = uv[0].max(uv[1]).max(uv[2]);
-    maps.range_over([lo.x, hi.x], [lo.y, hi.y])
 }
 
 fn key_of(p: DVec3, cell_mm: f64) -> [i32; 3] {

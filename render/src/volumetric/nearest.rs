@@ -298,11 +298,50 @@ impl NearestSurface {
         }
     }
 
-    /// The texture coordinates of the triangle `index` (as [`NearestSurface::triangles_within`]
-    /// numbers them).
+    /// A box [u₀, u₁] × [v₀, v₁] holding the texture coordinates of every point of triangle
+    /// `index` (as [`NearestSurface::triangles_within`] numbers them) within `radius_mm` of `p`:
+    /// that part lies in the disc where the ball cuts the triangle's plane, whose image under the
+    /// triangle's affine texture map is an ellipse, boxed by its centre ± the disc's radius times
+    /// the length of each coordinate's gradient; the box is clipped to the triangle's own.
     #[must_use]
-    pub fn triangle_uvs(&self, index: u32) -> [Vec2; 3] {
-        self.tris[index as usize].uv
+    pub fn uv_box_within(&self, index: u32, p: DVec3, radius_mm: f64) -> ([f32; 2], [f32; 2]) {
+        let t = &self.tris[index as usize];
+        let lo = t.uv[0].min(t.uv[1]).min(t.uv[2]);
+        let hi = t.uv[0].max(t.uv[1]).max(t.uv[2]);
+        let whole = ([lo.x, hi.x], [lo.y, hi.y]);
+        let n = t.ab.cross(t.ac);
+        let (d00, d01, d11) = (t.ab.dot(t.ab), t.ab.dot(t.ac), t.ac.dot(t.ac));
+        let det = d00 * d11 - d01 * d01;
+        if !(n.length_squared() > 0.0 && det > 1e-12 * d00 * d11) {
+            return whole;
+        }
+        let n = n.normalize();
+        let height = n.dot(p - t.a);
+        let disc = radius_mm * radius_mm - height * height;
+        if disc < 0.0 {
+            return whole;
+        }
+        let rho = disc.sqrt();
+        // Gradients of the barycentrics v, w (p − a = v·ab + w·ac) within the plane.
+        let grad_v = (t.ab * d11 - t.ac * d01) / det;
+        let grad_w = (t.ac * d00 - t.ab * d01) / det;
+        let foot = p - n * height - t.a;
+        let (v, w) = (grad_v.dot(foot), grad_w.dot(foot));
+        let (du1, du2) = (
+            (t.uv[1] - t.uv[0]).as_dvec2(),
+            (t.uv[2] - t.uv[0]).as_dvec2(),
+        );
+        let centre = t.uv[0].as_dvec2() + du1 * v + du2 * w;
+        let half = |k: usize| (grad_v * du1[k] + grad_w * du2[k]).length() * rho;
+        let clip = |k: usize, whole: [f32; 2]| {
+            // f32 rounding of the box kept outward; the texel margin covers the lookups'.
+            let (a, b) = (centre[k] - half(k), centre[k] + half(k));
+            [
+                (a as f32).max(whole[0]).min(whole[1]),
+                (b as f32).min(whole[1]).max(whole[0]),
+            ]
+        };
+        (clip(0, whole.0), clip(1, whole.1))
     }
 
     /// [`NearestSurface::uv`] for a point `p` whose nearest triangle is among `list` ((distance

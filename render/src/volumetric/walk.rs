@@ -170,16 +170,14 @@ pub fn walk<R: RngCore>(
         } else {
             f64::INFINITY
         };
-        // The flight ends at the cell's face when it would pass it.
+        // The flight ends at the cell's face when it would pass it. The surface is looked for
+        // over the whole flight, and kept across the cells it passes: a surface lying on a
+        // cell's face (a slab's top on the grid's plane) is then met from the side it was
+        // found from, not missed from a point within rounding of it.
         let exit = local.zip(cell.as_ref()).map(|(m, c)| m.exit(c, x, d));
         let flight = exit.map_or(s, |(t, _)| s.min(t));
         if ahead.is_none() {
-            let f = Flight {
-                x,
-                d,
-                s: flight,
-                on_face,
-            };
+            let f = Flight { x, d, s, on_face };
             match look_ahead(geometry, material, region, &mut anchor, f, rays) {
                 Ahead::Surface(b) => ahead = Some(b),
                 Ahead::Clear => {}
@@ -217,7 +215,9 @@ pub fn walk<R: RngCore>(
             // Into the next cell, no collision: the rest of the flight is drawn afresh there
             // (the exponential forgets the distance flown).
             x += d * t;
-            on_face = None;
+            if t > 0.0 {
+                on_face = None;
+            }
             if let Some(b) = &mut ahead {
                 b.t -= t;
             }
