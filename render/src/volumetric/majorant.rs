@@ -1,16 +1,18 @@
 //! The local majorant of a skin with chromophore maps (docs/physics.md §19.1): a sparse grid of
 //! cubic cells over the surface, each holding the box of parameters (C_m, β_m, C_h) that the
-//! nearest surface point of any point of the cell can read, and which layers the cell can hold.
-//! At one wavelength a cell's majorant is the largest σt over that box and those layers; the walk
-//! tracks each cell with its own majorant and carries the remainder of a flight into the next
-//! cell (regular tracking of a piecewise-constant majorant, [NGHJ18] §4.2), so delta tracking
-//! stays unbiased and light skin's flights are no longer bounded by the lips' absorption.
+//! nearest surface point of any point of the cell can read, the layers the cell can hold, and
+//! the triangles that can be nearest to its points. At one wavelength a cell's majorant is the
+//! largest σt over that box and those layers; the walk tracks each cell with its own majorant
+//! and draws the rest of a flight afresh in the next cell (delta tracking against a
+//! piecewise-constant majorant, [NGHJ18]), so it stays unbiased while light skin's flights are no
+//! longer bounded by the lips' absorption.
 //!
 //! The bound: for x in a cell of centre c and half-diagonal r, the distance D to the surface
 //! obeys D(x) ≤ D(c) + r (D is 1-Lipschitz), so the nearest surface point q of x lies within
-//! D(x) + r ≤ D(c) + 2r of c. Every triangle within that radius of c is merged, each by the
-//! texels its texture coordinates' box can read (bilinear footprint and a texel of margin). The
-//! grid covers the cells within [`SHELL_MM`] of the surface; deeper points lie in the dermis
+//! D(x) + r ≤ D(c) + 2r of c. Every triangle within that radius of c is listed, each adding the
+//! texels of the part of it within the radius (its texture map's image of the disc where the ball
+//! cuts its plane; bilinear footprint and a texel of margin). The grid keys the cells within
+//! [`SHELL_MM`] of the surface and builds each on first use; deeper points lie in the dermis
 //! alone and take its largest σa over the whole maps.
 
 use super::nearest::{NearestAnchor, NearestSurface};
@@ -56,15 +58,16 @@ impl FromStr for Majorant {
     }
 }
 
-/// Default edge of the grid's cells, mm (BENCHMARKS.md, "Heterogeneous skin": the walk's cost
-/// per cell size).
+/// Default edge of the grid's cells, mm: a few transport mean free paths of skin, so a cell
+/// crossing is rare beside the collisions, and small beside the face's features.
 pub const DEFAULT_CELL_MM: f64 = 2.0;
 
-/// Depth under the surface the grid covers, mm: deeper cells (a tenth of a percent of the
-/// walk's collisions on the head) take the dermis' largest σa over the whole maps.
+/// Depth under the surface the grid covers, mm: deeper cells take the dermis' largest σa over
+/// the whole maps.
 pub const SHELL_MM: f64 = 4.0;
 
-/// Most cells the grid holds (about 40 bytes each); the cells grow until it fits.
+/// Most cells the grid keys (about 30 bytes each, plus the lists of those built); the cells grow
+/// until it fits.
 const MAX_CELLS: f64 = 2.0e6;
 
 /// A box of parameters (C_m, β_m, C_h), [lo, hi] each.
