@@ -146,8 +146,7 @@ fn local_and_global_majorants_agree() {
             region(&cols, half, 1.0, half),
         ]);
     }
-    for side in 0..2 {
-        let ((l, ls), (g, gs)) = (means[0][side], means[1][side]);
+    for (side, (&(l, ls), &(g, gs))) in means[0].iter().zip(&means[1]).enumerate() {
         eprintln!("side {side}: local {l:.5} ± {ls:.5}, global {g:.5} ± {gs:.5}");
         assert!(
             (l - g).abs() <= 3.0 * ls.hypot(gs),
