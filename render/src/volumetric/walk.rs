@@ -1,5 +1,6 @@
 //! One random walk through a skin volume (docs/physics.md §15): delta (Woodcock) tracking against
-//! the majorant σ̄ = max(σt_epidermis, σt_dermis) at the hero wavelength, so the layer boundary
+//! the majorant σ̄ = max(σt_epidermis, σt_dermis) at the hero wavelength (with chromophore maps,
+//! by default each cell's own σ̄, [`super::majorant`], §19.1), so the layer boundary
 //! (a distance from the surface, not a plane) is crossed exactly without ever being intersected;
 //! at a real collision the weight keeps σs/σt (implicit capture) and the direction turns by
 //! Henyey–Greenstein — both from `multipole::exact::montecarlo`, the photon physics of the layered Monte
