@@ -80,7 +80,7 @@ impl Passes {
                                 maps: Some(maps),
                                 ..
                             }) => {
-                                let at = maps.grid.corners(maps.maps.at(s.uv));
+                                let at = maps.corners(s.uv);
                                 (reflectance_rgb(|nm| at.total(nm).min(1.0)), 1.0)
                             }
                             Material::Skin(m) => {

@@ -338,6 +338,13 @@ pub enum MaterialDesc {
         /// Target of the profile grid's measured interpolation error, (0, 1) (default 0.02).
         #[serde(default, deserialize_with = "opt_finite")]
         map_profile_error: Option<f32>,
+        /// Whether texels flagged in the maps' `thin_epidermis` channel (or fitted so by
+        /// `fit_maps`) take the thin epidermis (default true; false: the material's everywhere).
+        thin_epidermis: Option<bool>,
+        /// The thin epidermis' thickness, mm, (0, 10] (default: maps.exr's `thin_epidermis_mm`
+        /// attribute; with `fit_maps`, the fit's, 0.05 mm by default).
+        #[serde(default, deserialize_with = "opt_finite_f64")]
+        thin_epidermis_mm: Option<f64>,
     },
     /// Lambertian.
     Diffuse {

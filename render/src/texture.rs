@@ -305,14 +305,31 @@ pub fn channels_exr_bytes(
     height: usize,
     channels: Vec<(&str, Vec<f32>)>,
 ) -> Result<Vec<u8>, String> {
+    channels_exr_bytes_with(width, height, channels, &[])
+}
+
+/// [`channels_exr_bytes`] with float attributes `attributes` (name, value) in the layer's header:
+/// what makes a channel's meaning self-describing (maps.exr's `thin_epidermis_mm`).
+pub fn channels_exr_bytes_with(
+    width: usize,
+    height: usize,
+    channels: Vec<(&str, Vec<f32>)>,
+    attributes: &[(&str, f32)],
+) -> Result<Vec<u8>, String> {
     use exr::prelude::*;
     let list: Vec<AnyChannel<FlatSamples>> = channels
         .into_iter()
         .map(|(name, data)| AnyChannel::new(name, FlatSamples::F32(data)))
         .collect();
+    let mut layer_attributes = LayerAttributes::default();
+    for (name, value) in attributes {
+        layer_attributes
+            .other
+            .insert(Text::from(*name), AttributeValue::F32(*value));
+    }
     let layer = Layer::new(
         (width, height),
-        LayerAttributes::default(),
+        layer_attributes,
         Encoding::FAST_LOSSLESS,
         AnyChannels::sort(list.into()),
     );

@@ -75,7 +75,8 @@ pub struct MapsArgs {
     /// Texels out of gamut are fitted again under a thin epidermis of this thickness, mm, in
     /// [0.04, 0.3] (lip vermilion), and keep that skin where it reproduces them at least 1
     /// ΔE2000 closer; `off`: one skin for every texel. maps.exr gets a channel
-    /// `thin_epidermis` (1 where a texel has it).
+    /// `thin_epidermis` (1 where a texel has it; its header attribute `thin_epidermis_mm` holds
+    /// the thickness).
     #[arg(long, value_name = "MM|off", default_value = "0.05", value_parser = crate::args::Checked(parse_thin_epidermis))]
     pub thin_epidermis: ThinEpidermisArg,
     /// The top of the thin-epidermis skin's blood fraction C_h, in (0.001, 1]: the default 0.25 is
@@ -427,13 +428,21 @@ fn write_outputs(
         (CHANNELS[4], flag),
     ];
     channels.extend(extra.iter().map(|(name, v)| (*name, vec![*v; n])));
+    // The flag's thickness travels with it, so a renderer reads the texel's epidermis from the
+    // file alone.
+    let mut attributes = Vec::new();
     if let Some(t) = &maps.thin_epidermis {
         channels.push((
-            "thin_epidermis",
+            render::material::maps::THIN_EPIDERMIS_CHANNEL,
             t.texels.iter().map(|f| f32::from(u8::from(*f))).collect(),
         ));
+        attributes.push((
+            render::material::maps::THIN_EPIDERMIS_ATTRIBUTE,
+            t.epidermis_mm as f32,
+        ));
     }
-    let exr = render::texture::channels_exr_bytes(w, h, channels).map_err(anyhow::Error::msg)?;
+    let exr = render::texture::channels_exr_bytes_with(w, h, channels, &attributes)
+        .map_err(anyhow::Error::msg)?;
     let encoder = SrgbEncoder::default();
     let rgb: Vec<u8> = albedo
         .par_iter()

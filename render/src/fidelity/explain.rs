@@ -172,6 +172,9 @@ pub struct MapChoice {
     pub target: f32,
     /// The rule combining the profiles of a path's two ends.
     pub blend: String,
+    /// Where texels have a thin epidermis: its thickness (mm), the nodes of its profile grid per
+    /// axis and that grid's measured interpolation error.
+    pub thin: Option<(f32, [usize; 3], f32)>,
 }
 
 /// Why the shapes have their photon count, in words.
@@ -299,6 +302,17 @@ pub fn explain_table(skins: &[(&str, &SkinChoices)]) -> String {
                 100.0 * m.target,
                 m.blend
             );
+            if let Some((mm, nodes, error)) = m.thin {
+                let _ = writeln!(
+                    s,
+                    "  {:<16} {mm} mm under the flagged texels; profile grid {}×{}×{} tables, interpolation error {:.2}%",
+                    "thin epidermis",
+                    nodes[0],
+                    nodes[1],
+                    nodes[2],
+                    100.0 * error,
+                );
+            }
         }
         if let Some(f) = &c.diffusion_failures {
             let _ = writeln!(

@@ -1,9 +1,10 @@
 //! What a skin material with chromophore maps holds (docs/physics.md §19, "Heterogeneous skin"):
 //! the maps, both layers' absorption at any parameters (for the volumetric walk) and the profile
-//! grid (for the BSSRDF), with the rule that combines the profiles of the two ends of a path.
+//! grid (for the BSSRDF; a second one under a thin epidermis where texels have it), with the rule
+//! that combines the profiles of the two ends of a path.
 
 use super::maps::ChromophoreMaps;
-use crate::bssrdf::ProfileGrid;
+use crate::bssrdf::{Corners, ProfileGrid};
 use crate::media::{MediaError, SkinMedia};
 use crate::spectrum::{N_WAVELENGTHS, SampledSpectrum, SampledWavelengths, SpectrumTable};
 use glam::Vec2;
@@ -167,11 +168,56 @@ pub struct SkinMaps {
     pub absorption: CornerAbsorption,
     /// Profiles over the maps' parameter box (the BSSRDF and the diffuse body).
     pub grid: ProfileGrid,
+    /// Profiles under the thin epidermis over the box its texels use (`None` when no texel has
+    /// it): the second node of the thickness axis.
+    pub thin_grid: Option<ProfileGrid>,
     /// How the BSSRDF combines the two ends' profiles.
     pub blend: ProfileBlend,
+    /// The material's epidermis thickness (texels without a thin epidermis), mm.
+    pub epidermis_mm: f32,
 }
 
 impl SkinMaps {
+    /// The profile tables at the texel of `uv` and their weights: the grid's corners at its
+    /// parameters, and where the filtered thin-epidermis flag f is not 0, those of both grids at
+    /// weight 1 − f and f (ln R linear in the epidermis thickness, §19.2).
+    #[must_use]
+    #[inline]
+    pub fn corners(&self, uv: Vec2) -> Corners<'_> {
+        let p = self.maps.at(uv);
+        let thick = self.grid.corners(p);
+        match (&self.thin_grid, self.maps.thin()) {
+            (Some(grid), Some(thin)) => {
+                let f = thin.at(uv);
+                if f > 0.0 {
+                    Corners::across_thickness(thick, grid.corners(p), f)
+                } else {
+                    thick
+                }
+            }
+            _ => thick,
+        }
+    }
+
+    /// The epidermis thickness at the texel of `uv`, mm: the material's where it has no thin
+    /// epidermis, the thin one where it has, linear in the filtered flag between (as the profiles'
+    /// ln R is, [`SkinMaps::corners`]).
+    #[must_use]
+    #[inline]
+    pub fn epidermis_at_mm(&self, uv: Vec2) -> f32 {
+        let d = self.epidermis_mm;
+        self.maps
+            .thin()
+            .map_or(d, |t| d + t.at(uv) * (t.thickness_mm - d))
+    }
+
+    /// The deepest epidermis/dermis boundary under any texel, mm.
+    #[must_use]
+    pub fn deepest_epidermis_mm(&self) -> f32 {
+        let d = self.epidermis_mm;
+        self.maps.thin().map_or(d, |t| t.thickness_mm.max(d))
+    }
+
     /// R(r) per lane of a path through skin from `uv_i` (entry) to `uv_o` (exit) at distance
     /// `r_mm`, combined by the material's rule, mm⁻².
     #[must_use]
@@ -182,8 +228,8 @@ impl SkinMaps {
         uv_o: Vec2,
         r_mm: f32,
     ) -> SampledSpectrum {
-        let at_o = self.grid.corners(self.maps.at(uv_o)).eval(wl, r_mm);
-        let at_i = self.grid.corners(self.maps.at(uv_i)).eval(wl, r_mm);
+        let at_o = self.corners(uv_o).eval(wl, r_mm);
+        let at_i = self.corners(uv_i).eval(wl, r_mm);
         SampledSpectrum(std::array::from_fn(|k| {
             self.blend.combine(at_i.0[k], at_o.0[k])
         }))
@@ -217,7 +263,7 @@ impl SkinMaps {
     /// The total diffuse reflectance R_tot per lane at the texel of `uv`.
     #[must_use]
     pub fn totals(&self, wl: &SampledWavelengths, uv: Vec2) -> SampledSpectrum {
-        let corners = self.grid.corners(self.maps.at(uv));
+        let corners = self.corners(uv);
         SampledSpectrum(std::array::from_fn(|k| corners.total(wl.nm(k))))
     }
 }
@@ -258,8 +304,31 @@ impl super::SkinMaterial {
         };
         let grid = crate::fidelity::grid::profile_grid(&settings, maps.range())
             .map_err(super::SkinBuildError::Profiles)?;
+        let thin_grid = match maps.thin() {
+            Some(thin) => {
+                let params = self
+                    .params
+                    .with_epidermis_thickness_mm(f64::from(thin.thickness_mm))
+                    .map_err(|e| super::SkinBuildError::Profiles(e.into()))?;
+                let settings = crate::fidelity::grid::GridSettings {
+                    params: &params,
+                    ..settings
+                };
+                Some(
+                    crate::fidelity::grid::profile_grid(&settings, thin.range())
+                        .map_err(super::SkinBuildError::Profiles)?,
+                )
+            }
+            None => None,
+        };
         if let Some(ss) = &mut self.subsurface {
-            ss.table = grid.lowest().clone();
+            // Radii are drawn from the widest profile: the least absorbing node of either
+            // thickness, whichever reaches farther (a sample's weight is 0 beyond its table).
+            let reach = |t: &crate::bssrdf::ProfileTable| t.largest_radius_for_energy_mm(1.0);
+            ss.table = match &thin_grid {
+                Some(t) if reach(t.lowest()) > reach(grid.lowest()) => t.lowest().clone(),
+                _ => grid.lowest().clone(),
+            };
         }
         if let Some(c) = &mut self.choices {
             c.maps = Some(crate::fidelity::explain::MapChoice {
@@ -269,13 +338,22 @@ impl super::SkinMaterial {
                 max_error: grid.max_error,
                 target: grid_error,
                 blend: blend.to_string(),
+                thin: maps.thin().zip(thin_grid.as_ref()).map(|(t, g)| {
+                    (
+                        t.thickness_mm,
+                        g.axes().clone().map(|a| a.len()),
+                        g.max_error,
+                    )
+                }),
             });
         }
         self.maps = Some(std::sync::Arc::new(SkinMaps {
             maps,
             absorption,
             grid,
+            thin_grid,
             blend,
+            epidermis_mm: self.params.epidermis_thickness_mm() as f32,
         }));
         Ok(self)
     }

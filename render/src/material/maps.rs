@@ -7,6 +7,10 @@
 //! the parameter) or a grey PNG whose 8- or 16-bit values hold the parameter directly
 //! (value / 255 or value / 65535; no transfer curve). Sizes are capped as textures are
 //! (`crate::texture::MAX_TEXELS`), checked before anything is allocated.
+//!
+//! `maps.exr`'s `thin_epidermis` channel (1 where a texel was fitted under the thin epidermis of
+//! §18, 0 where it has the material's) is read with the thickness its `thin_epidermis_mm` header
+//! attribute records (or the scene's `thin_epidermis_mm`): the epidermis per texel (§19).
 
 use crate::error::RenderError;
 use crate::texture::{Texture, check_exr_headers, check_size};
@@ -75,6 +79,46 @@ pub enum Source {
     Scalar(f64),
 }
 
+/// The thin-epidermis flag of a skin's maps as given, before assembly.
+#[derive(Debug, Clone)]
+pub struct ThinInput {
+    /// Dotted scene key the flag came with (`maps` or `fit_maps`).
+    pub key: String,
+    /// The file as given.
+    pub path: PathBuf,
+    /// Per texel, 1 where the texel has the thin epidermis, 0 where it has the material's.
+    pub image: ValueImage,
+    /// The thin epidermis' thickness, mm (checked by the caller, which knows its key).
+    pub thickness_mm: f32,
+}
+
+/// Where a skin has a thinner epidermis than the material's (docs/physics.md §19): a flag per
+/// texel, bilinearly filtered like the maps (a fraction across the border of a thin region).
+#[derive(Debug, Clone)]
+pub struct ThinEpidermisMap {
+    /// The thin epidermis' thickness, mm.
+    pub thickness_mm: f32,
+    flag: Texture,
+    /// [lo, hi] of each parameter (C_m, β_m, C_h) over the texels a filtered lookup with a
+    /// non-zero flag can read: those within one texel of a thin texel.
+    range: [[f32; 2]; 3],
+}
+
+impl ThinEpidermisMap {
+    /// The filtered flag at `uv`: 1 in thin skin, 0 in the material's, a fraction between.
+    #[must_use]
+    #[inline]
+    pub fn at(&self, uv: Vec2) -> f32 {
+        self.flag.lookup(uv)[0]
+    }
+
+    /// [lo, hi] of each parameter (C_m, β_m, C_h) wherever the flag is not 0.
+    #[must_use]
+    pub fn range(&self) -> [[f32; 2]; 3] {
+        self.range
+    }
+}
+
 /// What the scene gives for a skin's maps, before assembly.
 #[derive(Debug, Clone)]
 pub struct MapInputs {
@@ -86,6 +130,8 @@ pub struct MapInputs {
     pub edits: [(Parameter, Edit); 2],
     /// The mask weighting the edits (`edit_mask`): scene key, file and values in [0, 1].
     pub mask: Option<(String, PathBuf, ValueImage)>,
+    /// The thin-epidermis flag (`None`: every texel has the material's epidermis).
+    pub thin: Option<ThinInput>,
 }
 
 /// Per-texel (C_m, β_m, C_h) of one skin material, bilinearly filtered like a texture (u wraps,
@@ -94,6 +140,7 @@ pub struct MapInputs {
 pub struct ChromophoreMaps {
     texels: Texture,
     range: [[f32; 2]; 3],
+    thin: Option<ThinEpidermisMap>,
 }
 
 fn map_err(key: &str, path: &Path, message: impl Into<String>) -> RenderError {
@@ -117,7 +164,8 @@ impl ChromophoreMaps {
                 Source::Map { key, path, image } => Some((key, path, image)),
                 Source::Scalar(_) => None,
             })
-            .chain(inputs.mask.iter().map(|(k, p, i)| (k, p, i)));
+            .chain(inputs.mask.iter().map(|(k, p, i)| (k, p, i)))
+            .chain(inputs.thin.iter().map(|t| (&t.key, &t.path, &t.image)));
         for (key, path, image) in images {
             if let Some(v) = image.values.iter().position(|v| !v.is_finite()) {
                 return Err(map_err(
@@ -231,13 +279,24 @@ impl ChromophoreMaps {
                     [lo.min(v), hi.max(v)]
                 })
         });
+        let thin = match &inputs.thin {
+            Some(t) => thin_map(t, &values, width, height)?,
+            None => None,
+        };
         let texels = (0..n)
             .map(|i| [values[0][i], values[1][i], values[2][i]])
             .collect();
         Ok(Some(Self {
             texels: Texture::from_texels(width, height, texels),
             range,
+            thin,
         }))
+    }
+
+    /// Where the skin has a thin epidermis (`None`: nowhere).
+    #[must_use]
+    pub fn thin(&self) -> Option<&ThinEpidermisMap> {
+        self.thin.as_ref()
     }
 
     /// (C_m, β_m, C_h) at `uv`, bilinearly filtered.
@@ -267,10 +326,81 @@ impl ChromophoreMaps {
     }
 }
 
-/// The three channels `melanin`, `eumelanin`, `hemoglobin` of a `maps.exr` (each `None` when
-/// absent; other channels are ignored). An error when none of the three is present.
-pub fn read_maps_exr(bytes: &[u8], path: &Path) -> Result<[Option<ValueImage>; 3], RenderError> {
-    let channels = exr_channels(bytes, path)?;
+/// The flag of `input` checked (every texel in [0, 1], else an error naming its key, file and
+/// texel), with the parameters' range over the texels within one texel of a thin one (u wraps,
+/// v clamps, as the filter reads them); `None` when no texel is thin.
+fn thin_map(
+    input: &ThinInput,
+    values: &[Vec<f32>; 3],
+    width: usize,
+    height: usize,
+) -> Result<Option<ThinEpidermisMap>, RenderError> {
+    let flag = &input.image.values;
+    if let Some(i) = flag.iter().position(|v| !(0.0..=1.0).contains(v)) {
+        return Err(map_err(
+            &input.key,
+            &input.path,
+            format!(
+                "thin_epidermis at texel ({}, {}) is {}, outside [0, 1] (1: the texel has the \
+                 thin epidermis, 0: the material's)",
+                i % width,
+                i / width,
+                flag[i]
+            ),
+        ));
+    }
+    if flag.iter().all(|&f| f == 0.0) {
+        return Ok(None);
+    }
+    let mut near = vec![false; width * height];
+    for (i, _) in flag.iter().enumerate().filter(|(_, f)| **f > 0.0) {
+        let (x, y) = ((i % width) as isize, (i / width) as isize);
+        for dy in -1..=1isize {
+            let yy = (y + dy).clamp(0, height as isize - 1) as usize;
+            for dx in -1..=1isize {
+                let xx = (x + dx).rem_euclid(width as isize) as usize;
+                near[yy * width + xx] = true;
+            }
+        }
+    }
+    let range = std::array::from_fn(|k| {
+        values[k]
+            .iter()
+            .zip(&near)
+            .filter(|(_, n)| **n)
+            .fold([f32::INFINITY, f32::NEG_INFINITY], |[lo, hi], (&v, _)| {
+                [lo.min(v), hi.max(v)]
+            })
+    });
+    Ok(Some(ThinEpidermisMap {
+        thickness_mm: input.thickness_mm,
+        flag: Texture::from_texels(width, height, flag.iter().map(|&f| [f, 0.0, 0.0]).collect()),
+        range,
+    }))
+}
+
+/// Name of maps.exr's thin-epidermis flag channel.
+pub const THIN_EPIDERMIS_CHANNEL: &str = "thin_epidermis";
+
+/// Name of maps.exr's header attribute holding the thin epidermis' thickness, mm.
+pub const THIN_EPIDERMIS_ATTRIBUTE: &str = "thin_epidermis_mm";
+
+/// What a `maps.exr` holds for the renderer.
+#[derive(Debug, Clone)]
+pub struct MapsExr {
+    /// The channels `melanin`, `eumelanin`, `hemoglobin` (each `None` when absent).
+    pub parameters: [Option<ValueImage>; 3],
+    /// The `thin_epidermis` channel, if present.
+    pub thin_epidermis: Option<ValueImage>,
+    /// The `thin_epidermis_mm` header attribute, mm, if present (unchecked).
+    pub thin_epidermis_mm: Option<f64>,
+}
+
+/// The channels `melanin`, `eumelanin`, `hemoglobin` and `thin_epidermis` of a `maps.exr` with
+/// its `thin_epidermis_mm` attribute (other channels are ignored). An error when none of the
+/// three parameters is present.
+pub fn read_maps_exr(bytes: &[u8], path: &Path) -> Result<MapsExr, RenderError> {
+    let (channels, attributes) = exr_contents(bytes, path)?;
     let found: [Option<ValueImage>; 3] = std::array::from_fn(|k| {
         channels
             .iter()
@@ -287,7 +417,19 @@ pub fn read_maps_exr(bytes: &[u8], path: &Path) -> Result<[Option<ValueImage>; 3
             ),
         });
     }
-    Ok(found)
+    let thin_epidermis = channels
+        .iter()
+        .find(|(name, _)| name == THIN_EPIDERMIS_CHANNEL)
+        .map(|(_, image)| image.clone());
+    let thin_epidermis_mm = attributes
+        .iter()
+        .find(|(name, _)| name == THIN_EPIDERMIS_ATTRIBUTE)
+        .map(|(_, v)| *v);
+    Ok(MapsExr {
+        parameters: found,
+        thin_epidermis,
+        thin_epidermis_mm,
+    })
 }
 
 /// One parameter's values from a single-channel EXR (its one channel, or the channel named
@@ -344,6 +486,14 @@ pub fn read_value_image(bytes: &[u8], path: &Path, name: &str) -> Result<ValueIm
 
 /// Every channel of an EXR's first layer (largest resolution), by name, as f32.
 fn exr_channels(bytes: &[u8], path: &Path) -> Result<Vec<(String, ValueImage)>, RenderError> {
+    exr_contents(bytes, path).map(|(channels, _)| channels)
+}
+
+/// Named channels and float attributes.
+type ExrContents = (Vec<(String, ValueImage)>, Vec<(String, f64)>);
+
+/// [`exr_channels`] with the float attributes of the layer's and the image's headers.
+fn exr_contents(bytes: &[u8], path: &Path) -> Result<ExrContents, RenderError> {
     use exr::prelude::*;
     check_exr_headers(bytes, path)?;
     let img = read()
@@ -358,7 +508,7 @@ fn exr_channels(bytes: &[u8], path: &Path) -> Result<Vec<(String, ValueImage)>, 
             message: e.to_string(),
         })?;
     let (width, height) = (img.layer_data.size.0, img.layer_data.size.1);
-    Ok(img
+    let channels = img
         .layer_data
         .channel_data
         .list
@@ -373,7 +523,23 @@ fn exr_channels(bytes: &[u8], path: &Path) -> Result<Vec<(String, ValueImage)>, 
                 },
             )
         })
-        .collect())
+        .collect();
+    let attributes = img
+        .layer_data
+        .attributes
+        .other
+        .iter()
+        .chain(&img.attributes.other)
+        .filter_map(|(name, value)| {
+            let v = match value {
+                AttributeValue::F32(v) => f64::from(*v),
+                AttributeValue::F64(v) => *v,
+                _ => return None,
+            };
+            Some((name.to_string(), v))
+        })
+        .collect();
+    Ok((channels, attributes))
 }
 
 #[cfg(test)]
@@ -411,6 +577,7 @@ mod tests {
                 ),
             ],
             mask: None,
+            thin: None,
         }
     }
 

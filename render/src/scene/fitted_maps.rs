@@ -8,33 +8,51 @@ use crate::texture::Texture;
 use serde::{Deserialize, Serialize};
 use skin_fit::maps::{Eumelanin, Exposure, MapsModel, MapsOptions};
 
-/// What the cache keeps: the three maps of one texture.
+/// What the cache keeps: the maps of one texture.
 #[derive(Debug, Serialize, Deserialize)]
 struct Stored {
     width: usize,
     height: usize,
     /// C_m, β_m, C_h per texel.
     values: [Vec<f32>; 3],
+    /// 1 where the texel was fitted under the thin epidermis, 0 elsewhere (`None`: no texel was).
+    thin: Option<Vec<f32>>,
+}
+
+/// The maps of a texture as fitted at load.
+#[derive(Debug, Clone)]
+pub(super) struct Fitted {
+    /// C_m, β_m, C_h.
+    pub parameters: [ValueImage; 3],
+    /// 1 where the texel was fitted under the thin epidermis, and that epidermis' thickness, mm
+    /// (`None` when no texel was).
+    pub thin: Option<(ValueImage, f64)>,
 }
 
 /// The options of a fit under `exposure`: `skin maps`' defaults (β_m fitted, the thin-epidermis
-/// skin for texels out of gamut), the shared disk cache.
-fn options(exposure: Exposure) -> Result<MapsOptions, String> {
+/// skin of `thin_epidermis_mm` for texels out of gamut, none when `None`), the shared disk cache.
+fn options(exposure: Exposure, thin_epidermis_mm: Option<f64>) -> Result<MapsOptions, String> {
     Ok(MapsOptions {
         eumelanin: Eumelanin::Fit,
         exposure,
+        thin_epidermis_mm,
         cache_dir: skin_io::cache::cache_dir(),
         cache_max_bytes: skin_io::cache::max_bytes().map_err(|e| e.to_string())?,
         ..MapsOptions::default()
     })
 }
 
-/// The maps (melanin, eumelanin, hemoglobin) of `texture` fitted under the exposure `spec`
-/// (`1`, `auto`, `auto-rgb`, `G` or `R,G,B`, as `skin maps --exposure`), from the disk cache when
-/// an earlier load fitted the same texels with the same options.
-pub(super) fn fit(texture: &Texture, spec: &str) -> Result<[ValueImage; 3], String> {
+/// The maps (melanin, eumelanin, hemoglobin, thin epidermis) of `texture` fitted under the
+/// exposure `spec` (`1`, `auto`, `auto-rgb`, `G` or `R,G,B`, as `skin maps --exposure`), texels
+/// out of gamut fitted again under an epidermis `thin_epidermis_mm` thick (none: `None`), from the
+/// disk cache when an earlier load fitted the same texels with the same options.
+pub(super) fn fit(
+    texture: &Texture,
+    spec: &str,
+    thin_epidermis_mm: Option<f64>,
+) -> Result<Fitted, String> {
     let exposure: Exposure = spec.parse()?;
-    let opts = options(exposure)?;
+    let opts = options(exposure, thin_epidermis_mm)?;
     let (width, height) = texture.size();
     let texels = texture.texels();
     let bytes: Vec<u8> = texels
@@ -43,7 +61,7 @@ pub(super) fn fit(texture: &Texture, spec: &str) -> Result<[ValueImage; 3], Stri
         .flat_map(|c| c.to_le_bytes())
         .collect();
     let key = format!(
-        "fitted-chromophore-maps v1; {width}x{height}; texels {:016x}; options {:016x}",
+        "fitted-chromophore-maps v2; {width}x{height}; texels {:016x}; options {:016x}",
         skin_io::cache::fnv1a(&bytes),
         skin_io::cache::fnv1a(format!("{opts:?}").as_bytes()),
     );
@@ -56,10 +74,14 @@ pub(super) fn fit(texture: &Texture, spec: &str) -> Result<[ValueImage; 3], Stri
             .eumelanin_map
             .clone()
             .unwrap_or_else(|| vec![maps.eumelanin as f32; texels.len()]);
+        let thin = maps
+            .thin_epidermis
+            .map(|t| t.texels.iter().map(|&f| f32::from(u8::from(f))).collect());
         Ok(Stored {
             width,
             height,
             values: [maps.melanin, beta, maps.hemoglobin],
+            thin,
         })
     };
     let (stored, _) = skin_io::cache::load_or_build(
@@ -70,11 +92,22 @@ pub(super) fn fit(texture: &Texture, spec: &str) -> Result<[ValueImage; 3], Stri
     )?;
     let whole = stored.width == width
         && stored.height == height
-        && stored.values.iter().all(|v| v.len() == width * height);
+        && stored
+            .values
+            .iter()
+            .chain(&stored.thin)
+            .all(|v| v.len() == width * height);
     let stored = if whole { stored } else { build()? };
-    Ok(stored.values.map(|values| ValueImage {
+    let image = |values| ValueImage {
         width,
         height,
         values,
-    }))
+    };
+    Ok(Fitted {
+        parameters: stored.values.map(image),
+        thin: stored
+            .thin
+            .zip(opts.thin_epidermis_mm)
+            .map(|(v, mm)| (image(v), mm)),
+    })
 }

@@ -1,5 +1,6 @@
 //! A skin material's chromophore-map keys (`maps`, `melanin_map`, `eumelanin_map`,
-//! `hemoglobin_map`, the edits and `edit_mask`, `profile_blend`, `map_profile_error`): each file
+//! `hemoglobin_map`, the edits and `edit_mask`, `profile_blend`, `map_profile_error`,
+//! `thin_epidermis`, `thin_epidermis_mm`): each file
 //! read through the guarded reader and decoded by `material::maps`, every error naming its key.
 
 use super::fitted_maps;
@@ -8,8 +9,8 @@ use crate::error::RenderError;
 use crate::fidelity::grid::DEFAULT_GRID_ERROR;
 use crate::material::hetero::ProfileBlend;
 use crate::material::maps::{
-    ChromophoreMaps, Edit, MapInputs, Parameter, Source, ValueImage, read_maps_exr,
-    read_value_image,
+    ChromophoreMaps, Edit, MapInputs, Parameter, Source, THIN_EPIDERMIS_ATTRIBUTE,
+    THIN_EPIDERMIS_CHANNEL, ThinInput, ValueImage, read_maps_exr, read_value_image,
 };
 use crate::material::{SkinBuildError, SkinKnobs, SkinMaterial};
 use crate::texture::Texture;
@@ -30,6 +31,8 @@ pub(super) struct MapKeys<'a> {
     pub edit_mask: &'a Option<String>,
     pub profile_blend: &'a Option<String>,
     pub map_profile_error: &'a Option<f32>,
+    /// `thin_epidermis` (whether flagged texels take it) and `thin_epidermis_mm`.
+    pub thin_epidermis: (&'a Option<bool>, &'a Option<f64>),
 }
 
 impl Loader<'_> {
@@ -43,11 +46,13 @@ impl Loader<'_> {
     ) -> Result<SkinMaterial, RenderError> {
         let edited = keys.edits.iter().any(|(s, o)| s.is_some() || o.is_some());
         let Some(maps) = self.chromophore_maps(key, &skin, keys)? else {
-            if edited || keys.profile_blend.is_some() || keys.map_profile_error.is_some() {
+            let thin = keys.thin_epidermis.0.is_some() || keys.thin_epidermis.1.is_some();
+            if edited || keys.profile_blend.is_some() || keys.map_profile_error.is_some() || thin {
                 return Err(self.err(
                     key,
-                    "the edits, profile_blend and map_profile_error need a map (maps, \
-                     melanin_map, eumelanin_map, hemoglobin_map or edit_mask)",
+                    "the edits, profile_blend, map_profile_error, thin_epidermis and \
+                     thin_epidermis_mm need a map (maps, fit_maps, melanin_map, eumelanin_map, \
+                     hemoglobin_map or edit_mask)",
                 ));
             }
             return Ok(skin);
@@ -99,9 +104,54 @@ impl Loader<'_> {
         // The file the maps came from, and the key that named it.
         let mut exr_source: Option<(&str, String)> =
             keys.maps.as_deref().map(|s| ("maps", s.to_string()));
+        let (thin_on, thin_key_mm) = (
+            keys.thin_epidermis.0.unwrap_or(true),
+            *keys.thin_epidermis.1,
+        );
+        let thin_mm_key = format!("{key}.thin_epidermis_mm");
+        // The thickness of a thin epidermis: (0, 10] mm as SkinParams takes it.
+        let check_mm = |mm: f64| -> Result<f32, String> {
+            skin.params
+                .with_epidermis_thickness_mm(mm)
+                .map(|_| mm as f32)
+                .map_err(|e| e.to_string())
+        };
+        if let Some(mm) = thin_key_mm {
+            check_mm(mm).map_err(|e| self.err(&thin_mm_key, e))?;
+        }
+        let mut thin: Option<ThinInput> = None;
         if let Some(spec) = keys.maps {
             let (bytes, path) = read("maps", spec)?;
-            from_exr = read_maps_exr(&bytes, &path).map_err(|e| named("maps", spec, e))?;
+            let exr = read_maps_exr(&bytes, &path).map_err(|e| named("maps", spec, e))?;
+            from_exr = exr.parameters;
+            if let (true, Some(image)) = (thin_on, exr.thin_epidermis) {
+                let map_key = format!("{key}.maps");
+                let file_err = |message: String| RenderError::ChromophoreMap {
+                    key: map_key.clone(),
+                    path: PathBuf::from(spec),
+                    message,
+                };
+                let thickness_mm = match (thin_key_mm, exr.thin_epidermis_mm) {
+                    (Some(mm), _) => mm as f32,
+                    (None, Some(mm)) => check_mm(mm).map_err(|e| {
+                        file_err(format!("attribute {THIN_EPIDERMIS_ATTRIBUTE} = {mm}: {e}"))
+                    })?,
+                    (None, None) => {
+                        return Err(file_err(format!(
+                            "channel {THIN_EPIDERMIS_CHANNEL} without the attribute \
+                             {THIN_EPIDERMIS_ATTRIBUTE} (the thin epidermis' thickness, which \
+                             skin maps records): give {thin_mm_key} (skin maps' --thin-epidermis, \
+                             0.05 mm by default) or {key}.thin_epidermis = false"
+                        )));
+                    }
+                };
+                thin = Some(ThinInput {
+                    key: map_key,
+                    path: PathBuf::from(spec),
+                    image,
+                    thickness_mm,
+                });
+            }
         }
         if let Some(exposure) = keys.fit_maps {
             let fit_key = format!("{key}.fit_maps");
@@ -111,9 +161,19 @@ impl Loader<'_> {
             let Some((texture, name)) = keys.albedo else {
                 return Err(self.err(fit_key, "needs an albedo_texture to fit the maps to"));
             };
-            let fitted = fitted_maps::fit(texture, exposure).map_err(|e| self.err(&fit_key, e))?;
-            from_exr = fitted.map(Some);
-            exr_source = Some(("fit_maps", name.unwrap_or("albedo_texture").to_string()));
+            let thin_mm =
+                thin_on.then_some(thin_key_mm.unwrap_or(skin_fit::maps::THIN_EPIDERMIS_MM));
+            let fitted =
+                fitted_maps::fit(texture, exposure, thin_mm).map_err(|e| self.err(&fit_key, e))?;
+            from_exr = fitted.parameters.map(Some);
+            let source = name.unwrap_or("albedo_texture").to_string();
+            thin = fitted.thin.map(|(image, mm)| ThinInput {
+                key: fit_key.clone(),
+                path: PathBuf::from(&source),
+                image,
+                thickness_mm: mm as f32,
+            });
+            exr_source = Some(("fit_maps", source));
         }
         let scalars = [
             skin.params.melanin(),
@@ -163,6 +223,7 @@ impl Loader<'_> {
                 (Parameter::Hemoglobin, edit(keys.edits[1])),
             ],
             mask,
+            thin,
         })
     }
 }

@@ -76,6 +76,8 @@ impl Loader<'_> {
                     edit_mask,
                     profile_blend,
                     map_profile_error,
+                    thin_epidermis,
+                    thin_epidermis_mm,
                 } => {
                     let params =
                         self.skin_params(&key, preset, [*melanin, *eumelanin, *hemoglobin, *oil])?;
@@ -104,6 +106,7 @@ impl Loader<'_> {
                         edit_mask,
                         profile_blend,
                         map_profile_error,
+                        thin_epidermis: (thin_epidermis, thin_epidermis_mm),
                     };
                     let skin = self.skin_with_maps(&key, skin, &map_keys, &knobs)?;
                     Material::Skin(skin)

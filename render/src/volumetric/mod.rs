@@ -3,7 +3,8 @@
 //! ([`walk`]) until it leaves through the surface.
 //!
 //! Each skin material's meshes together bound its volume (closed meshes). The epidermis is the set
-//! of points within d_epi of that surface ([`distance::SurfaceDistance`]), the dermis the rest.
+//! of points within d_epi of that surface ([`distance::SurfaceDistance`]), the dermis the rest
+//! (with a thin epidermis in the maps, d_epi is the nearest surface texel's, [`hetero`]).
 //! Both layers' σa, σs and g are the material's own (`crate::media::SkinMedia`, built once when
 //! the material is), tabulated every 5 nm and read at the path's hero wavelength.
 
@@ -157,7 +158,11 @@ impl Volumetric {
                 skin.media.dermis.clone(),
                 skin.media.phase_g,
                 skin.params.eta() as f32,
-                skin.params.epidermis_thickness_mm() as f32,
+                skin.maps
+                    .as_ref()
+                    .map_or(skin.params.epidermis_thickness_mm() as f32, |m| {
+                        m.deepest_epidermis_mm()
+                    }),
                 triangles,
             );
             volume.maps = skin.maps.as_ref().map(|maps| {

@@ -108,7 +108,12 @@ impl ThinParts {
                 dermis: skin.media.dermis.clone(),
                 phase_g: skin.media.phase_g,
                 eta: skin.params.eta() as f32,
-                d_epi_mm: skin.params.epidermis_thickness_mm() as f32,
+                d_epi_mm: skin
+                    .maps
+                    .as_ref()
+                    .map_or(skin.params.epidermis_thickness_mm() as f32, |m| {
+                        m.deepest_epidermis_mm()
+                    }),
                 maps: skin.maps.clone(),
                 volume: OnceLock::new(),
                 tested: AtomicU64::new(0),
