@@ -4,6 +4,7 @@
 mod adaptive;
 mod fidelity;
 mod hetero;
+mod hetero_thin;
 mod majorant;
 mod passes;
 mod sampler;

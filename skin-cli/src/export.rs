@@ -183,7 +183,7 @@ fn run_textured(
         .read(maps)
         .with_context(|| format!("--maps {}", maps.display()))?;
     let channels = render::material::maps::read_maps_exr(&bytes, maps).context("--maps")?;
-    let [melanin, eumelanin, hemoglobin] = channels;
+    let [melanin, eumelanin, hemoglobin] = channels.parameters;
     let missing = |name: &str| anyhow::anyhow!("--maps {}: no channel '{name}'", maps.display());
     let melanin = melanin.ok_or_else(|| missing("melanin"))?;
     let eumelanin = eumelanin.ok_or_else(|| missing("eumelanin"))?;

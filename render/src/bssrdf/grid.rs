@@ -37,12 +37,10 @@ pub struct ProfileGrid {
     pub max_error: f32,
 }
 
-/// Up to sixteen tables and their multilinear weights (those of weight 0 left out): the eight
-/// corners of a grid's cell, or of two grids' cells across the epidermis thickness
-/// ([`Corners::across_thickness`]).
+/// Up to eight tables and their multilinear weights (those of weight 0 left out).
 #[derive(Debug, Clone, Copy)]
 pub struct Corners<'a> {
-    tables: [Option<(&'a ProfileTable, f32)>; 16],
+    tables: [Option<(&'a ProfileTable, f32)>; 8],
 }
 
 impl ProfileGrid {
@@ -100,8 +98,8 @@ impl ProfileGrid {
         };
         let at = [0, 1, 2].map(|k| locate(k, p[k]));
         let (n0, n1) = (self.axes[0].len(), self.axes[1].len());
-        let mut tables = [None; 16];
-        for (c, slot) in tables.iter_mut().take(8).enumerate() {
+        let mut tables = [None; 8];
+        for (c, slot) in tables.iter_mut().enumerate() {
             let bits = [c & 1, (c >> 1) & 1, (c >> 2) & 1];
             let mut w = 1.0;
             let mut index = [0usize; 3];
@@ -118,31 +116,7 @@ impl ProfileGrid {
     }
 }
 
-impl<'a> Corners<'a> {
-    /// The corners of the grid at the material's epidermis thickness (`thick`) and of the grid at
-    /// the thin one (`thin`) at weight `f` ∈ [0, 1] of the thin one: the interpolation in ln R is
-    /// then linear along the thickness d = d_thick + f (d_thin − d_thick), exact where R carries
-    /// the epidermis' filter exp(−2 σa d) (docs/physics.md §19.2).
-    #[must_use]
-    pub fn across_thickness(thick: Corners<'a>, thin: Corners<'a>, f: f32) -> Self {
-        let f = f.clamp(0.0, 1.0);
-        let mut tables = [None; 16];
-        let scaled = |c: Corners<'a>, s: f32| {
-            c.tables
-                .into_iter()
-                .flatten()
-                .map(move |(t, w)| (t, w * s))
-                .filter(|(_, w)| *w > 0.0)
-        };
-        for (slot, entry) in tables
-            .iter_mut()
-            .zip(scaled(thick, 1.0 - f).chain(scaled(thin, f)))
-        {
-            *slot = Some(entry);
-        }
-        Self { tables }
-    }
-
+impl Corners<'_> {
     /// The multilinear interpolation of ln v over the corners' values `v` (weights `w`):
     /// ∏ v_c^{w_c}, exact where v is exponential in the parameters (an absorbing layer's
     /// filter, §19.2); linear where a corner's value is 0 (beyond its profile's end).
@@ -158,7 +132,7 @@ impl<'a> Corners<'a> {
     /// R(r) at `r_mm` for each active lane of `wl` (0 for terminated lanes), mm⁻².
     #[must_use]
     pub fn eval(&self, wl: &SampledWavelengths, r_mm: f32) -> SampledSpectrum {
-        let mut at = [[(0.0f32, 0.0f32); 16]; N_WAVELENGTHS];
+        let mut at = [[(0.0f32, 0.0f32); 8]; N_WAVELENGTHS];
         let mut n = 0;
         for (table, w) in self.tables.iter().flatten() {
             let lanes: [_; N_WAVELENGTHS] =

@@ -178,37 +178,30 @@ pub struct SkinMaps {
 }
 
 impl SkinMaps {
-    /// The profile tables at the texel of `uv` and their weights: the grid's corners at its
-    /// parameters, and where the filtered thin-epidermis flag f is not 0, those of both grids at
-    /// weight 1 − f and f (ln R linear in the epidermis thickness, §19.2).
+    /// The profile tables at the texel of `uv` and their weights: the corners at its parameters
+    /// of the thin epidermis' grid where the texel is thin ([`ThinEpidermisMap::is_thin`]), else of
+    /// the material's (§19.2).
+    ///
+    /// [`ThinEpidermisMap::is_thin`]: super::maps::ThinEpidermisMap::is_thin
     #[must_use]
     #[inline]
     pub fn corners(&self, uv: Vec2) -> Corners<'_> {
         let p = self.maps.at(uv);
-        let thick = self.grid.corners(p);
         match (&self.thin_grid, self.maps.thin()) {
-            (Some(grid), Some(thin)) => {
-                let f = thin.at(uv);
-                if f > 0.0 {
-                    Corners::across_thickness(thick, grid.corners(p), f)
-                } else {
-                    thick
-                }
-            }
-            _ => thick,
+            (Some(grid), Some(thin)) if thin.is_thin(uv) => grid.corners(p),
+            _ => self.grid.corners(p),
         }
     }
 
-    /// The epidermis thickness at the texel of `uv`, mm: the material's where it has no thin
-    /// epidermis, the thin one where it has, linear in the filtered flag between (as the profiles'
-    /// ln R is, [`SkinMaps::corners`]).
+    /// The epidermis thickness at the texel of `uv`, mm: the thin one where the texel is thin,
+    /// else the material's.
     #[must_use]
     #[inline]
     pub fn epidermis_at_mm(&self, uv: Vec2) -> f32 {
-        let d = self.epidermis_mm;
-        self.maps
-            .thin()
-            .map_or(d, |t| d + t.at(uv) * (t.thickness_mm - d))
+        match self.maps.thin() {
+            Some(t) if t.is_thin(uv) => t.thickness_mm,
+            _ => self.epidermis_mm,
+        }
     }
 
     /// The deepest epidermis/dermis boundary under any texel, mm.

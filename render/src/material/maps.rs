@@ -93,14 +93,14 @@ pub struct ThinInput {
 }
 
 /// Where a skin has a thinner epidermis than the material's (docs/physics.md §19): a flag per
-/// texel, bilinearly filtered like the maps (a fraction across the border of a thin region).
+/// texel, bilinearly filtered like the maps and read as thin where the filtered flag is ≥ ½.
 #[derive(Debug, Clone)]
 pub struct ThinEpidermisMap {
     /// The thin epidermis' thickness, mm.
     pub thickness_mm: f32,
     flag: Texture,
-    /// [lo, hi] of each parameter (C_m, β_m, C_h) over the texels a filtered lookup with a
-    /// non-zero flag can read: those within one texel of a thin texel.
+    /// [lo, hi] of each parameter (C_m, β_m, C_h) over the texels a filtered lookup where the
+    /// flag is not 0 can read: those within one texel of a thin texel.
     range: [[f32; 2]; 3],
 }
 
@@ -110,6 +110,15 @@ impl ThinEpidermisMap {
     #[inline]
     pub fn at(&self, uv: Vec2) -> f32 {
         self.flag.lookup(uv)[0]
+    }
+
+    /// Whether the skin at `uv` has the thin epidermis: the filtered flag at least ½, so the
+    /// border between the two skins is the flag's smooth ½ contour, between the texel centres
+    /// (docs/physics.md §19.2).
+    #[must_use]
+    #[inline]
+    pub fn is_thin(&self, uv: Vec2) -> bool {
+        self.at(uv) >= 0.5
     }
 
     /// [lo, hi] of each parameter (C_m, β_m, C_h) wherever the flag is not 0.
@@ -579,6 +588,63 @@ mod tests {
             mask: None,
             thin: None,
         }
+    }
+
+    /// A texel is thin where the bilinearly filtered flag is at least ½: between a thin texel
+    /// and a normal one the border lies midway between their centres (u wraps, so also across
+    /// u = 0); the thin skin's parameter box spans the texels within one texel of a thin one and
+    /// no others; a flag that is 0 everywhere gives no thin skin.
+    #[test]
+    fn thin_texels_border_midway_and_bound_their_box() {
+        let mut i = inputs(
+            ValueImage {
+                width: 4,
+                height: 1,
+                values: vec![0.1, 0.2, 0.3, 0.4],
+            },
+            Edit {
+                scale: 1.0,
+                offset: 0.0,
+            },
+        );
+        let thin = |flags: Vec<f32>| ThinInput {
+            key: "materials.s.maps".into(),
+            path: "maps.exr".into(),
+            image: ValueImage {
+                width: 4,
+                height: 1,
+                values: flags,
+            },
+            thickness_mm: 0.05,
+        };
+        i.thin = Some(thin(vec![0.0, 1.0, 0.0, 0.0]));
+        let maps = ChromophoreMaps::assemble(i.clone()).unwrap().unwrap();
+        let t = maps.thin().expect("a thin texel");
+        // Texel centres at u = 0.125 + 0.25 k; texel 1 (u 0.375) is thin.
+        for (u, want) in [
+            (0.26, true),
+            (0.374, true),
+            (0.49, true),
+            (0.24, false),
+            (0.51, false),
+        ] {
+            assert_eq!(t.is_thin(Vec2::new(u, 0.5)), want, "u = {u}");
+        }
+        assert_eq!(t.range()[0], [0.1, 0.3]);
+        i.thin = Some(thin(vec![1.0, 0.0, 0.0, 0.0]));
+        let maps = ChromophoreMaps::assemble(i.clone()).unwrap().unwrap();
+        let t = maps.thin().unwrap();
+        // The border with texel 3 lies at u = 1 ≡ 0.
+        assert!(t.is_thin(Vec2::new(0.01, 0.5)) && !t.is_thin(Vec2::new(0.99, 0.5)));
+        assert_eq!(t.range()[0], [0.1, 0.4]);
+        i.thin = Some(thin(vec![0.0; 4]));
+        assert!(
+            ChromophoreMaps::assemble(i)
+                .unwrap()
+                .unwrap()
+                .thin()
+                .is_none()
+        );
     }
 
     /// Scalars fill the parameters without a map; the edit v' = s v + o applies everywhere without
