@@ -339,7 +339,8 @@ pub enum MaterialDesc {
         #[serde(default, deserialize_with = "opt_finite")]
         map_profile_error: Option<f32>,
         /// Whether texels flagged in the maps' `thin_epidermis` channel (or fitted so by
-        /// `fit_maps`) take the thin epidermis (default true; false: the material's everywhere).
+        /// `fit_maps`) take the thin epidermis (default true; false: every texel keeps its
+        /// chromophores under the material's epidermis).
         thin_epidermis: Option<bool>,
         /// The thin epidermis' thickness, mm, (0, 10] (default: maps.exr's `thin_epidermis_mm`
         /// attribute; with `fit_maps`, the fit's, 0.05 mm by default).

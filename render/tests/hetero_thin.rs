@@ -56,8 +56,8 @@ fn with_epidermis(mut scene: Scene, d_mm: f64) -> Scene {
 /// noise plus 2% (the BSSRDF's thin grid holds that skin's table on the material's wavelength
 /// rows, the scalar skin its own). The flag
 /// is read: with `thin_epidermis = false` the same maps render under the 0.25 mm epidermis, less
-/// than half as bright (the filter's ratio exp(−2 σa · 0.2 mm) is about 0.1 at normal incidence,
-/// diffuse light crossing obliquely darkens more).
+/// than half as bright (the walk at high counts: 0.069 against 0.201, BENCHMARKS.md
+/// "Heterogeneous skin").
 #[test]
 fn uniform_thin_map_renders_as_the_scalar_thin_skin() {
     let dir = tempfile::tempdir().unwrap();
@@ -103,9 +103,10 @@ fn uniform_thin_map_renders_as_the_scalar_thin_skin() {
 
 /// The slab split at x = 0 into thin (0.05 mm, left) and normal (0.25 mm, right) epidermis over
 /// the same chromophores, at 550 nm: the BSSRDF with the default rule against the volumetric walk,
-/// region means ≥ 1 mm from the split within 10% + 3σ (the uniform slabs' own BSSRDF–walk gap,
-/// measured at 550 nm with high counts: 6.6% thin, 2.1% normal; BENCHMARKS.md "Heterogeneous
-/// skin"), and the two halves at least twice apart in both (the flag's effect is what is tested).
+/// region means ≥ 1 mm from the split within 8% + 3σ (the uniform slabs' own BSSRDF–walk gap,
+/// measured at 550 nm with high counts, is 4.1% thin and 5.2% normal, and the split adds at most
+/// 2% to it, as for melanin, BENCHMARKS.md "Heterogeneous skin"), and the two halves at least
+/// twice apart in both (0.20 against 0.069 measured: the flag's effect is what is tested).
 #[test]
 fn split_thin_slab_follows_the_volumetric_walk() {
     let dir = tempfile::tempdir().unwrap();
@@ -137,7 +138,7 @@ fn split_thin_slab_follows_the_volumetric_walk() {
         let (v, vs) = region(&vol, half, from, to);
         let (b, bs) = region(&bss, half, from, to);
         assert!(
-            (b - v).abs() <= 0.10 * v + 3.0 * vs.hypot(bs),
+            (b - v).abs() <= 0.08 * v + 3.0 * vs.hypot(bs),
             "[{from}, {to}] mm: BSSRDF {b} ± {bs} vs walk {v} ± {vs}"
         );
         means.push((v, b));

@@ -161,18 +161,22 @@ impl Loader<'_> {
             let Some((texture, name)) = keys.albedo else {
                 return Err(self.err(fit_key, "needs an albedo_texture to fit the maps to"));
             };
-            let thin_mm =
-                thin_on.then_some(thin_key_mm.unwrap_or(skin_fit::maps::THIN_EPIDERMIS_MM));
-            let fitted =
-                fitted_maps::fit(texture, exposure, thin_mm).map_err(|e| self.err(&fit_key, e))?;
+            // The fit is the same whether the flag is then read or not: `thin_epidermis = false`
+            // only renders every texel under the material's epidermis.
+            let thin_mm = thin_key_mm.unwrap_or(skin_fit::maps::THIN_EPIDERMIS_MM);
+            let fitted = fitted_maps::fit(texture, exposure, Some(thin_mm))
+                .map_err(|e| self.err(&fit_key, e))?;
             from_exr = fitted.parameters.map(Some);
             let source = name.unwrap_or("albedo_texture").to_string();
-            thin = fitted.thin.map(|(image, mm)| ThinInput {
-                key: fit_key.clone(),
-                path: PathBuf::from(&source),
-                image,
-                thickness_mm: mm as f32,
-            });
+            thin = fitted
+                .thin
+                .filter(|_| thin_on)
+                .map(|(image, mm)| ThinInput {
+                    key: fit_key.clone(),
+                    path: PathBuf::from(&source),
+                    image,
+                    thickness_mm: mm as f32,
+                });
             exr_source = Some(("fit_maps", source));
         }
         let scalars = [
