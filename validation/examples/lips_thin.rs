@@ -4,10 +4,9 @@
 //! linear sRGB (1, 1, 1)), seen close up along the lips' mean normal. Renders with
 //! `thin_epidermis = false` (every texel under the material's 0.25 mm epidermis: the renderer
 //! before) and with the flag read (0.05 mm under the lips), with the default integrator. The lip
-//! pixels are those whose primary ray hits a thin texel inside the lips' uv box (the thin
-//! triangles facing forward within 40 mm of the foremost); their mean colour is compared in
-//! CIELAB (ΔE2000) with the mean of the texture's thin texels in that box at the fit's exposure
-//! (linear texel ×
+//! texels are the thin ones as red as the vermilion (a* > 27, 40 < L* < 56 as given), the lip
+//! pixels those whose primary ray hits one; their mean colour is compared in CIELAB (ΔE2000) with
+//! the mean of the lip texels at the fit's exposure (linear texel ×
 //! gains: the colour the fitted skin reproduces), raw and with the render's luminance scaled to
 //! the texture's (shading and the sky's occlusion darken a render, not the texture). Writes
 //! OUT/lips_before_after.png (before | after) and OUT/lips.csv.
@@ -57,45 +56,43 @@ fn main() -> anyhow::Result<()> {
     };
     let maps = skin.maps.as_ref().expect("fitted maps");
     let thin = maps.maps.thin().expect("thin texels on the lips");
-    // The lips: the thin triangles facing forward within 40 mm of the foremost one (the scalp's
-    // pink texels are thin too), their area-weighted centre and normal, and their uv box.
-    let tris: Vec<_> = probe
-        .geometry
-        .triangles_with_uvs_of(0)
-        .into_iter()
-        .filter(|(t, uv)| {
-            let n = (t[1] - t[0]).cross(t[2] - t[0]).normalize_or_zero();
-            n.z > 0.5 && thin.is_thin((uv[0] + uv[1] + uv[2]) / 3.0)
+    // The lips: thin texels as red as the vermilion (a* > 27, 40 < L* < 56 as given, the lips'
+    // selection of BENCHMARKS.md "Chromophore maps"); the triangles whose centroid reads one,
+    // their area-weighted centre and normal.
+    let texture = &probe.textures[0];
+    let (tw, th) = texture.size();
+    let texel_of = |uv: Vec2| {
+        let x = ((uv.x.rem_euclid(1.0) * tw as f32) as usize).min(tw - 1);
+        let y = ((uv.y.clamp(0.0, 1.0) * th as f32) as usize).min(th - 1);
+        y * tw + x
+    };
+    let lips: Vec<bool> = texture
+        .texels()
+        .iter()
+        .enumerate()
+        .map(|(i, t)| {
+            let uv = Vec2::new(
+                ((i % tw) as f32 + 0.5) / tw as f32,
+                ((i / tw) as f32 + 0.5) / th as f32,
+            );
+            let l = lab(t.map(f64::from));
+            thin.is_thin(uv) && l.a > 27.0 && l.l > 40.0 && l.l < 56.0
         })
         .collect();
     let centroid = |t: &[Vec3; 3]| (t[0] + t[1] + t[2]) / 3.0;
-    let front = tris
-        .iter()
-        .map(|(t, _)| centroid(t))
-        .max_by(|a, b| a.z.total_cmp(&b.z))
-        .expect("forward thin triangles");
-    let lips: Vec<_> = tris
-        .iter()
-        .filter(|(t, _)| centroid(t).distance(front) < 40.0)
-        .collect();
-    let (mut centre, mut normal, mut area) = (Vec3::ZERO, Vec3::ZERO, 0.0f32);
-    let (mut uv_lo, mut uv_hi) = (Vec2::splat(f32::INFINITY), Vec2::splat(f32::NEG_INFINITY));
-    for (t, uv) in &lips {
+    let (mut centre, mut normal, mut area, mut count) = (Vec3::ZERO, Vec3::ZERO, 0.0f32, 0);
+    for (t, uv) in probe.geometry.triangles_with_uvs_of(0) {
         let n = (t[1] - t[0]).cross(t[2] - t[0]);
-        let a = 0.5 * n.length();
-        centre += a * centroid(t);
-        normal += 0.5 * n;
-        area += a;
-        for p in uv {
-            uv_lo = uv_lo.min(*p);
-            uv_hi = uv_hi.max(*p);
+        if n.z > 0.0 && lips[texel_of((uv[0] + uv[1] + uv[2]) / 3.0)] {
+            let a = 0.5 * n.length();
+            centre += a * centroid(&t);
+            normal += 0.5 * n;
+            area += a;
+            count += 1;
         }
     }
     let (centre, normal) = (centre / area, normal.normalize());
-    println!(
-        "lips: {} triangles, {area:.0} mm² around {centre} facing {normal}, uv {uv_lo}–{uv_hi}",
-        lips.len()
-    );
+    println!("lips: {count} triangles, {area:.0} mm² around {centre} facing {normal}");
     let eye = centre + normal * DISTANCE_MM;
     let fov = 2.0 * (HALF_VIEW_MM / DISTANCE_MM).atan().to_degrees();
     let camera = format!(
@@ -119,20 +116,13 @@ fn main() -> anyhow::Result<()> {
     let fit = MapsModel::load(&opts)?.fit(texels, None, &opts, &|_| {})?;
     let gains = fit.summary.exposure;
     let flags = &fit.thin_epidermis.as_ref().expect("thin texels").texels;
-    let (tw, th) = probe.textures[0].size();
-    let in_lips = |i: usize| {
-        let uv = Vec2::new(
-            ((i % tw) as f32 + 0.5) / tw as f32,
-            ((i / tw) as f32 + 0.5) / th as f32,
-        );
-        uv.cmpge(uv_lo).all() && uv.cmple(uv_hi).all()
-    };
     let (mut sum, mut n) = ([0.0f64; 3], 0usize);
-    for (_, (t, _)) in texels
+    for (t, _) in texels
         .iter()
         .zip(flags)
-        .enumerate()
-        .filter(|(i, (_, f))| **f && in_lips(*i))
+        .zip(&lips)
+        .filter(|((_, f), l)| **f && **l)
+        .map(|(x, _)| x)
     {
         for c in 0..3 {
             sum[c] += f64::from(t[c]) * gains[c];
@@ -179,8 +169,7 @@ fn main() -> anyhow::Result<()> {
                 let Some(hit) = scene.geometry.intersect(o, d, 0.0, f32::INFINITY) else {
                     continue;
                 };
-                let in_box = hit.uv.cmpge(uv_lo).all() && hit.uv.cmple(uv_hi).all();
-                if hit.material == 0 && in_box && thin.is_thin(hit.uv) {
+                if hit.material == 0 && lips[texel_of(hit.uv)] {
                     let c = film.linear_srgb(x, y);
                     for i in 0..3 {
                         sum[i] += f64::from(c[i]);
