@@ -223,3 +223,51 @@ fn bad_thin_epidermis_is_an_error_naming_key_and_file() {
         thin.thickness_mm
     );
 }
+
+/// `fit_maps` hands its thin-epidermis flag to the renderer: a 2 × 1 PNG of a skin of the exact
+/// model under a 0.05 mm epidermis with C_h 0.15 (beyond the normal skin's gamut, as the lips;
+/// 8-bit sRGB) beside a skin of the default epidermis (C_m 0.02, C_h 0.02) gives the first texel
+/// the thin epidermis (0.05 mm, the fit's default) and not the second; with `thin_epidermis =
+/// false` the flag is dropped and the fit kept.
+#[test]
+fn fit_maps_flags_its_thin_texels() {
+    use skin_fit::ColourModel;
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let base = skin_fit::FitOptions::default().base;
+    let rgb: Vec<u8> = [(0.05, [0.02, 0.6, 0.15]), (0.25, [0.02, 0.6, 0.02])]
+        .iter()
+        .flat_map(|(mm, p)| {
+            let params = base.with_epidermis_thickness_mm(*mm).unwrap();
+            let model = ColourModel::new(10.0, multipole::Method::Exact, params).unwrap();
+            let skin = model.skin(p[0], p[1], p[2]).unwrap();
+            let linear = model.xyz(&skin).unwrap().to_linear_srgb().0;
+            linear.map(|c| (skin_optics::color::srgb_encode(c) * 255.0).round() as u8)
+        })
+        .collect();
+    image::RgbImage::from_raw(2, 1, rgb)
+        .unwrap()
+        .save(d.join("albedo.png"))
+        .unwrap();
+    let load = |keys: &str| {
+        strip_scene(
+            d,
+            1.0,
+            4,
+            &format!("albedo_texture = \"albedo.png\"\nfit_maps = \"1\"\n{keys}"),
+        )
+    };
+    let scene = load("");
+    let Material::Skin(skin) = &scene.materials[0] else {
+        panic!("skin");
+    };
+    let thin = skin.maps.as_ref().unwrap().maps.thin().expect("a thin texel");
+    assert!((thin.thickness_mm - 0.05).abs() < 1e-7, "{}", thin.thickness_mm);
+    assert!(thin.is_thin(glam::Vec2::new(0.25, 0.5)));
+    assert!(!thin.is_thin(glam::Vec2::new(0.75, 0.5)));
+    let scene = load("thin_epidermis = false");
+    let Material::Skin(skin) = &scene.materials[0] else {
+        panic!("skin");
+    };
+    assert!(skin.maps.as_ref().unwrap().maps.thin().is_none());
+}
