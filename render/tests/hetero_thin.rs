@@ -261,8 +261,18 @@ fn fit_maps_flags_its_thin_texels() {
     let Material::Skin(skin) = &scene.materials[0] else {
         panic!("skin");
     };
-    let thin = skin.maps.as_ref().unwrap().maps.thin().expect("a thin texel");
-    assert!((thin.thickness_mm - 0.05).abs() < 1e-7, "{}", thin.thickness_mm);
+    let thin = skin
+        .maps
+        .as_ref()
+        .unwrap()
+        .maps
+        .thin()
+        .expect("a thin texel");
+    assert!(
+        (thin.thickness_mm - 0.05).abs() < 1e-7,
+        "{}",
+        thin.thickness_mm
+    );
     assert!(thin.is_thin(glam::Vec2::new(0.25, 0.5)));
     assert!(!thin.is_thin(glam::Vec2::new(0.75, 0.5)));
     let scene = load("thin_epidermis = false");
