@@ -450,3 +450,30 @@ fn bad_input_is_one_line_and_leaves_no_maps() {
         );
     }
 }
+
+/// Texels out of the texture skin's gamut that the thin-epidermis skin reproduces (a skin of the
+/// exact model under 0.05 mm with C_h 0.15, as the lips) are flagged in maps.exr's
+/// `thin_epidermis` channel, and the file records the thickness they were fitted under in its
+/// `thin_epidermis_mm` attribute (`--thin-epidermis 0.06` here), which the renderer reads with it.
+#[test]
+fn thin_epidermis_texels_carry_their_thickness() {
+    let base = skin_fit::FitOptions::default().base;
+    let thin = base.with_epidermis_thickness_mm(0.06).unwrap();
+    let m = ColourModel::new(10.0, multipole::Method::Exact, thin).unwrap();
+    let skin = m.skin(0.02, 0.6, 0.15).unwrap();
+    let red = m.xyz(&skin).unwrap().to_linear_srgb().0.map(|c| c as f32);
+    let normal = skin_texel([0.02, 0.6, 0.02]);
+    let (tmp, out) = out_dir("thin");
+    let exr = tmp.path().join("albedo.exr");
+    write_exr(&exr, 2, 1, &[red, normal]);
+    maps_of(
+        &exr,
+        &out,
+        &["--eumelanin", "0.6", "--thin-epidermis", "0.06"],
+    );
+    let bytes = std::fs::read(out.join("maps.exr")).unwrap();
+    let maps = render::material::maps::read_maps_exr(&bytes, &out.join("maps.exr")).unwrap();
+    assert_eq!(maps.thin_epidermis.unwrap().values, vec![1.0, 0.0]);
+    let mm = maps.thin_epidermis_mm.expect("the thickness attribute");
+    assert!((mm - 0.06).abs() < 1e-7, "{mm}");
+}
