@@ -2,7 +2,8 @@
 //! chromophores are those of the texel of its nearest surface point, in the epidermis and in the
 //! dermis alike; σs does not depend on them ([DJ06] eq. 6), so only σa varies, and the walk's
 //! majorant takes the largest σa over the maps' parameter box, or over the box of the cell it
-//! is in ([`super::majorant`]).
+//! is in ([`super::majorant`]). Where texels have a thin epidermis, the epidermis/dermis boundary
+//! lies at the nearest texel's thickness below the surface.
 
 use super::majorant::{CellMajorant, MajorantGrid};
 use super::nearest::{NearestAnchor, NearestSurface};
@@ -68,6 +69,27 @@ impl MapMedium {
 }
 
 impl MapAbsorption<'_> {
+    /// Whether some texel of the maps has a thin epidermis.
+    #[must_use]
+    pub fn has_thin(&self) -> bool {
+        self.medium.maps.maps.thin().is_some()
+    }
+
+    /// The epidermis thickness under the texel of the surface point nearest `x`, mm: the thin one
+    /// where that texel is thin, else the material's (docs/physics.md §19).
+    #[must_use]
+    #[inline]
+    pub fn epidermis_mm(&self, x: DVec3) -> f32 {
+        let mut anchor = self.anchor.get();
+        let uv = self
+            .medium
+            .grid
+            .uv(&self.medium.nearest, x, &mut anchor)
+            .unwrap_or_default();
+        self.anchor.set(anchor);
+        self.medium.maps.epidermis_at_mm(uv)
+    }
+
     /// σa at `x` of the epidermis (`epidermis`) or the dermis, from the texel of the surface
     /// point nearest `x`, mm⁻¹.
     #[must_use]

@@ -210,10 +210,15 @@ impl MajorantGrid {
             let (u, v) = nearest.uv_box_within(t, c, reach_mm);
             union(acc, maps.range_over(u, v))
         });
+        // With a thin epidermis in the maps, d_epi is the deepest boundary and the dermis may
+        // begin at the thin one.
+        let shallowest = maps.thin().map_or(self.d_epi_mm, |t| {
+            self.d_epi_mm.min(f64::from(t.thickness_mm))
+        });
         Cell {
             range,
             epidermis: dist - r <= self.d_epi_mm,
-            dermis: dist + r > self.d_epi_mm,
+            dermis: dist + r > shallowest,
             reach_mm,
             list: list.into_boxed_slice(),
         }

@@ -169,7 +169,7 @@ impl Volumetric {
                 hetero::MapMedium::new(
                     maps.clone(),
                     &scene.geometry.triangles_with_uvs_of(index as u32),
-                    skin.params.epidermis_thickness_mm(),
+                    f64::from(maps.deepest_epidermis_mm()),
                     majorant::DEFAULT_CELL_MM,
                 )
             });

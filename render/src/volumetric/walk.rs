@@ -232,7 +232,13 @@ pub fn walk<R: RngCore>(
         }
         out.tentative += 1;
         segment.collide(s);
-        let layer = if !one_layer && in_epidermis(region, &mut anchor, x, d_epi) {
+        // With a thin epidermis in the maps, d_epi is the deepest boundary; a point above it is
+        // in the epidermis when it also lies above its nearest texel's.
+        let layer = if !one_layer
+            && in_epidermis(region, &mut anchor, x, d_epi)
+            && maps.as_ref().is_none_or(|m| {
+                !m.has_thin() || in_epidermis(region, &mut anchor, x, f64::from(m.epidermis_mm(x)))
+            }) {
             Layer::Epidermis
         } else {
             Layer::Dermis
