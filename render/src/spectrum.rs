@@ -54,9 +54,24 @@ pub fn visible_wavelength_pdf(nm: f32) -> f32 {
 /// The wavelength of [`WavelengthSampling::Visible`] at CDF value `u` in [0, 1), nm.
 #[must_use]
 pub fn sample_visible_wavelength(u: f32) -> f32 {
+    sample_visible_with_pdf(u).0
+}
+
+/// The wavelength of [`WavelengthSampling::Visible`] at CDF value `u` in [0, 1) (nm) and its
+/// density there (nm⁻¹, [`visible_wavelength_pdf`]). The sampler inverts tanh(A (λ − 538)) = y,
+/// y = t₀ + u (t₁ − t₀), so the density's 1/cosh² is 1 − y² = (1 − y)(1 + y) without a cosh
+/// (four per path were a few % of a path's instructions).
+fn sample_visible_with_pdf(u: f32) -> (f32, f32) {
     let (t0, t1) = visible_cdf_bounds();
-    let nm = VISIBLE_CENTRE_NM + (t0 + u * (t1 - t0)).atanh() / VISIBLE_A_PER_NM;
-    nm.clamp(LAMBDA_MIN_NM, LAMBDA_MAX_NM)
+    let y = t0 + u * (t1 - t0);
+    let nm = VISIBLE_CENTRE_NM + y.atanh() / VISIBLE_A_PER_NM;
+    if (LAMBDA_MIN_NM..=LAMBDA_MAX_NM).contains(&nm) {
+        (nm, VISIBLE_A_PER_NM * ((1.0 - y) * (1.0 + y)) / (t1 - t0))
+    } else {
+        // Rounding at the ends of the range: the density where the wavelength is kept.
+        let nm = nm.clamp(LAMBDA_MIN_NM, LAMBDA_MAX_NM);
+        (nm, visible_wavelength_pdf(nm))
+    }
 }
 
 /// A quantity (radiance, throughput, albedo) at the four sampled wavelengths of a path.
@@ -178,16 +193,16 @@ impl SampledWavelengths {
         match how {
             WavelengthSampling::Uniform => Self::sample_visible(u),
             WavelengthSampling::Visible => {
-                let lambda_nm = std::array::from_fn(|i| {
+                let drawn: [(f32, f32); N_WAVELENGTHS] = std::array::from_fn(|i| {
                     let mut x = u + i as f32 / N_WAVELENGTHS as f32;
                     if x >= 1.0 {
                         x -= 1.0;
                     }
-                    sample_visible_wavelength(x)
+                    sample_visible_with_pdf(x)
                 });
                 Self {
-                    lambda_nm,
-                    pdf: lambda_nm.map(visible_wavelength_pdf),
+                    lambda_nm: drawn.map(|(nm, _)| nm),
+                    pdf: drawn.map(|(_, pdf)| pdf),
                 }
             }
         }
@@ -484,6 +499,22 @@ mod tests {
         }
         assert_eq!(k, 10);
         assert!((cdf - 1.0).abs() < 1e-4, "∫ p dλ = {cdf}");
+    }
+
+    /// The density the sampler returns with each wavelength, (1 − y²) from the inverted tanh, is
+    /// the closed-form 1/cosh² density at that wavelength: over 1001 CDF values, within 1e-5
+    /// relative (f32 rounding of y, of the wavelength and of cosh: a few 1e-7 each).
+    #[test]
+    fn sampled_density_is_the_closed_form_density() {
+        for k in 0..=1000 {
+            let u = (k as f32 / 1000.0).min(1.0 - f32::EPSILON);
+            let (nm, pdf) = sample_visible_with_pdf(u);
+            let want = visible_wavelength_pdf(nm);
+            assert!(
+                (pdf / want - 1.0).abs() < 1e-5,
+                "u = {u}: {nm} nm, density {pdf} against {want}"
+            );
+        }
     }
 
     /// Visible sampling estimates the luminance of a constant spectrum as 1, with less spread

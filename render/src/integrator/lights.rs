@@ -7,10 +7,23 @@ use crate::sampler::PathSampler;
 use crate::scene::Scene;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use glam::Vec3;
+use smallvec::SmallVec;
+
+/// Lights whose probabilities a path keeps without allocating (a scene with more spills to the
+/// heap, still correct).
+const INLINE_LIGHTS: usize = 8;
+
+/// Light selection probabilities at a vertex, the environment last.
+pub(super) type LightProbabilities = SmallVec<[f32; INLINE_LIGHTS]>;
 
 /// Probability of picking each light (the environment last) at `p` with shading normal `n`,
 /// ∝ its selection weight; written into `probs`, returns false when nothing can light `p`.
-pub(super) fn light_probabilities(scene: &Scene, p: Vec3, n: Vec3, probs: &mut Vec<f32>) -> bool {
+pub(super) fn light_probabilities(
+    scene: &Scene,
+    p: Vec3,
+    n: Vec3,
+    probs: &mut LightProbabilities,
+) -> bool {
     probs.clear();
     probs.extend(scene.lights.iter().map(|l| l.selection_weight(p, n)));
     if let Some(env) = &scene.environment {
@@ -95,17 +108,17 @@ pub(super) struct PrevVertex {
     pub ns: Vec3,
     pub bsdf_pdf: f32,
     /// Light selection probabilities there (environment last).
-    pub pick: Vec<f32>,
+    pub pick: LightProbabilities,
     pub p: Vec3,
 }
 
 impl PrevVertex {
     /// Make the vertex (position, shading normal, density of the direction sampled there, sr⁻¹)
     /// the previous one: it takes over `pick` (zeroed first when nothing lit it), and `pick`
-    /// gets the old vertex's buffer back, so no path allocates after its first bounce.
+    /// gets the old vertex's buffer back.
     pub fn record(
         prev: &mut Option<PrevVertex>,
-        pick: &mut Vec<f32>,
+        pick: &mut LightProbabilities,
         lit: bool,
         n_lights: usize,
         (p, ns, bsdf_pdf): (Vec3, Vec3, f32),

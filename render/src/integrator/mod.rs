@@ -34,7 +34,7 @@ use crate::scene::{Hit, Scene};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths, WavelengthSampling};
 use crate::volumetric::{SkinVolume, ThinParts, Volumetric};
 use glam::Vec3;
-use lights::{PrevVertex, Receiver, direct_light, light_probabilities};
+use lights::{LightProbabilities, PrevVertex, Receiver, direct_light, light_probabilities};
 
 /// Where each decision of a bounce reads its uniforms in the bounce's region of
 /// [`PathSampler`] (sets of four dimensions: light choice and position at the hit with the
@@ -224,8 +224,8 @@ struct Path {
     d: Vec3,
     prev: Option<PrevVertex>,
     /// Light probabilities at the current vertex and at a subsurface exit point.
-    pick: Vec<f32>,
-    exit_pick: Vec<f32>,
+    pick: LightProbabilities,
+    exit_pick: LightProbabilities,
     /// Distance travelled from the camera, mm (the pixel footprint's scale).
     travelled_mm: f32,
     depth: u32,
@@ -287,8 +287,8 @@ impl PathTracer<'_> {
             o: origin,
             d: dir,
             prev: None,
-            pick: Vec::with_capacity(n_lights),
-            exit_pick: Vec::with_capacity(n_lights),
+            pick: LightProbabilities::new(),
+            exit_pick: LightProbabilities::new(),
             travelled_mm: 0.0,
             depth: 0,
             n_lights,

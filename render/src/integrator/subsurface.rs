@@ -6,7 +6,7 @@
 //! branch is chosen (weight 1/q). Both are unbiased; splitting removes the variance of skipping
 //! the exit's light whenever the surface branch is taken.
 
-use super::lights::{PrevVertex, Receiver, direct_light, light_probabilities};
+use super::lights::{LightProbabilities, PrevVertex, Receiver, direct_light, light_probabilities};
 use super::{Path, PathTracer, Random, Shading, Step, dims, probe, russian_roulette};
 use crate::bssrdf::{Exit, ProbeFrame, Subsurface, texture_modulation};
 use crate::material::{Material, SkinMaterial};
@@ -250,7 +250,7 @@ impl PathTracer<'_> {
         exit: &Exit,
         wl: &SampledWavelengths,
         (sampler, rays): (&mut PathSampler, &mut u64),
-        pick: &mut Vec<f32>,
+        pick: &mut LightProbabilities,
         outgoing: Option<Outgoing>,
     ) -> (SampledSpectrum, bool) {
         let scene = self.scene;

@@ -38,6 +38,7 @@ use brdf::Frame;
 #[cfg(test)]
 use brdf::TorranceSparrow;
 use glam::{Vec2, Vec3};
+use std::cell::Cell;
 use std::f32::consts::{FRAC_1_PI, PI};
 
 pub mod hetero;
@@ -85,6 +86,10 @@ pub struct Bsdf<'a> {
     /// Shading frame (+Z = shading normal, facing the outgoing direction).
     pub frame: Frame,
     lobes: Lobes<'a>,
+    /// The last (cos θ_o, surface lobe probability) of [`Bsdf::specular_probability`]: a path
+    /// asks for it at one ω_o up to four times per hit (light sampling, the branch, the
+    /// continuation and its density), and each costs a table lookup with a cube root.
+    specular: Cell<Option<(f32, f32)>>,
 }
 
 #[derive(Debug, Clone)]
@@ -209,7 +214,11 @@ impl Material {
                 }
             }
         };
-        Bsdf { frame, lobes }
+        Bsdf {
+            frame,
+            lobes,
+            specular: Cell::new(None),
+        }
     }
 }
 
@@ -254,27 +263,36 @@ impl Bsdf<'_> {
     /// Probability of choosing the surface lobe when sampling from `o` (local): proportional to
     /// the lobe's albedo against the body's mean albedo.
     fn specular_probability(&self, o_z: f32) -> f32 {
-        match &self.lobes {
+        if let Some((z, p)) = self.specular.get()
+            && z.to_bits() == o_z.to_bits()
+        {
+            return p;
+        }
+        let p = match &self.lobes {
             Lobes::Skin {
                 surface,
                 body,
                 directional,
                 ..
             } => {
-                let d = body.average() * surface.transmitted(o_z) / directional.normalisation();
-                surface_share(surface.albedo(o_z), d, 0.0)
+                let s = surface.albedo(o_z);
+                let d = body.average() * Surface::transmitted_of(s) / directional.normalisation();
+                surface_share(s, d, 0.0)
             }
             Lobes::SkinSurface {
                 surface,
                 subsurface_albedo,
             } => {
-                let d = subsurface_albedo * surface.transmitted(o_z);
+                let s = surface.albedo(o_z);
+                let d = subsurface_albedo * Surface::transmitted_of(s);
                 // The subsurface branch keeps at least 5% for the surface even where it
                 // reflects nothing, so the branch's weight 1/q stays bounded.
-                surface_share(surface.albedo(o_z), d, 0.05)
+                surface_share(s, d, 0.05)
             }
             Lobes::Lambert { .. } => 0.0,
-        }
+        };
+        self.specular.set(Some((o_z, p)));
+        p
     }
 
     /// Density with which [`Bsdf::sample`] picks `wi` for `wo`, sr⁻¹.

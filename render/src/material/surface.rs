@@ -60,9 +60,9 @@ impl<'a> Surface<'a> {
         }
     }
 
-    /// Fraction that enters: 1 − [`Self::albedo`].
-    pub(super) fn transmitted(&self, cos: f32) -> f32 {
-        1.0 - self.albedo(cos)
+    /// The fraction that enters where the surface reflects the fraction `albedo` ([`Self::albedo`]).
+    pub(super) fn transmitted_of(albedo: f32) -> f32 {
+        1.0 - albedo
     }
 
     /// The BRDF of the non-delta part, sr⁻¹ (0 for the smooth surface).
