@@ -175,7 +175,7 @@ impl Subsurface {
 
     /// The table resolved at each active lane's wavelength (`None` for a terminated lane).
     fn lanes(&self, wl: &SampledWavelengths) -> Lanes<'_> {
-        std::array::from_fn(|k| (wl.pdf()[k] > 0.0).then(|| self.table.at(wl.nm(k))))
+        std::array::from_fn(|k| (wl.pdf()[k] > 0.0).then(|| self.table.at_lane(wl, k)))
     }
 
     /// The lane probabilities of the radius wavelength under `radius` (luminance weight

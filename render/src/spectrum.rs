@@ -156,6 +156,45 @@ impl Div<f32> for SampledSpectrum {
     }
 }
 
+/// Where a wavelength falls on a uniform grid of wavelengths from [`LAMBDA_MIN_NM`]: the node at
+/// or below it and the weight of the next one (linear interpolation between nodes).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GridPosition {
+    /// Index of the lower node (at most the last but one).
+    pub index: usize,
+    /// Weight of node `index + 1`, in [0, 1].
+    pub weight: f32,
+}
+
+impl GridPosition {
+    /// `nm` on the grid of `nodes` ≥ 2 nodes `step_nm` apart from [`LAMBDA_MIN_NM`], clamped to
+    /// the grid's ends.
+    #[must_use]
+    #[inline]
+    pub fn on_grid(nm: f32, step_nm: f32, nodes: usize) -> Self {
+        let x = ((nm - LAMBDA_MIN_NM) / step_nm).clamp(0.0, (nodes - 1) as f32);
+        let index = (x as usize).min(nodes - 2);
+        Self {
+            index,
+            weight: x - index as f32,
+        }
+    }
+
+    /// The value between `values[index]` and `values[index + 1]`.
+    #[must_use]
+    #[inline]
+    pub fn lerp(self, values: &[f32]) -> f32 {
+        let (a, b) = (values[self.index], values[self.index + 1]);
+        a + self.weight * (b - a)
+    }
+}
+
+/// Step of the per-wavelength tables every 10 nm over the rendered range (the BSSRDF's profiles
+/// and incidence gain), nm.
+pub const GRID_10NM_STEP_NM: f32 = 10.0;
+/// Nodes of the 10-nm grid over 380–780 nm.
+pub const GRID_10NM_NODES: usize = 41;
+
 /// The four wavelengths of one path (nm) and their sampling densities (nm⁻¹).
 ///
 /// The hero wavelength λ₀ is uniform in [380, 780] nm and the other three are rotated by a quarter
@@ -165,9 +204,31 @@ impl Div<f32> for SampledSpectrum {
 pub struct SampledWavelengths {
     lambda_nm: [f32; N_WAVELENGTHS],
     pdf: [f32; N_WAVELENGTHS],
+    /// Each wavelength's place on [`SpectrumTable`]'s grid and on the 10-nm grid, found once per
+    /// path: every table a path reads at its wavelengths shares them.
+    on_5nm: [GridPosition; N_WAVELENGTHS],
+    on_10nm: [GridPosition; N_WAVELENGTHS],
 }
 
 impl SampledWavelengths {
+    /// The wavelengths `lambda_nm` with densities `pdf`, and their places on the shared grids.
+    fn new(lambda_nm: [f32; N_WAVELENGTHS], pdf: [f32; N_WAVELENGTHS]) -> Self {
+        Self {
+            lambda_nm,
+            pdf,
+            on_5nm: lambda_nm.map(SpectrumTable::position),
+            on_10nm: lambda_nm
+                .map(|nm| GridPosition::on_grid(nm, GRID_10NM_STEP_NM, GRID_10NM_NODES)),
+        }
+    }
+
+    /// Where wavelength `i` falls on the 10-nm grid from 380 nm ([`GRID_10NM_NODES`] nodes).
+    #[must_use]
+    #[inline]
+    pub fn on_10nm(&self, i: usize) -> GridPosition {
+        self.on_10nm[i]
+    }
+
     /// Stratified sample of the visible range from `u` in [0, 1).
     #[must_use]
     pub fn sample_visible(u: f32) -> Self {
@@ -179,10 +240,7 @@ impl SampledWavelengths {
             }
             LAMBDA_MIN_NM + x * range
         });
-        Self {
-            lambda_nm,
-            pdf: [1.0 / range; N_WAVELENGTHS],
-        }
+        Self::new(lambda_nm, [1.0 / range; N_WAVELENGTHS])
     }
 
     /// Four wavelengths from `u` in [0, 1) by `how`: the hero at CDF value u, the others at
@@ -200,10 +258,7 @@ impl SampledWavelengths {
                     }
                     sample_visible_with_pdf(x)
                 });
-                Self {
-                    lambda_nm: drawn.map(|(nm, _)| nm),
-                    pdf: drawn.map(|(_, pdf)| pdf),
-                }
+                Self::new(drawn.map(|(nm, _)| nm), drawn.map(|(_, pdf)| pdf))
             }
         }
     }
@@ -212,10 +267,7 @@ impl SampledWavelengths {
     /// read with [`SampledWavelengths::to_grey_xyz`], not integrated over the visible range.
     #[must_use]
     pub fn fixed(nm: f32) -> Self {
-        Self {
-            lambda_nm: [nm; N_WAVELENGTHS],
-            pdf: [1.0; N_WAVELENGTHS],
-        }
+        Self::new([nm; N_WAVELENGTHS], [1.0; N_WAVELENGTHS])
     }
 
     /// The XYZ of a grey of linear sRGB R = G = B = L, L the radiance at a [`Self::fixed`]
@@ -358,12 +410,19 @@ pub struct SpectrumTable {
 impl SpectrumTable {
     /// Table step, nm.
     pub const STEP_NM: f32 = 5.0;
+    /// Tabulated values: 380–780 nm every [`Self::STEP_NM`].
+    const NODES: usize = ((LAMBDA_MAX_NM - LAMBDA_MIN_NM) / Self::STEP_NM) as usize + 1;
+
+    /// Where `nm` falls on the table's grid.
+    #[inline]
+    fn position(nm: f32) -> GridPosition {
+        GridPosition::on_grid(nm, Self::STEP_NM, Self::NODES)
+    }
 
     /// Tabulate `f(λ_nm)` on the 5-nm grid.
     #[must_use]
     pub fn from_fn(f: impl Fn(f64) -> f64) -> Self {
-        let n = ((LAMBDA_MAX_NM - LAMBDA_MIN_NM) / Self::STEP_NM) as usize + 1;
-        let values = (0..n)
+        let values = (0..Self::NODES)
             .map(|i| f(f64::from(LAMBDA_MIN_NM + i as f32 * Self::STEP_NM)) as f32)
             .collect();
         Self::from_values(values)
@@ -383,16 +442,13 @@ impl SpectrumTable {
     /// Value at `nm` (clamped to the table's range).
     #[must_use]
     pub fn at_nm(&self, nm: f32) -> f32 {
-        let x = ((nm - LAMBDA_MIN_NM) / Self::STEP_NM).clamp(0.0, (self.values.len() - 1) as f32);
-        let i = (x as usize).min(self.values.len() - 2);
-        let f = x - i as f32;
-        self.values[i] + f * (self.values[i + 1] - self.values[i])
+        Self::position(nm).lerp(&self.values)
     }
 
     /// Values at the path's four wavelengths.
     #[must_use]
     pub fn eval(&self, wl: &SampledWavelengths) -> SampledSpectrum {
-        SampledSpectrum(wl.all_nm().map(|nm| self.at_nm(nm)))
+        SampledSpectrum(wl.on_5nm.map(|at| at.lerp(&self.values)))
     }
 
     /// Largest tabulated value.

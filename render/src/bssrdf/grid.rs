@@ -136,7 +136,7 @@ impl Corners<'_> {
         let mut n = 0;
         for (table, w) in self.tables.iter().flatten() {
             let lanes: [_; N_WAVELENGTHS] =
-                std::array::from_fn(|k| (wl.pdf()[k] > 0.0).then(|| table.at(wl.nm(k))));
+                std::array::from_fn(|k| (wl.pdf()[k] > 0.0).then(|| table.at_lane(wl, k)));
             let r = table.eval_each(&lanes, r_mm);
             for k in 0..N_WAVELENGTHS {
                 at[k][n] = (r[k], *w);
@@ -163,5 +163,16 @@ impl Corners<'_> {
     #[must_use]
     pub fn total(&self, nm: f32) -> f32 {
         Self::blend(self.tables.iter().flatten().map(|(t, w)| (t.total(nm), *w)))
+    }
+
+    /// [`Self::total`] at the path's wavelength `k`.
+    #[must_use]
+    pub fn total_lane(&self, wl: &SampledWavelengths, k: usize) -> f32 {
+        Self::blend(
+            self.tables
+                .iter()
+                .flatten()
+                .map(|(t, w)| (t.at_lane(wl, k).total(), *w)),
+        )
     }
 }

@@ -5,7 +5,10 @@
 //! operator (`multipole::exact::adding_doubling::reflectance_by_angle`, §10) at the skin's own
 //! parameters and g, tabulated every [`INCIDENCE_STEP_NM`] nm at the quadrature's angles.
 
-use crate::spectrum::{LAMBDA_MAX_NM, LAMBDA_MIN_NM};
+use crate::spectrum::{
+    GRID_10NM_NODES, GRID_10NM_STEP_NM, GridPosition, LAMBDA_MAX_NM, LAMBDA_MIN_NM,
+    SampledWavelengths,
+};
 use multipole::exact::adding_doubling::{
     AddingDoublingOptions, DEFAULT_QUADRATURE_POINTS, reflectance_by_angle,
 };
@@ -139,10 +142,11 @@ impl IncidenceGain {
     /// The row index and weight of the next row for wavelength `nm` (linear in λ).
     #[must_use]
     pub fn rows_at(&self, nm: f32) -> (usize, f32) {
-        let x = ((f64::from(nm) - FROM_NM) / INCIDENCE_STEP_NM)
-            .clamp(0.0, (self.rows.len() - 1) as f64);
-        let i = (x as usize).min(self.rows.len().saturating_sub(2));
-        (i, (x - i as f64) as f32)
+        if self.rows.len() < 2 {
+            return (0, 0.0);
+        }
+        let at = GridPosition::on_grid(nm, INCIDENCE_STEP_NM as f32, self.rows.len());
+        (at.index, at.weight)
     }
 
     /// a(μ, λ) at outside incidence cosine `mu` and wavelength `nm` (1 at μ = 1).
@@ -160,6 +164,28 @@ impl IncidenceGain {
         }
         let (a, b) = (self.row_gain_at(i, c), self.row_gain_at(i + 1, c));
         a + t * (b - a)
+    }
+
+    /// [`Self::gain_at`] at the path's wavelength `k`, whose row was found once per path.
+    #[must_use]
+    #[inline]
+    pub fn gain_lane(&self, c: Column, wl: &SampledWavelengths, k: usize) -> f32 {
+        if !self.on_10nm_grid() {
+            return self.gain_at(c, wl.nm(k));
+        }
+        let at = wl.on_10nm(k);
+        let (a, b) = (
+            self.row_gain_at(at.index, c),
+            self.row_gain_at(at.index + 1, c),
+        );
+        a + at.weight * (b - a)
+    }
+
+    /// Whether the rows are the path's 10-nm grid (always, as built: 380–780 nm every 10 nm).
+    #[must_use]
+    #[inline]
+    pub fn on_10nm_grid(&self) -> bool {
+        self.rows.len() == GRID_10NM_NODES && INCIDENCE_STEP_NM as f32 == GRID_10NM_STEP_NM
     }
 }
 

@@ -158,6 +158,16 @@ impl Directional {
         }
     }
 
+    /// [`Self::normalisation_at`] at the path's wavelength `k`.
+    #[must_use]
+    #[inline]
+    pub fn normalisation_lane(&self, wl: &SampledWavelengths, k: usize) -> f32 {
+        match &self.incidence {
+            Some((gain, c)) if gain.on_10nm_grid() => wl.on_10nm(k).lerp(c),
+            _ => self.normalisation_at(wl.nm(k)),
+        }
+    }
+
     /// S_ω(ω) = T(cos θ) a(cos θ, λ) / (c(λ) π), sr⁻¹, at `nm`: the directional factor at the
     /// point where light enters.
     #[must_use]
@@ -178,7 +188,7 @@ impl Directional {
         match &self.incidence {
             Some((gain, _)) if t > 0.0 => {
                 let column = gain.column(cos_theta.min(1.0));
-                SampledSpectrum(std::array::from_fn(|k| t * gain.gain_at(column, wl.nm(k))))
+                SampledSpectrum(std::array::from_fn(|k| t * gain.gain_lane(column, wl, k)))
             }
             _ => SampledSpectrum([t; N_WAVELENGTHS]),
         }
@@ -189,7 +199,7 @@ impl Directional {
     pub fn s_omegas(&self, cos_theta: f32, wl: &SampledWavelengths) -> SampledSpectrum {
         let f = self.factors(cos_theta, wl);
         SampledSpectrum(std::array::from_fn(|k| {
-            f.0[k] * FRAC_1_PI / self.normalisation_at(wl.nm(k))
+            f.0[k] * FRAC_1_PI / self.normalisation_lane(wl, k)
         }))
     }
 
@@ -202,7 +212,7 @@ impl Directional {
     ) -> SampledSpectrum {
         let f = self.factors(cos_theta, wl);
         SampledSpectrum(std::array::from_fn(|k| {
-            f.0[k] / self.normalisation_at(wl.nm(k))
+            f.0[k] / self.normalisation_lane(wl, k)
         }))
     }
 }

@@ -20,7 +20,9 @@
 //! R_tot / ∫table so the table integrates to the model's total R_tot (exact, from q = 0): the 0.1%
 //! tail is redistributed over the table instead of being lost.
 
-use crate::spectrum::{LAMBDA_MAX_NM, LAMBDA_MIN_NM};
+use crate::spectrum::{
+    GRID_10NM_NODES, GRID_10NM_STEP_NM, LAMBDA_MAX_NM, LAMBDA_MIN_NM, SampledWavelengths,
+};
 use multipole::{Method, MultipoleError, Profile, ProfileOptions, SpectralProfiles, sampling};
 use serde::{Deserialize, Serialize};
 use skin_optics::{SkinParams, WavelengthGrid};
@@ -252,9 +254,19 @@ impl ProfileTable {
 
     /// The rows and weights mixed at `nm`.
     fn mix(&self, nm: f32) -> [(&Row, f32); 2] {
-        let l = self.lerp(nm);
+        self.mix_at(self.lerp(nm))
+    }
+
+    fn mix_at(&self, l: Lerp) -> [(&Row, f32); 2] {
         let upper = (l.j + 1).min(self.rows.len() - 1);
         [(&self.rows[l.j], 1.0 - l.t), (&self.rows[upper], l.t)]
+    }
+
+    /// Whether the rows are the path's 10-nm grid (380–780 nm every 10 nm, the default).
+    fn on_10nm_grid(&self) -> bool {
+        self.rows.len() == GRID_10NM_NODES
+            && self.from_nm == LAMBDA_MIN_NM
+            && self.step_nm == GRID_10NM_STEP_NM
     }
 
     /// The model's total diffuse reflectance R_tot at `nm` (per unit flux entering), dimensionless.
@@ -266,7 +278,23 @@ impl ProfileTable {
     /// The table resolved at `nm` (for [`ProfileTable::eval_each`]).
     #[must_use]
     pub fn at(&self, nm: f32) -> RowsAt<'_> {
-        let rows = self.mix(nm);
+        Self::rows_at(self.mix(nm))
+    }
+
+    /// [`Self::at`] the path's wavelength `k` (on the 10-nm grid its row was found once per path).
+    #[must_use]
+    pub fn at_lane(&self, wl: &SampledWavelengths, k: usize) -> RowsAt<'_> {
+        if !self.on_10nm_grid() {
+            return self.at(wl.nm(k));
+        }
+        let at = wl.on_10nm(k);
+        Self::rows_at(self.mix_at(Lerp {
+            j: at.index,
+            t: at.weight,
+        }))
+    }
+
+    fn rows_at(rows: [(&Row, f32); 2]) -> RowsAt<'_> {
         RowsAt {
             rows,
             total: rows.iter().map(|(row, w)| w * row.total).sum(),

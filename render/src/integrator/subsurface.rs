@@ -234,7 +234,7 @@ impl PathTracer<'_> {
             .map_or(m_o, |h| skin.texture_factor(h.uv, &scene.textures));
         let m = texture_modulation(m_o, m_i);
         let cap = SampledSpectrum(std::array::from_fn(|k| {
-            m.min(1.0 / ss.table.total(wl.nm(k)).max(1e-6))
+            m.min(1.0 / ss.table.at_lane(wl, k).total().max(1e-6))
         }));
         let weight = exit.weight * cap * t_o;
         (!weight.is_black() && weight.is_finite()).then_some((exit, weight))

@@ -242,7 +242,7 @@ impl SkinMaps {
     ) -> SampledSpectrum {
         let het = self.profile(wl, uv_i, uv_o, r_mm);
         let lanes: [_; N_WAVELENGTHS] =
-            std::array::from_fn(|k| (wl.pdf()[k] > 0.0).then(|| table.at(wl.nm(k))));
+            std::array::from_fn(|k| (wl.pdf()[k] > 0.0).then(|| table.at_lane(wl, k)));
         let base = table.eval_each(&lanes, r_mm);
         SampledSpectrum(std::array::from_fn(|k| {
             if base[k] > 0.0 {
@@ -257,7 +257,7 @@ impl SkinMaps {
     #[must_use]
     pub fn totals(&self, wl: &SampledWavelengths, uv: Vec2) -> SampledSpectrum {
         let corners = self.corners(uv);
-        SampledSpectrum(std::array::from_fn(|k| corners.total(wl.nm(k))))
+        SampledSpectrum(std::array::from_fn(|k| corners.total_lane(wl, k)))
     }
 }
 

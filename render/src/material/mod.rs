@@ -101,6 +101,10 @@ enum Lobes<'a> {
         /// T(θ) a(θ, λ) / c(λ) on both sides (the BSSRDF's angular factor).
         directional: &'a Directional,
         wl: SampledWavelengths,
+        /// π c(λ) per lane.
+        pi_c: SampledSpectrum,
+        /// The last (cos θ_o, T(θ_o) a(θ_o, λ)): ω_o is the same for every evaluation at a hit.
+        outgoing: Cell<Option<(f32, SampledSpectrum)>>,
     },
     Lambert {
         /// ρ(λ) / π.
@@ -199,6 +203,10 @@ impl Material {
                     body: rd,
                     directional: &s.directional,
                     wl: *wl,
+                    pi_c: SampledSpectrum(std::array::from_fn(|k| {
+                        PI * s.directional.normalisation_lane(wl, k)
+                    })),
+                    outgoing: Cell::new(None),
                 }
             }
             Material::Diffuse(d) => {
@@ -237,11 +245,19 @@ impl Bsdf<'_> {
                 body,
                 directional,
                 wl,
+                pi_c,
+                outgoing,
             } => {
-                let (fi, fo) = (directional.factors(i.z, wl), directional.factors(o.z, wl));
-                let split = SampledSpectrum(std::array::from_fn(|k| {
-                    fi.0[k] * fo.0[k] / (PI * directional.normalisation_at(wl.nm(k)))
-                }));
+                let fo = match outgoing.get() {
+                    Some((z, fo)) if z.to_bits() == o.z.to_bits() => fo,
+                    _ => {
+                        let fo = directional.factors(o.z, wl);
+                        outgoing.set(Some((o.z, fo)));
+                        fo
+                    }
+                };
+                let fi = directional.factors(i.z, wl);
+                let split = SampledSpectrum(std::array::from_fn(|k| fi.0[k] * fo.0[k] / pi_c.0[k]));
                 *body * split + SampledSpectrum::splat(surface.eval(o, i))
             }
             Lobes::Lambert { body } => *body,
