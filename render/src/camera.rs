@@ -113,6 +113,13 @@ impl Camera {
         (origin, (focus_point - origin).normalize())
     }
 
+    /// Whether rays start from a lens of finite aperture (the `lens` of [`Camera::generate_ray`]
+    /// is read) rather than from a pinhole.
+    #[must_use]
+    pub fn has_lens(&self) -> bool {
+        self.lens_radius_mm != 0.0
+    }
+
     /// Angle one pixel subtends at the image centre for an image `height` pixels tall, radians:
     /// 2 tan(fov/2) / height (the pixel footprint is this times the distance).
     #[must_use]

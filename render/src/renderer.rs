@@ -281,8 +281,14 @@ fn sample_pixel(
         (x as f32 + jitter.x) / w as f32,
         (y as f32 + jitter.y) / h as f32,
     );
-    let lens = sampler.get_2d();
-    let (o, d) = tracer.scene.camera.generate_ray(film_pos, aspect, lens);
+    // A pinhole reads no lens point: its two uniforms would cost a Sobol set of their own.
+    let camera = &tracer.scene.camera;
+    let lens = if camera.has_lens() {
+        sampler.get_2d()
+    } else {
+        Vec2::ZERO
+    };
+    let (o, d) = camera.generate_ray(film_pos, aspect, lens);
     let l = tracer.radiance(o, d, &wl, &mut sampler, rays);
     // A non-finite sample is dropped and counted by the accumulator.
     if s.wavelength_nm.is_some() {

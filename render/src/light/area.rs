@@ -4,7 +4,7 @@
 use super::{LightSample, facing, selection};
 use crate::sampling::{uniform_cone, uniform_cone_pdf};
 use crate::spectrum::{SampledWavelengths, SpectrumTable};
-use glam::{Vec2, Vec3};
+use glam::{DVec3, Vec2, Vec3};
 
 /// Spherical area light, emitting uniformly outwards.
 #[derive(Debug, Clone, PartialEq)]
@@ -98,15 +98,63 @@ pub struct QuadLight {
     pub edge_v_mm: Vec3,
     /// Emitted radiance spectrum.
     pub radiance: SpectrumTable,
+    /// What every query derives from the edges, found once.
+    shape: QuadShape,
+}
+
+/// A quad's normal, area and centre, which sampling, intersection and light selection read at
+/// every shading point and ray (f32 for the rays, f64 for the selection proxy).
+#[derive(Debug, Clone, PartialEq)]
+struct QuadShape {
+    /// edge_u × edge_v, mm², and its length (the area), mm².
+    n: Vec3,
+    area: f32,
+    /// |edge_u|², |edge_v|², mm².
+    uu: f32,
+    vv: f32,
+    /// The unit normal, the area (mm²), the corner and the centre (mm) and half the diagonal
+    /// (mm), in f64.
+    unit_n64: DVec3,
+    area64: f64,
+    corner64: DVec3,
+    centre64: DVec3,
+    half_diagonal64: f64,
 }
 
 impl QuadLight {
+    /// The quad `corner_mm + s·edge_u_mm + t·edge_v_mm` (s, t in [0, 1]) emitting `radiance` on
+    /// the side of `edge_u_mm × edge_v_mm`.
+    #[must_use]
+    pub fn new(corner_mm: Vec3, edge_u_mm: Vec3, edge_v_mm: Vec3, radiance: SpectrumTable) -> Self {
+        let n = edge_u_mm.cross(edge_v_mm);
+        let (eu, ev) = (edge_u_mm.as_dvec3(), edge_v_mm.as_dvec3());
+        let corner64 = corner_mm.as_dvec3();
+        let n64 = eu.cross(ev);
+        let area64 = n64.length();
+        Self {
+            corner_mm,
+            edge_u_mm,
+            edge_v_mm,
+            radiance,
+            shape: QuadShape {
+                n,
+                area: n.length(),
+                uu: edge_u_mm.length_squared(),
+                vv: edge_v_mm.length_squared(),
+                unit_n64: n64 / area64,
+                area64,
+                corner64,
+                centre64: corner64 + (eu + ev) * 0.5,
+                half_diagonal64: 0.5 * (eu + ev).length(),
+            },
+        }
+    }
+
     /// A point uniform in area, converted to solid angle (None from behind).
     #[must_use]
     pub fn sample(&self, p: Vec3, u: Vec2, wl: &SampledWavelengths) -> Option<LightSample> {
         let q = self.corner_mm + self.edge_u_mm * u.x + self.edge_v_mm * u.y;
-        let n = self.edge_u_mm.cross(self.edge_v_mm);
-        let area = n.length();
+        let (n, area) = (self.shape.n, self.shape.area);
         let d = q - p;
         let r2 = d.length_squared();
         let wi = d / r2.sqrt();
@@ -124,20 +172,17 @@ impl QuadLight {
     /// widened cosine; 0 behind the emitting side.
     #[must_use]
     pub fn selection_weight(&self, p: Vec3, n: Vec3) -> f32 {
-        let (eu, ev) = (self.edge_u_mm.as_dvec3(), self.edge_v_mm.as_dvec3());
-        let corner = self.corner_mm.as_dvec3();
-        let nl = eu.cross(ev);
-        let area = nl.length();
-        let nl = nl / area;
+        let s = &self.shape;
+        let (nl, area) = (s.unit_n64, s.area64);
         let p = p.as_dvec3();
-        if (p - corner).dot(nl) <= 0.0 {
+        if (p - s.corner64).dot(nl) <= 0.0 {
             return 0.0;
         }
-        let to = corner + (eu + ev) * 0.5 - p;
+        let to = s.centre64 - p;
         let d2 = to.length_squared().max(area);
         let d = d2.sqrt();
         let cos_l = (-to.dot(nl) / d).max(0.05);
-        let half_diagonal = 0.5 * (eu + ev).length();
+        let half_diagonal = s.half_diagonal64;
         let l = f64::from(self.radiance.mean());
         selection(l * area * cos_l / d2 * facing(n, to, d, half_diagonal / d))
     }
@@ -146,7 +191,7 @@ impl QuadLight {
     #[must_use]
     pub fn intersect(&self, o: Vec3, d: Vec3) -> Option<f32> {
         let (eu, ev) = (self.edge_u_mm, self.edge_v_mm);
-        let n = eu.cross(ev);
+        let n = self.shape.n;
         let denom = d.dot(n);
         if denom >= 0.0 {
             return None; // back side does not emit, and is not drawn
@@ -156,7 +201,7 @@ impl QuadLight {
             return None;
         }
         let rel = o + d * t - self.corner_mm;
-        let (uu, vv) = (eu.length_squared(), ev.length_squared());
+        let (uu, vv) = (self.shape.uu, self.shape.vv);
         let s = rel.dot(eu) / uu;
         let w = rel.dot(ev) / vv;
         ((0.0..=1.0).contains(&s) && (0.0..=1.0).contains(&w)).then_some(t)
@@ -165,8 +210,7 @@ impl QuadLight {
     /// Solid-angle density of [`QuadLight::sample`] for direction `wi` hitting at distance `t`, sr⁻¹.
     #[must_use]
     pub fn pdf(&self, wi: Vec3, t: f32) -> f32 {
-        let n = self.edge_u_mm.cross(self.edge_v_mm);
-        let area = n.length();
+        let (n, area) = (self.shape.n, self.shape.area);
         let cos_l = -wi.dot(n / area);
         if cos_l <= 0.0 {
             0.0
@@ -183,12 +227,12 @@ mod tests {
     #[test]
     fn quad_sample_pdf_matches_pdf_function() {
         let wl = SampledWavelengths::sample_visible(0.3);
-        let q = QuadLight {
-            corner_mm: Vec3::new(-1.0, -1.0, 5.0),
-            edge_u_mm: Vec3::new(0.0, 2.0, 0.0),
-            edge_v_mm: Vec3::new(2.0, 0.0, 0.0),
-            radiance: SpectrumTable::constant(1.0),
-        };
+        let q = QuadLight::new(
+            Vec3::new(-1.0, -1.0, 5.0),
+            Vec3::new(0.0, 2.0, 0.0),
+            Vec3::new(2.0, 0.0, 0.0),
+            SpectrumTable::constant(1.0),
+        );
         let s = q.sample(Vec3::ZERO, Vec2::new(0.3, 0.8), &wl).unwrap();
         let t = q.intersect(Vec3::ZERO, s.wi).unwrap();
         assert!((t - s.distance_mm).abs() < 1e-4);

@@ -149,12 +149,12 @@ mod tests {
         let hot = SpectrumTable::constant(MAX_INTENSITY);
         let (p, n) = (Vec3::ZERO, Vec3::Z);
         let lights = [
-            Light::Quad(QuadLight {
-                corner_mm: Vec3::new(-0.5, -0.5, 0.0) * MAX_COORD_MM - Vec3::Z,
-                edge_u_mm: Vec3::X * MAX_COORD_MM,
-                edge_v_mm: Vec3::Y * MAX_COORD_MM,
-                radiance: hot.clone(),
-            }),
+            Light::Quad(QuadLight::new(
+                Vec3::new(-0.5, -0.5, 0.0) * MAX_COORD_MM - Vec3::Z,
+                Vec3::X * MAX_COORD_MM,
+                Vec3::Y * MAX_COORD_MM,
+                hot.clone(),
+            )),
             Light::Sphere(SphereLight {
                 center_mm: Vec3::Z * MAX_COORD_MM,
                 radius_mm: MAX_COORD_MM,

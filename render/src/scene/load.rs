@@ -413,12 +413,12 @@ impl Loader<'_> {
                 let up = n.cross(right);
                 // edge_u × edge_v = w h (right × up) = w h n: the emitting side faces look_at.
                 let (eu, ev) = (right * w, up * h);
-                Light::Quad(QuadLight {
-                    corner_mm: c - eu * 0.5 - ev * 0.5,
-                    edge_u_mm: eu,
-                    edge_v_mm: ev,
-                    radiance: self.emission(key, *spectrum, *temperature_k, *intensity)?,
-                })
+                Light::Quad(QuadLight::new(
+                    c - eu * 0.5 - ev * 0.5,
+                    eu,
+                    ev,
+                    self.emission(key, *spectrum, *temperature_k, *intensity)?,
+                ))
             }
         })
     }

@@ -345,11 +345,13 @@ mod tests {
     /// as it fills the hemisphere (a = 10⁴ h); nothing behind its emitting side. Within 10⁻⁵ relative (f32).
     #[test]
     fn a_quads_irradiance_is_its_projected_solid_angle() {
-        let quad = |a: f32, h: f32| QuadLight {
-            corner_mm: Vec3::new(-a, -a, h),
-            edge_u_mm: Vec3::new(0.0, 2.0 * a, 0.0),
-            edge_v_mm: Vec3::new(2.0 * a, 0.0, 0.0),
-            radiance: SpectrumTable::constant(2.0),
+        let quad = |a: f32, h: f32| {
+            QuadLight::new(
+                Vec3::new(-a, -a, h),
+                Vec3::new(0.0, 2.0 * a, 0.0),
+                Vec3::new(2.0 * a, 0.0, 0.0),
+                SpectrumTable::constant(2.0),
+            )
         };
         for (a, h) in [(100.0f32, 60.0f32), (10.0, 60.0), (1e4, 1.0)] {
             let big_a = f64::from(a / h);
