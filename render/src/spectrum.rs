@@ -163,9 +163,9 @@ impl Div<f32> for SampledSpectrum {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GridPosition {
     /// Index of the lower node (at most the last but one).
-    pub index: usize,
+    index: u32,
     /// Weight of node `index + 1`, in [0, 1].
-    pub weight: f32,
+    weight: f32,
 }
 
 impl GridPosition {
@@ -177,16 +177,31 @@ impl GridPosition {
         let x = ((nm - LAMBDA_MIN_NM) / step_nm).clamp(0.0, (nodes - 1) as f32);
         let index = (x as usize).min(nodes - 2);
         Self {
-            index,
+            index: index as u32,
             weight: x - index as f32,
         }
+    }
+
+    /// Index of the node at or below the wavelength (at most the last but one).
+    #[must_use]
+    #[inline]
+    pub fn index(self) -> usize {
+        self.index as usize
+    }
+
+    /// Weight of the node above, in [0, 1].
+    #[must_use]
+    #[inline]
+    pub fn weight(self) -> f32 {
+        self.weight
     }
 
     /// The value between `values[index]` and `values[index + 1]`.
     #[must_use]
     #[inline]
     pub fn lerp(self, values: &[f32]) -> f32 {
-        let (a, b) = (values[self.index], values[self.index + 1]);
+        let i = self.index();
+        let (a, b) = (values[i], values[i + 1]);
         a + self.weight * (b - a)
     }
 }

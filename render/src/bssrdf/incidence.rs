@@ -146,7 +146,7 @@ impl IncidenceGain {
             return (0, 0.0);
         }
         let at = GridPosition::on_grid(nm, INCIDENCE_STEP_NM as f32, self.rows.len());
-        (at.index, at.weight)
+        (at.index(), at.weight())
     }
 
     /// a(μ, λ) at outside incidence cosine `mu` and wavelength `nm` (1 at μ = 1).
@@ -175,10 +175,10 @@ impl IncidenceGain {
         }
         let at = wl.on_10nm(k);
         let (a, b) = (
-            self.row_gain_at(at.index, c),
-            self.row_gain_at(at.index + 1, c),
+            self.row_gain_at(at.index(), c),
+            self.row_gain_at(at.index() + 1, c),
         );
-        a + at.weight * (b - a)
+        a + at.weight() * (b - a)
     }
 
     /// Whether the rows are the path's 10-nm grid (always, as built: 380–780 nm every 10 nm).

@@ -289,8 +289,8 @@ impl ProfileTable {
         }
         let at = wl.on_10nm(k);
         Self::rows_at(self.mix_at(Lerp {
-            j: at.index,
-            t: at.weight,
+            j: at.index(),
+            t: at.weight(),
         }))
     }
 

@@ -100,7 +100,7 @@ enum Lobes<'a> {
         body: SampledSpectrum,
         /// T(θ) a(θ, λ) / c(λ) on both sides (the BSSRDF's angular factor).
         directional: &'a Directional,
-        wl: SampledWavelengths,
+        wl: &'a SampledWavelengths,
         /// π c(λ) per lane.
         pi_c: SampledSpectrum,
         /// The last (cos θ_o, T(θ_o) a(θ_o, λ)): ω_o is the same for every evaluation at a hit.
@@ -164,7 +164,7 @@ impl Material {
         &'a self,
         n: Vec3,
         uv: Vec2,
-        wl: &SampledWavelengths,
+        wl: &'a SampledWavelengths,
         textures: &[Texture],
     ) -> Bsdf<'a> {
         self.bsdf_lod(n, uv, wl, textures, false)
@@ -177,7 +177,7 @@ impl Material {
         &'a self,
         n: Vec3,
         uv: Vec2,
-        wl: &SampledWavelengths,
+        wl: &'a SampledWavelengths,
         textures: &[Texture],
         collapsed: bool,
     ) -> Bsdf<'a> {
@@ -202,7 +202,7 @@ impl Material {
                     surface: Surface::of(s),
                     body: rd,
                     directional: &s.directional,
-                    wl: *wl,
+                    wl,
                     pi_c: SampledSpectrum(std::array::from_fn(|k| {
                         PI * s.directional.normalisation_lane(wl, k)
                     })),
