@@ -30,6 +30,8 @@ pub fn unwarp(knee: Option<f32>, w: f32) -> f32 {
 pub struct ProfileGrid {
     /// Node values of each axis (C_m, β_m, C_h), increasing.
     axes: [Vec<f32>; 3],
+    /// The same nodes warped ([`warp`]), where the interpolation weights are linear.
+    warped: [Vec<f32>; 3],
     /// The tables, C_m fastest, then β_m, then C_h.
     tables: Vec<Arc<ProfileTable>>,
     /// The largest relative L1 error of the interpolated radial energy 2πr R(r) against directly
@@ -56,8 +58,11 @@ impl ProfileGrid {
             axes.iter().map(Vec::len).product::<usize>(),
             "one table per node"
         );
+        let warped =
+            std::array::from_fn(|k| axes[k].iter().map(|&v| warp(AXIS_KNEES[k], v)).collect());
         Self {
             axes,
+            warped,
             tables,
             max_error,
         }
@@ -92,8 +97,8 @@ impl ProfileGrid {
             }
             let last = axis.len() - 1;
             let i = axis.partition_point(|&a| a <= x).clamp(1, last) - 1;
-            let w = |v: f32| warp(AXIS_KNEES[k], v);
-            let t = ((w(x) - w(axis[i])) / (w(axis[i + 1]) - w(axis[i]))).clamp(0.0, 1.0);
+            let w = &self.warped[k];
+            let t = ((warp(AXIS_KNEES[k], x) - w[i]) / (w[i + 1] - w[i])).clamp(0.0, 1.0);
             (i, t)
         };
         let at = [0, 1, 2].map(|k| locate(k, p[k]));
