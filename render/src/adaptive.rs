@@ -278,10 +278,29 @@ impl Accumulator {
         if n == 0 { 0.0 } else { (s / n as f64).sqrt() }
     }
 
+    /// Degrees of freedom pixel `i` adds to a pooled error estimate: n − 1 for the sample
+    /// variance and the calibrated estimate, one for the half difference.
+    fn degrees_of_freedom(&self, i: usize) -> f64 {
+        match self.estimate {
+            ErrorEstimate::HalfDifference => 1.0,
+            ErrorEstimate::SampleVariance | ErrorEstimate::Calibrated => {
+                f64::from(self.count[i].saturating_sub(1))
+            }
+        }
+    }
+
     /// Stop pixels that have at least `min_spp` samples and whose 3×3 neighbourhood's mean squared
-    /// relative error is at most `target²`; `active[i]` is cleared for them (never set again).
-    /// Returns the number of stopped pixels.
-    pub fn update_active(&self, active: &mut [bool], target: f64, min_spp: u32) -> usize {
+    /// relative error, raised to its one-sided upper confidence bound, is at most `target²`:
+    /// ê² (1 + z √(2/k)) ≤ ε², k the pooled degrees of freedom and z `confidence_z`
+    /// (docs/physics.md §17). `active[i]` is cleared for them (never set again). Returns the
+    /// number of stopped pixels.
+    pub fn update_active(
+        &self,
+        active: &mut [bool],
+        target: f64,
+        min_spp: u32,
+        confidence_z: f64,
+    ) -> usize {
         let (e2, _) = self.relative_error2();
         let (w, h) = (self.width, self.height);
         let target2 = target * target;
@@ -291,14 +310,16 @@ impl Accumulator {
                 if !active[i] || self.count[i] < min_spp {
                     continue;
                 }
-                let (mut s, mut n) = (0.0, 0.0);
+                let (mut s, mut n, mut k) = (0.0, 0.0, 0.0);
                 for yy in y.saturating_sub(1)..(y + 2).min(h) {
                     for xx in x.saturating_sub(1)..(x + 2).min(w) {
                         s += e2[yy * w + xx];
                         n += 1.0;
+                        k += self.degrees_of_freedom(yy * w + xx);
                     }
                 }
-                if s / n <= target2 {
+                let bound = 1.0 + confidence_z * (2.0 / k.max(1.0)).sqrt();
+                if s / n * bound <= target2 {
                     active[i] = false;
                 }
             }
@@ -384,9 +405,38 @@ mod tests {
             for i in 0..4 {
                 acc.add(i, k, [0.5; 3]);
             }
-            let stopped = acc.update_active(&mut active, 0.01, MIN_SPP);
+            let stopped = acc.update_active(&mut active, 0.01, MIN_SPP, 1.645);
             assert_eq!(stopped, if k + 1 < MIN_SPP { 0 } else { 4 });
         }
+    }
+
+    /// The stop asks the estimate's one-sided upper bound to meet the target: a 3 × 3 image of
+    /// pixels with samples 1 and 3 (n = 16, σ̂²/n = 1/15 each, relative error² 1/60 at mean 2)
+    /// stops at ε² just above 1/60 with z = 0; with z = 1.645 the centre, pooling k = 9 · 15
+    /// degrees of freedom, stops once ε² ≥ (1/60)(1 + z √(2/135)), and the corners, pooling
+    /// 4 · 15, once ε² ≥ (1/60)(1 + z √(2/60)).
+    #[test]
+    fn the_stop_bounds_the_estimate_from_above() {
+        let mut acc = Accumulator::new(3, 3, ErrorEstimate::SampleVariance);
+        for k in 0..16 {
+            for i in 0..9 {
+                let y = if k % 2 == 0 { 1.0 } else { 3.0 };
+                acc.add(i, k, [0.0, y, 0.0]);
+            }
+        }
+        let e2 = 1.0 / 60.0;
+        let bound = 1.0 + 1.645 * (2.0f64 / 135.0).sqrt();
+        let stops = |eps2: f64, z: f64| {
+            let mut active = vec![true; 9];
+            acc.update_active(&mut active, eps2.sqrt(), 16, z)
+        };
+        assert_eq!(stops(e2 * 1.001, 0.0), 9);
+        assert_eq!(stops(e2 * 1.001, 1.645), 0);
+        assert_eq!(stops(e2 * bound * 0.999, 1.645), 0);
+        assert_eq!(stops(e2 * bound * 1.001, 1.645), 1);
+        let corners = 1.0 + 1.645 * (2.0f64 / 60.0).sqrt();
+        assert_eq!(stops(e2 * corners * 0.999, 1.645), 5);
+        assert_eq!(stops(e2 * corners * 1.001, 1.645), 9);
     }
 
     /// The calibrated estimate scales each pixel's σ̂²/n by its block's Σ h/Σ v: a block whose

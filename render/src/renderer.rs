@@ -27,6 +27,9 @@ pub const TILE: usize = 16;
 
 /// Largest image side, pixels (a 16384² film of XYZ sums is 3 GiB).
 pub const MAX_SIDE: usize = 16384;
+/// z of the stopping rule's one-sided upper confidence bound: 1.645, 95% (docs/physics.md §17).
+pub const STOP_CONFIDENCE_Z: f64 = 1.645;
+
 /// Most worker threads accepted.
 pub const MAX_THREADS: usize = 1024;
 /// Longest path accepted, scattering events.
@@ -49,6 +52,10 @@ pub struct RenderOptions {
     pub noise: Option<f64>,
     /// Fewest samples a pixel takes before the noise target may stop it, ≥ 2.
     pub min_spp: u32,
+    /// z of the one-sided upper confidence bound a pixel's estimated error must bring within the
+    /// noise target, in [0, 10] ([`STOP_CONFIDENCE_Z`]: 95%; 0 stops on the estimate itself;
+    /// docs/physics.md §17).
+    pub stop_confidence_z: f64,
     /// How each pixel's error is estimated for the noise target and the reported noise (None:
     /// [`ErrorEstimate::for_sampler`]); the half-based ones need a sampler whose even and odd
     /// samples are independent (not [`SamplerKind::Sobol`]).
@@ -77,6 +84,7 @@ impl Default for RenderOptions {
             spp: 64,
             noise: None,
             min_spp: MIN_SPP,
+            stop_confidence_z: STOP_CONFIDENCE_Z,
             error_estimate: None,
             time_limit: None,
             seed: 1,
@@ -108,6 +116,13 @@ impl RenderOptions {
         }
         if self.min_spp < 2 {
             return Err(bad("min_spp", self.min_spp.to_string(), "[2, 2^32)"));
+        }
+        if !(0.0..=10.0).contains(&self.stop_confidence_z) {
+            return Err(bad(
+                "stop_confidence_z",
+                self.stop_confidence_z.to_string(),
+                "[0, 10]",
+            ));
         }
         if let Some(e) = self.error_estimate
             && e.needs_independent_halves()
@@ -346,7 +361,7 @@ fn render_passes(
             && done >= s.min_spp
             && done % 2 == 0
         {
-            converged = acc.update_active(&mut active, target, s.min_spp);
+            converged = acc.update_active(&mut active, target, s.min_spp, s.stop_confidence_z);
         }
         let elapsed = start.elapsed();
         // The image-wide estimate costs a pass over every pixel and is only shown, so it is formed

@@ -39,6 +39,10 @@ pub struct RenderArgs {
     /// stop on a low estimate) or sample-variance (an overstatement for Sobol points).
     #[arg(long, value_name = "E", value_enum, default_value_t = ErrorEstimateArg::Calibrated)]
     pub error_estimate: ErrorEstimateArg,
+    /// z of the one-sided upper confidence bound of a pixel's estimated noise that must be within
+    /// --noise before it stops, in [0, 10] (default 1.645: 95%; 0 = the estimate itself).
+    #[arg(long, value_name = "Z", default_value_t = ::render::renderer::STOP_CONFIDENCE_Z, value_parser = Checked(parse_confidence), allow_hyphen_values = true)]
+    pub noise_confidence: f64,
     /// Image width, pixels.
     #[arg(long, value_name = "W", default_value_t = 768, value_parser = Checked(parse_pixels), allow_hyphen_values = true)]
     pub width: u32,
@@ -179,6 +183,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         spp: args.spp,
         noise: (args.noise > 0.0).then_some(args.noise),
         error_estimate: Some(args.error_estimate.into()),
+        stop_confidence_z: args.noise_confidence,
         time_limit: (args.time_limit > 0.0).then(|| Duration::from_secs_f64(args.time_limit)),
         seed: args.seed,
         threads: args.threads.map(|t| t as usize),
@@ -383,6 +388,14 @@ fn parse_noise(s: &str) -> Result<f64, String> {
     let v = parse_number(s, "[0, 1)")?;
     if !(0.0..1.0).contains(&v) {
         return Err(format!("{} outside [0, 1) (0 = off)", Num(v)));
+    }
+    Ok(v)
+}
+
+fn parse_confidence(s: &str) -> Result<f64, String> {
+    let v = parse_number(s, "[0, 10]")?;
+    if !(0.0..=10.0).contains(&v) {
+        return Err(format!("{} outside [0, 10]", Num(v)));
     }
     Ok(v)
 }
