@@ -233,6 +233,25 @@ pub mod hetero {
     /// Depth of the slab, mm.
     pub const SLAB_DEPTH_MM: f32 = 20.0;
 
+    /// The slab scene at `dir` (its OBJ written there) with skin keys `keys`, expected to fail to
+    /// load: the error and its message.
+    ///
+    /// # Panics
+    /// If the scene loads.
+    pub fn load_error(dir: &Path, keys: &str) -> (crate::error::RenderError, String) {
+        std::fs::write(dir.join("slab.obj"), slab_obj()).expect("a writable test folder");
+        let text = format!(
+            "[camera]\nposition_mm = [0, 0, 400]\nlook_at_mm = [0, 0, 0]\nfov_deg = 1\n\
+             [materials.skin]\ntype = \"skin\"\n{keys}\n\
+             [[meshes]]\nfile = \"slab.obj\"\nmaterial = \"skin\"\n"
+        );
+        let Err(e) = Scene::from_toml(&text, "bad.toml", Some(dir), &SkinKnobs::default()) else {
+            panic!("{keys}: the scene loaded");
+        };
+        let m = e.to_string();
+        (e, m)
+    }
+
     /// The slab as OBJ with its planar texture coordinates (12 triangles, outward faces).
     #[must_use]
     pub fn slab_obj() -> String {

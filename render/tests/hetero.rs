@@ -9,10 +9,9 @@ use render::integrator::IntegratorKind;
 use render::material::SkinKnobs;
 use render::scene::Scene;
 use render::testing::hetero::{
-    columns, exr_bytes, melanin_exr, region, render_strip, slab_obj, strip_scene,
+    columns, exr_bytes, load_error, melanin_exr, region, render_strip, slab_obj, strip_scene,
 };
 use skin_optics::{Preset, SkinParams};
-use std::path::Path;
 
 const NM: f32 = 650.0;
 
@@ -250,21 +249,6 @@ fn profile_grid_error_stays_within_its_measured_bound() {
             grid.max_error
         );
     }
-}
-
-/// The scene at `dir` with skin keys `keys`, expected to fail; its message.
-fn load_error(dir: &Path, keys: &str) -> (RenderError, String) {
-    std::fs::write(dir.join("slab.obj"), slab_obj()).unwrap();
-    let text = format!(
-        "[camera]\nposition_mm = [0, 0, 400]\nlook_at_mm = [0, 0, 0]\nfov_deg = 1\n\
-         [materials.skin]\ntype = \"skin\"\n{keys}\n\
-         [[meshes]]\nfile = \"slab.obj\"\nmaterial = \"skin\"\n"
-    );
-    let Err(e) = Scene::from_toml(&text, "bad.toml", Some(dir), &SkinKnobs::default()) else {
-        panic!("{keys}: the scene loaded");
-    };
-    let m = e.to_string();
-    (e, m)
 }
 
 /// Each bad map is a typed error naming its key and file: a missing file, maps of different

@@ -6,9 +6,10 @@ use render::error::RenderError;
 use render::integrator::IntegratorKind;
 use render::material::{Material, SkinKnobs, SkinMaterial};
 use render::scene::Scene;
-use render::testing::hetero::{SLAB_SIDE_MM, columns, region, render_strip, slab_obj, strip_scene};
+use render::testing::hetero::{
+    SLAB_SIDE_MM, columns, load_error, region, render_strip, strip_scene,
+};
 use render::texture::channels_exr_bytes_with;
-use std::path::Path;
 
 /// 550 nm: melanin and blood both absorb, so the epidermis' thickness shows.
 const NM: f32 = 550.0;
@@ -148,21 +149,6 @@ fn split_thin_slab_follows_the_volumetric_walk() {
         thin_v > 2.0 * thick_v && thin_b > 2.0 * thick_b,
         "thin {thin_v} / {thin_b} vs normal {thick_v} / {thick_b}"
     );
-}
-
-/// The scene at `dir` with skin keys `keys`, expected to fail; its message.
-fn load_error(dir: &Path, keys: &str) -> (RenderError, String) {
-    std::fs::write(dir.join("slab.obj"), slab_obj()).unwrap();
-    let text = format!(
-        "[camera]\nposition_mm = [0, 0, 400]\nlook_at_mm = [0, 0, 0]\nfov_deg = 1\n\
-         [materials.skin]\ntype = \"skin\"\n{keys}\n\
-         [[meshes]]\nfile = \"slab.obj\"\nmaterial = \"skin\"\n"
-    );
-    let Err(e) = Scene::from_toml(&text, "bad.toml", Some(dir), &SkinKnobs::default()) else {
-        panic!("{keys}: the scene loaded");
-    };
-    let m = e.to_string();
-    (e, m)
 }
 
 /// A flag outside [0, 1], a file without the thickness attribute (as written before it was
