@@ -171,42 +171,53 @@ impl NearestSurface {
             let off = closest_offset(p - t.a, t.ab, t.ac);
             best = ((p - t.a - off).length_squared(), i, off);
         }
+        // A node farther than the second nearest changes neither.
+        self.descend(p, second, |i, off, d2| {
+            if Some(i) != hint {
+                if d2 < best.0 {
+                    second = best.0;
+                    best = (d2, i, off);
+                } else if d2 < second {
+                    second = d2;
+                }
+            }
+            second
+        });
+        (best.1 != usize::MAX).then_some((best.1, best.2, second))
+    }
+
+    /// Visit the triangles depth first, the nearer child first, skipping every node whose box is
+    /// no nearer than the cutoff: `cutoff` to start with, then what `visit(triangle, offset of its
+    /// nearest point, squared distance)` returns after each triangle.
+    fn descend(&self, p: DVec3, mut cutoff: f64, mut visit: impl FnMut(usize, DVec3, f64) -> f64) {
+        // The hierarchy halves each node, so a traversal holds at most one node per level and
+        // one more: 64 cover any mesh (no allocation per query).
         let mut stack = [0usize; 64];
         let mut top = 1;
         while top > 0 {
             top -= 1;
             let n = stack[top];
             let node = self.nodes[n];
-            // A node farther than the second nearest changes neither.
-            if box_distance_squared(p, node.lo, node.hi) >= second {
+            if box_distance_squared(p, node.lo, node.hi) >= cutoff {
                 continue;
             }
             if self.is_leaf(n) {
                 let (s, c) = (node.start as usize, node.count as usize);
                 for (i, t) in self.tris[s..s + c].iter().enumerate() {
-                    if Some(s + i) == hint {
-                        continue;
-                    }
                     let off = closest_offset(p - t.a, t.ab, t.ac);
-                    let d2 = (p - t.a - off).length_squared();
-                    if d2 < best.0 {
-                        second = best.0;
-                        best = (d2, s + i, off);
-                    } else if d2 < second {
-                        second = d2;
-                    }
+                    cutoff = visit(s + i, off, (p - t.a - off).length_squared());
                 }
                 continue;
             }
             let (a, b) = (node.start as usize, node.start as usize + 1);
             let da = box_distance_squared(p, self.nodes[a].lo, self.nodes[a].hi);
             let db = box_distance_squared(p, self.nodes[b].lo, self.nodes[b].hi);
+            // The nearer child is popped first.
             let (far, near) = if da <= db { (b, a) } else { (a, b) };
             stack[top] = far;
             stack[top + 1] = near;
             top += 2;
         }
-        (best.1 != usize::MAX).then_some((best.1, best.2, second))
     }
 
     /// The distance from `p` to the surface, mm; `None` without triangles.
@@ -224,37 +235,12 @@ impl NearestSurface {
             let off = closest_offset(p - t.a, t.ab, t.ac);
             best = ((p - t.a - off).length_squared(), Some((i, off)));
         }
-        // The hierarchy halves each node, so a traversal holds at most one node per level and
-        // one more: 64 cover any mesh (no allocation per query).
-        let mut stack = [0usize; 64];
-        let mut top = 1;
-        while top > 0 {
-            top -= 1;
-            let n = stack[top];
-            let node = self.nodes[n];
-            if box_distance_squared(p, node.lo, node.hi) >= best.0 {
-                continue;
+        self.descend(p, best.0, |i, off, d2| {
+            if d2 < best.0 {
+                best = (d2, Some((i, off)));
             }
-            if self.is_leaf(n) {
-                let (s, c) = (node.start as usize, node.count as usize);
-                for (i, t) in self.tris[s..s + c].iter().enumerate() {
-                    let off = closest_offset(p - t.a, t.ab, t.ac);
-                    let d2 = (p - t.a - off).length_squared();
-                    if d2 < best.0 {
-                        best = (d2, Some((s + i, off)));
-                    }
-                }
-                continue;
-            }
-            let (a, b) = (node.start as usize, node.start as usize + 1);
-            let da = box_distance_squared(p, self.nodes[a].lo, self.nodes[a].hi);
-            let db = box_distance_squared(p, self.nodes[b].lo, self.nodes[b].hi);
-            // The nearer child is popped first.
-            let (far, near) = if da <= db { (b, a) } else { (a, b) };
-            stack[top] = far;
-            stack[top + 1] = near;
-            top += 2;
-        }
+            best.0
+        });
         let (i, off) = best.1?;
         *hint = Some(i as u32);
         Some((best.0, i, off))
