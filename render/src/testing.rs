@@ -385,4 +385,29 @@ pub mod hetero {
         let se = picked.iter().map(|c| c.1 * c.1).sum::<f64>().sqrt() / k;
         (mean, se)
     }
+
+    /// The mean over the whole strip of `scene` (half-width `half_mm`, `columns` columns) at `nm`,
+    /// with its standard error, by the walk at `spp_walk` (seed 1) and the BSSRDF at `spp_bssrdf`
+    /// (seed 2): a uniform slab's BSSRDF–walk gap.
+    #[must_use]
+    pub fn uniform_means(
+        scene: &Scene,
+        half_mm: f32,
+        columns_n: usize,
+        nm: f32,
+        (spp_walk, spp_bssrdf): (u32, u32),
+    ) -> [(f64, f64); 2] {
+        let mean = |kind, spp, seed| {
+            region(
+                &columns(&render_strip(scene, kind, columns_n, nm, spp, seed)),
+                half_mm,
+                -half_mm,
+                half_mm,
+            )
+        };
+        [
+            mean(IntegratorKind::Volumetric, spp_walk, 1),
+            mean(IntegratorKind::Bssrdf, spp_bssrdf, 2),
+        ]
+    }
 }

@@ -10,7 +10,9 @@
 
 use render::integrator::IntegratorKind;
 use render::material::hetero::ProfileBlend;
-use render::testing::hetero::{columns, melanin_exr, region, render_strip, strip_scene};
+use render::testing::hetero::{
+    columns, melanin_exr, region, render_strip, strip_scene, uniform_means,
+};
 use skin_plot::{LineChart, Panel, Series, save_png};
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -63,16 +65,8 @@ fn main() -> anyhow::Result<()> {
                 COLUMNS,
                 &format!("melanin = {cm}"),
             );
-            let mean = |kind, spp, seed| {
-                region(
-                    &columns(&render_strip(&scene, kind, COLUMNS, nm, spp, seed)),
-                    HALF_MM,
-                    -HALF_MM,
-                    HALF_MM,
-                )
-            };
-            let (v, vs) = mean(IntegratorKind::Volumetric, spp_vol / 4, 1);
-            let (b, bs) = mean(IntegratorKind::Bssrdf, spp_bss / 4, 2);
+            let [(v, vs), (b, bs)] =
+                uniform_means(&scene, HALF_MM, COLUMNS, nm, (spp_vol / 4, spp_bss / 4));
             println!(
                 "uniform C_m {cm} at {nm} nm: walk {v:.4} ± {vs:.4}, BSSRDF {b:.4} ± {bs:.4} ({:+.2}%)",
                 100.0 * (b / v - 1.0)

@@ -9,7 +9,9 @@
 //!     cargo run --release -p validation --features studies --example hetero_thin -- OUT [SPP_VOL] [SPP_BSSRDF]
 
 use render::integrator::IntegratorKind;
-use render::testing::hetero::{SLAB_SIDE_MM, columns, region, render_strip, strip_scene};
+use render::testing::hetero::{
+    SLAB_SIDE_MM, columns, region, render_strip, strip_scene, uniform_means,
+};
 use skin_plot::{LineChart, Panel, Series, save_png};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -52,16 +54,8 @@ fn main() -> anyhow::Result<()> {
             let dir = tempfile::tempdir()?;
             write_maps(dir.path(), flag)?;
             let scene = strip_scene(dir.path(), HALF_MM, COLUMNS, keys);
-            let mean = |kind, spp, seed| {
-                region(
-                    &columns(&render_strip(&scene, kind, COLUMNS, nm, spp, seed)),
-                    HALF_MM,
-                    -HALF_MM,
-                    HALF_MM,
-                )
-            };
-            let (v, vs) = mean(IntegratorKind::Volumetric, spp_vol / 4, 1);
-            let (b, bs) = mean(IntegratorKind::Bssrdf, spp_bss / 4, 2);
+            let [(v, vs), (b, bs)] =
+                uniform_means(&scene, HALF_MM, COLUMNS, nm, (spp_vol / 4, spp_bss / 4));
             println!(
                 "uniform {label} epidermis at {nm} nm: walk {v:.4} ± {vs:.4}, BSSRDF {b:.4} ± {bs:.4} ({:+.2}%)",
                 100.0 * (b / v - 1.0)
