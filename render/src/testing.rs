@@ -386,6 +386,19 @@ pub mod hetero {
         (mean, se)
     }
 
+    /// The columns of [`render_strip`]'s film ([`columns`]).
+    #[must_use]
+    pub fn strip_columns(
+        scene: &Scene,
+        kind: IntegratorKind,
+        columns_n: usize,
+        nm: f32,
+        spp: u32,
+        seed: u64,
+    ) -> Vec<(f64, f64)> {
+        columns(&render_strip(scene, kind, columns_n, nm, spp, seed))
+    }
+
     /// The mean over the whole strip of `scene` (half-width `half_mm`, `columns` columns) at `nm`,
     /// with its standard error, by the walk at `spp_walk` (seed 1) and the BSSRDF at `spp_bssrdf`
     /// (seed 2): a uniform slab's BSSRDF–walk gap.
@@ -399,7 +412,7 @@ pub mod hetero {
     ) -> [(f64, f64); 2] {
         let mean = |kind, spp, seed| {
             region(
-                &columns(&render_strip(scene, kind, columns_n, nm, spp, seed)),
+                &strip_columns(scene, kind, columns_n, nm, spp, seed),
                 half_mm,
                 -half_mm,
                 half_mm,

@@ -9,7 +9,7 @@ use render::integrator::IntegratorKind;
 use render::material::SkinKnobs;
 use render::scene::Scene;
 use render::testing::hetero::{
-    columns, exr_bytes, load_error, melanin_exr, region, render_strip, slab_obj, strip_scene,
+    exr_bytes, load_error, melanin_exr, region, slab_obj, strip_columns, strip_scene,
 };
 use skin_optics::{Preset, SkinParams};
 
@@ -32,14 +32,7 @@ fn uniform_map_renders_as_the_scalar_skin() {
         (IntegratorKind::Bssrdf, 256),
         (IntegratorKind::Volumetric, 256),
     ] {
-        let mean = |s: &Scene| {
-            region(
-                &columns(&render_strip(s, kind, 4, NM, spp, 5)),
-                1.0,
-                -1.0,
-                1.0,
-            )
-        };
+        let mean = |s: &Scene| region(&strip_columns(s, kind, 4, NM, spp, 5), 1.0, -1.0, 1.0);
         let ((va, sa), (vb, sb), (vl, _)) = (mean(&scalar), mean(&mapped), mean(&light));
         assert!(
             (va - vb).abs() <= 3.0 * sa.hypot(sb),
@@ -84,22 +77,8 @@ fn split_slab_and_freckle_follow_the_volumetric_walk() {
         std::fs::write(dir.path().join("maps.exr"), map).unwrap();
         let keys = |rule: &str| format!("maps = \"maps.exr\"\nprofile_blend = \"{rule}\"");
         let scene = strip_scene(dir.path(), half, cols, &keys("geometric"));
-        let vol = columns(&render_strip(
-            &scene,
-            IntegratorKind::Volumetric,
-            cols,
-            NM,
-            256,
-            7,
-        ));
-        let geo = columns(&render_strip(
-            &scene,
-            IntegratorKind::Bssrdf,
-            cols,
-            NM,
-            256,
-            8,
-        ));
+        let vol = strip_columns(&scene, IntegratorKind::Volumetric, cols, NM, 256, 7);
+        let geo = strip_columns(&scene, IntegratorKind::Bssrdf, cols, NM, 256, 8);
         for &(from, to, allowance) in regions {
             let (v, vs) = region(&vol, half, from, to);
             let (b, bs) = region(&geo, half, from, to);
@@ -109,14 +88,7 @@ fn split_slab_and_freckle_follow_the_volumetric_walk() {
             );
         }
         let entry_scene = strip_scene(dir.path(), half, cols, &keys("entry"));
-        let entry = columns(&render_strip(
-            &entry_scene,
-            IntegratorKind::Bssrdf,
-            cols,
-            NM,
-            256,
-            8,
-        ));
+        let entry = strip_columns(&entry_scene, IntegratorKind::Bssrdf, cols, NM, 256, 8);
         let rms = |c: &[(f64, f64)]| {
             let near: Vec<f64> = (0..cols)
                 .filter(|&i| {
@@ -162,14 +134,7 @@ fn the_geometric_rule_is_reciprocal_on_the_split_slab() {
         );
         let scene =
             Scene::from_toml(&text, "pair.toml", Some(dir.path()), &SkinKnobs::default()).unwrap();
-        columns(&render_strip(
-            &scene,
-            IntegratorKind::Bssrdf,
-            1,
-            NM,
-            40_000,
-            9,
-        ))[0]
+        strip_columns(&scene, IntegratorKind::Bssrdf, 1, NM, 40_000, 9)[0]
     };
     let (a, b) = (-2.0, 2.0);
     let (ab, sab) = pixel(b, a, "geometric");

@@ -6,9 +6,7 @@ use render::error::RenderError;
 use render::integrator::IntegratorKind;
 use render::material::{Material, SkinKnobs, SkinMaterial};
 use render::scene::Scene;
-use render::testing::hetero::{
-    SLAB_SIDE_MM, columns, load_error, region, render_strip, strip_scene,
-};
+use render::testing::hetero::{SLAB_SIDE_MM, load_error, region, strip_columns, strip_scene};
 use render::texture::channels_exr_bytes_with;
 
 /// 550 nm: melanin and blood both absorb, so the epidermis' thickness shows.
@@ -82,14 +80,7 @@ fn uniform_thin_map_renders_as_the_scalar_thin_skin() {
         (IntegratorKind::Bssrdf, 256),
         (IntegratorKind::Volumetric, 256),
     ] {
-        let mean = |s: &Scene| {
-            region(
-                &columns(&render_strip(s, kind, 4, NM, spp, 5)),
-                1.0,
-                -1.0,
-                1.0,
-            )
-        };
+        let mean = |s: &Scene| region(&strip_columns(s, kind, 4, NM, spp, 5), 1.0, -1.0, 1.0);
         let ((va, sa), (vb, sb), (vt, _)) = (mean(&scalar), mean(&mapped), mean(&thick));
         assert!(
             (va - vb).abs() <= 0.02 * va + 3.0 * sa.hypot(sb),
@@ -118,22 +109,8 @@ fn split_thin_slab_follows_the_volumetric_walk() {
     )
     .unwrap();
     let scene = strip_scene(dir.path(), half, cols, "maps = \"maps.exr\"");
-    let vol = columns(&render_strip(
-        &scene,
-        IntegratorKind::Volumetric,
-        cols,
-        NM,
-        256,
-        7,
-    ));
-    let bss = columns(&render_strip(
-        &scene,
-        IntegratorKind::Bssrdf,
-        cols,
-        NM,
-        256,
-        8,
-    ));
+    let vol = strip_columns(&scene, IntegratorKind::Volumetric, cols, NM, 256, 7);
+    let bss = strip_columns(&scene, IntegratorKind::Bssrdf, cols, NM, 256, 8);
     let mut means = Vec::new();
     for (from, to) in [(-4.0, -1.0), (1.0, 4.0)] {
         let (v, vs) = region(&vol, half, from, to);

@@ -10,9 +10,7 @@
 
 use render::integrator::IntegratorKind;
 use render::material::hetero::ProfileBlend;
-use render::testing::hetero::{
-    columns, melanin_exr, region, render_strip, strip_scene, uniform_means,
-};
+use render::testing::hetero::{melanin_exr, region, strip_columns, strip_scene, uniform_means};
 use skin_plot::{LineChart, Panel, Series, save_png};
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -86,27 +84,13 @@ fn main() -> anyhow::Result<()> {
             let keys =
                 |blend: ProfileBlend| format!("maps = \"maps.exr\"\nprofile_blend = \"{blend}\"");
             let scene = strip_scene(dir.path(), HALF_MM, COLUMNS, &keys(ProfileBlend::default()));
-            let vol = columns(&render_strip(
-                &scene,
-                IntegratorKind::Volumetric,
-                COLUMNS,
-                nm,
-                spp_vol,
-                1,
-            ));
+            let vol = strip_columns(&scene, IntegratorKind::Volumetric, COLUMNS, nm, spp_vol, 1);
             let mut bss = Vec::new();
             for blend in ProfileBlend::ALL {
                 let scene = strip_scene(dir.path(), HALF_MM, COLUMNS, &keys(blend));
                 bss.push((
                     blend,
-                    columns(&render_strip(
-                        &scene,
-                        IntegratorKind::Bssrdf,
-                        COLUMNS,
-                        nm,
-                        spp_bss,
-                        2,
-                    )),
+                    strip_columns(&scene, IntegratorKind::Bssrdf, COLUMNS, nm, spp_bss, 2),
                 ));
             }
             let x = |i: usize| -HALF_MM + (i as f32 + 0.5) * 2.0 * HALF_MM / COLUMNS as f32;

@@ -9,9 +9,7 @@
 //!     cargo run --release -p validation --features studies --example hetero_thin -- OUT [SPP_VOL] [SPP_BSSRDF]
 
 use render::integrator::IntegratorKind;
-use render::testing::hetero::{
-    SLAB_SIDE_MM, columns, region, render_strip, strip_scene, uniform_means,
-};
+use render::testing::hetero::{SLAB_SIDE_MM, region, strip_columns, strip_scene, uniform_means};
 use skin_plot::{LineChart, Panel, Series, save_png};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -64,22 +62,8 @@ fn main() -> anyhow::Result<()> {
         let dir = tempfile::tempdir()?;
         write_maps(dir.path(), |x| if x < 0.0 { 1.0 } else { 0.0 })?;
         let scene = strip_scene(dir.path(), HALF_MM, COLUMNS, keys);
-        let vol = columns(&render_strip(
-            &scene,
-            IntegratorKind::Volumetric,
-            COLUMNS,
-            nm,
-            spp_vol,
-            1,
-        ));
-        let bss = columns(&render_strip(
-            &scene,
-            IntegratorKind::Bssrdf,
-            COLUMNS,
-            nm,
-            spp_bss,
-            2,
-        ));
+        let vol = strip_columns(&scene, IntegratorKind::Volumetric, COLUMNS, nm, spp_vol, 1);
+        let bss = strip_columns(&scene, IntegratorKind::Bssrdf, COLUMNS, nm, spp_bss, 2);
         let mut csv = String::from("x_mm,volumetric,volumetric_se,bssrdf,bssrdf_se\n");
         for i in 0..COLUMNS {
             let _ = writeln!(
