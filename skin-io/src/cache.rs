@@ -19,9 +19,11 @@ use std::path::{Path, PathBuf};
 pub const CACHE_VERSION: u32 = 2;
 /// First word of an entry's header.
 const MAGIC: &str = "skin-tables";
-/// Largest total size of the entries in the folder, bytes (512 MiB; `$SKIN_CACHE_MAX_MIB`
-/// overrides): a light-skin table at full fidelity is about 0.1 MiB, so thousands of skins fit.
-pub const DEFAULT_MAX_BYTES: u64 = 512 << 20;
+/// Largest total size of the entries in the folder, bytes (2 GiB; `$SKIN_CACHE_MAX_MIB`
+/// overrides): a light-skin table at full fidelity is about 0.1 MiB, and one skin with chromophore
+/// maps keeps a grid of a few hundred (the three heads of `builtin:three-heads-maps` about 700 MiB
+/// at 768×384), which must fit or every load rebuilds what the last one evicted.
+pub const DEFAULT_MAX_BYTES: u64 = 2 << 30;
 /// Prefix of an entry's file name.
 const PREFIX: &str = "skin-tables-";
 
