@@ -170,21 +170,20 @@ fn bad_thin_epidermis_is_an_error_naming_key_and_file() {
     let (_, m) = load_error(d, "thin_epidermis_mm = 0.05");
     assert!(m.contains("need a map"), "{m}");
     let scene = strip_scene(d, 1.0, 4, "maps = \"old.exr\"\nthin_epidermis_mm = 0.07");
-    let Material::Skin(skin) = &scene.materials[0] else {
-        panic!("skin");
-    };
-    let thin = skin
-        .maps
-        .as_ref()
-        .unwrap()
-        .maps
-        .thin()
-        .expect("thin texels");
+    let thin = thin_of(&scene).expect("thin texels");
     assert!(
         (thin.thickness_mm - 0.07).abs() < 1e-7,
         "{}",
         thin.thickness_mm
     );
+}
+
+/// The thin-epidermis map of `scene`'s first material, a skin with chromophore maps.
+fn thin_of(scene: &Scene) -> Option<render::material::maps::ThinEpidermisMap> {
+    let Material::Skin(skin) = &scene.materials[0] else {
+        panic!("skin");
+    };
+    skin.maps.as_ref().expect("maps").maps.thin().cloned()
 }
 
 /// `fit_maps` hands its thin-epidermis flag to the renderer: a 2 × 1 PNG of a skin of the exact
@@ -221,16 +220,7 @@ fn fit_maps_flags_its_thin_texels() {
         )
     };
     let scene = load("");
-    let Material::Skin(skin) = &scene.materials[0] else {
-        panic!("skin");
-    };
-    let thin = skin
-        .maps
-        .as_ref()
-        .unwrap()
-        .maps
-        .thin()
-        .expect("a thin texel");
+    let thin = thin_of(&scene).expect("a thin texel");
     assert!(
         (thin.thickness_mm - 0.05).abs() < 1e-7,
         "{}",
@@ -238,9 +228,5 @@ fn fit_maps_flags_its_thin_texels() {
     );
     assert!(thin.is_thin(glam::Vec2::new(0.25, 0.5)));
     assert!(!thin.is_thin(glam::Vec2::new(0.75, 0.5)));
-    let scene = load("thin_epidermis = false");
-    let Material::Skin(skin) = &scene.materials[0] else {
-        panic!("skin");
-    };
-    assert!(skin.maps.as_ref().unwrap().maps.thin().is_none());
+    assert!(thin_of(&load("thin_epidermis = false")).is_none());
 }

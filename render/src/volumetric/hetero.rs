@@ -80,6 +80,13 @@ impl MapAbsorption<'_> {
     #[must_use]
     #[inline]
     pub fn epidermis_mm(&self, x: DVec3) -> f32 {
+        self.medium.maps.epidermis_at_mm(self.nearest_uv(x))
+    }
+
+    /// The texture coordinates of the surface point nearest `x`, the last answer kept as the
+    /// next query's anchor.
+    #[inline]
+    fn nearest_uv(&self, x: DVec3) -> glam::Vec2 {
         let mut anchor = self.anchor.get();
         let uv = self
             .medium
@@ -87,7 +94,7 @@ impl MapAbsorption<'_> {
             .uv(&self.medium.nearest, x, &mut anchor)
             .unwrap_or_default();
         self.anchor.set(anchor);
-        self.medium.maps.epidermis_at_mm(uv)
+        uv
     }
 
     /// σa at `x` of the epidermis (`epidermis`) or the dermis, from the texel of the surface
@@ -95,13 +102,7 @@ impl MapAbsorption<'_> {
     #[must_use]
     #[inline]
     pub fn sigma_a(&self, epidermis: bool, x: DVec3) -> f32 {
-        let mut anchor = self.anchor.get();
-        let uv = self
-            .medium
-            .grid
-            .uv(&self.medium.nearest, x, &mut anchor)
-            .unwrap_or_default();
-        self.anchor.set(anchor);
+        let uv = self.nearest_uv(x);
         self.corners
             .sigma_a(epidermis, self.medium.maps.maps.at(uv))
     }
