@@ -19,8 +19,7 @@ fn region(scene: &Scene, side: usize, keep: impl Fn(glam::Vec3) -> bool) -> Vec<
     (0..side * side)
         .filter(|&i| {
             let (x, y) = (i % side, i / side);
-            let ndc = Vec2::new((x as f32 + 0.5) / side as f32, (y as f32 + 0.5) / side as f32);
-            let (o, d) = scene.camera.generate_ray(ndc, 1.0, Vec2::ZERO);
+            let (o, d) = render::testing::pixel_ray(scene, side, x, y);
             matches!(scene.intersect(o, d, 0.0, f32::INFINITY), Some(Hit::Surface(si)) if keep(si.p))
         })
         .collect()

@@ -130,7 +130,6 @@ fn main() -> anyhow::Result<()> {
 /// within 10 mm), "lit" (thick, the back light's centre in view above the surface) and "shade"
 /// (the rest); per region the mean of the walk, the separable BSSRDF and the lobe.
 fn ear(side: usize, spp: u32, ref_spp: u32) -> anyhow::Result<()> {
-    use glam::Vec2;
     use render::geometry::offset_origin;
     use render::scene::Hit;
     let surface = std::env::var("SURFACE").unwrap_or_else(|_| "smooth".into());
@@ -182,11 +181,7 @@ fn ear(side: usize, spp: u32, ref_spp: u32) -> anyhow::Result<()> {
     let mut cosines = (0.0f64, 0.0f64, 0.0f64);
     for y in 0..side {
         for x in 0..side {
-            let ndc = Vec2::new(
-                (x as f32 + 0.5) / side as f32,
-                (y as f32 + 0.5) / side as f32,
-            );
-            let (o, d) = scene.camera.generate_ray(ndc, 1.0, Vec2::ZERO);
+            let (o, d) = render::testing::pixel_ray(&scene, side, x, y);
             let c = match scene.intersect(o, d, 0.0, f32::INFINITY) {
                 Some(Hit::Surface(si))
                     if matches!(

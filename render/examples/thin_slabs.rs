@@ -12,7 +12,6 @@
 //!
 //! `cargo run --release -p render --features studies --example thin_slabs -- SIDE SPP REF_SPP [TONES|ear|lamp] [front]`
 
-use glam::Vec2;
 use render::fidelity::FidelityKnobs;
 use render::geometry::offset_origin;
 use render::integrator::{BodyIntegrator, IntegratorKind, PathSettings, ThinExit};
@@ -259,11 +258,7 @@ fn thin_pixels(scene: &Scene, side: usize) -> Vec<bool> {
     let mut thin = Vec::with_capacity(side * side);
     for y in 0..side {
         for x in 0..side {
-            let ndc = Vec2::new(
-                (x as f32 + 0.5) / side as f32,
-                (y as f32 + 0.5) / side as f32,
-            );
-            let (o, d) = scene.camera.generate_ray(ndc, 1.0, Vec2::ZERO);
+            let (o, d) = render::testing::pixel_ray(scene, side, x, y);
             let t = match scene.intersect(o, d, 0.0, f32::INFINITY) {
                 Some(Hit::Surface(si)) => {
                     let ng = if si.ng.dot(d) > 0.0 { -si.ng } else { si.ng };

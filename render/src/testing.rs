@@ -111,6 +111,17 @@ impl SceneText {
     }
 }
 
+/// The camera ray of `scene` through the centre of pixel (`x`, `y`) of a `side` × `side` image:
+/// origin (mm) and unit direction.
+#[must_use]
+pub fn pixel_ray(scene: &Scene, side: usize, x: usize, y: usize) -> (glam::Vec3, glam::Vec3) {
+    let ndc = glam::Vec2::new(
+        (x as f32 + 0.5) / side as f32,
+        (y as f32 + 0.5) / side as f32,
+    );
+    scene.camera.generate_ray(ndc, 1.0, glam::Vec2::ZERO)
+}
+
 /// The white furnace: a diffuse albedo-1 sphere of radius 100 mm inside a constant environment
 /// of luminance 1, seen from 300 mm.
 #[must_use]

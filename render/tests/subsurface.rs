@@ -380,7 +380,6 @@ fn edge_parameters_render_finite_non_negative_images() {
 /// tables' adding-doubling totals are then the same physics, §15): the region's mean radiance of
 /// each integrator and the standard error of their ratio (both renders' variance passes).
 mod against_the_walk {
-    use glam::Vec2;
     use render::film::Film;
     use render::integrator::{BodyIntegrator, IntegratorKind};
     use render::renderer::{RenderOptions, render_with};
@@ -409,11 +408,7 @@ mod against_the_walk {
     fn region(scene: &Scene, side: usize, keep: impl Fn(glam::Vec3) -> bool) -> Vec<usize> {
         (0..side * side)
             .filter(|&i| {
-                let ndc = Vec2::new(
-                    ((i % side) as f32 + 0.5) / side as f32,
-                    ((i / side) as f32 + 0.5) / side as f32,
-                );
-                let (o, d) = scene.camera.generate_ray(ndc, 1.0, Vec2::ZERO);
+                let (o, d) = render::testing::pixel_ray(scene, side, i % side, i / side);
                 matches!(scene.intersect(o, d, 0.0, f32::INFINITY),
                     Some(Hit::Surface(si)) if keep(si.p))
             })
