@@ -247,7 +247,14 @@ fn ear(side: usize, spp: u32, ref_spp: u32) -> anyhow::Result<()> {
         if n == 0 {
             continue;
         }
-        let film = pixels(sc, kind, side, n, seed)?;
+        let film = pixels(
+            sc,
+            kind,
+            side,
+            n,
+            seed,
+            std::env::var("NM").ok().and_then(|s| s.parse().ok()),
+        )?;
         for (c, name) in ["thin", "lit", "shade", "other"].iter().enumerate() {
             let (m, se, px) = region(&film, c);
             println!("{label},{n},{name},{px},{m:.5},{se:.5},{:.2}", film.1);
@@ -310,13 +317,15 @@ fn ear(side: usize, spp: u32, ref_spp: u32) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Each pixel's (luminance, variance of its mean) and the process CPU seconds.
+/// Each pixel's (luminance, variance of its mean) and the process CPU seconds, at the single
+/// wavelength `nm` (colour without one).
 fn pixels(
     scene: &Scene,
     kind: IntegratorKind,
     side: usize,
     spp: u32,
     seed: u64,
+    nm: Option<f32>,
 ) -> anyhow::Result<(Vec<(f64, f64)>, f64)> {
     let body = BodyIntegrator::build(scene, kind);
     let opts = RenderOptions {
@@ -325,7 +334,7 @@ fn pixels(
         spp,
         seed,
         noise: None,
-        wavelength_nm: std::env::var("NM").ok().and_then(|s| s.parse().ok()),
+        wavelength_nm: nm,
         ..Default::default()
     };
     let t0 = cpu_time::ProcessTime::now();
@@ -349,27 +358,9 @@ fn run(
     seed: u64,
     nm: Option<f32>,
 ) -> anyhow::Result<(f64, f64, f64)> {
-    let body = BodyIntegrator::build(scene, kind);
-    let opts = RenderOptions {
-        width: side,
-        height: side,
-        spp,
-        seed,
-        noise: None,
-        wavelength_nm: nm,
-        ..Default::default()
-    };
-    let t0 = cpu_time::ProcessTime::now();
-    let (film, _) = render_with(scene, &body, &opts.validate()?, None)?;
-    let cpu = t0.elapsed().as_secs_f64();
-    let n = (side * side) as f64;
-    let (mut sum, mut var) = (0.0, 0.0);
-    for y in 0..side {
-        for x in 0..side {
-            sum += f64::from(film.xyz(x, y)[1]);
-            var += film.variance(x, y);
-        }
-    }
+    let (px, cpu) = pixels(scene, kind, side, spp, seed, nm)?;
+    let n = px.len() as f64;
+    let (sum, var) = px.iter().fold((0.0, 0.0), |(s, v), p| (s + p.0, v + p.1));
     Ok((sum / n, var.sqrt() / n, cpu))
 }
 
