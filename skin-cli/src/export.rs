@@ -4,7 +4,7 @@
 use crate::args::SkinArgs;
 use anyhow::Context;
 use clap::Args;
-use skin_export::textured::{ChromophoreTexture, TexturedOptions, export_textured};
+use skin_export::textured::{ChromophoreTexture, TexturedOptions, ThinTexels, export_textured};
 use skin_export::{ColourSpace, ExportOptions, Format, export};
 use skin_io::atomic::write_bytes;
 use skin_optics::{Wavelength, WavelengthGrid};
@@ -189,12 +189,39 @@ fn run_textured(
     let eumelanin = eumelanin.ok_or_else(|| missing("eumelanin"))?;
     let hemoglobin = hemoglobin.ok_or_else(|| missing("hemoglobin"))?;
     let (width, height) = (melanin.width, melanin.height);
+    let thin = match (channels.thin_epidermis, channels.thin_epidermis_mm) {
+        (None, _) => None,
+        (Some(_), None) => anyhow::bail!(
+            "--maps {}: channel '{}' without its header attribute '{}' (the thin epidermis' \
+             thickness, mm)",
+            maps.display(),
+            render::material::maps::THIN_EPIDERMIS_CHANNEL,
+            render::material::maps::THIN_EPIDERMIS_ATTRIBUTE
+        ),
+        (Some(flags), Some(epidermis_mm)) => {
+            if let Some(k) = flags.values.iter().position(|v| !(0.0..=1.0).contains(v)) {
+                anyhow::bail!(
+                    "--maps {}: {} at texel ({}, {}) is {}, outside [0, 1]",
+                    maps.display(),
+                    render::material::maps::THIN_EPIDERMIS_CHANNEL,
+                    k % flags.width,
+                    k / flags.width,
+                    flags.values[k]
+                );
+            }
+            Some(ThinTexels {
+                epidermis_mm,
+                texels: flags.values.iter().map(|&v| v >= 0.5).collect(),
+            })
+        }
+    };
     let texture = ChromophoreTexture {
         width,
         height,
         melanin: melanin.values,
         eumelanin: eumelanin.values,
         hemoglobin: hemoglobin.values,
+        thin,
     };
     let topts = TexturedOptions {
         nodes: args.texture_nodes,

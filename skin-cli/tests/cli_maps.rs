@@ -454,7 +454,8 @@ fn bad_input_is_one_line_and_leaves_no_maps() {
 /// Texels out of the texture skin's gamut that the thin-epidermis skin reproduces (a skin of the
 /// exact model under 0.05 mm with C_h 0.15, as the lips) are flagged in maps.exr's
 /// `thin_epidermis` channel, and the file records the thickness they were fitted under in its
-/// `thin_epidermis_mm` attribute (`--thin-epidermis 0.06` here), which the renderer reads with it.
+/// `thin_epidermis_mm` attribute (`--thin-epidermis 0.06` here), which the renderer and the
+/// textured export read with it.
 #[test]
 fn thin_epidermis_texels_carry_their_thickness() {
     let base = skin_fit::FitOptions::default().base;
@@ -476,4 +477,28 @@ fn thin_epidermis_texels_carry_their_thickness() {
     assert_eq!(maps.thin_epidermis.unwrap().values, vec![1.0, 0.0]);
     let mm = maps.thin_epidermis_mm.expect("the thickness attribute");
     assert!((mm - 0.06).abs() < 1e-7, "{mm}");
+    // The textured export fits the flagged texel under the thickness the file records.
+    let mtlx = tmp.path().join("mat").join("skin.mtlx");
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_skin"))
+        .args(["export", "openpbr", "--maps"])
+        .arg(out.join("maps.exr"))
+        .arg("--out")
+        .arg(&mtlx)
+        .args([
+            "--escapes",
+            "500",
+            "--volume-photons",
+            "2000",
+            "--step",
+            "20",
+        ])
+        .env("SKIN_CACHE_DIR", cache_dir())
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("for the 1 texels under a 0.060 mm epidermis"),
+        "{}",
+        stderr(&o)
+    );
 }

@@ -859,6 +859,7 @@ fn materialx_documents_pass_materialx_own_checks_where_it_is_installed() {
             melanin: vec![0.01, 0.1],
             eumelanin: vec![0.6, 0.6],
             hemoglobin: vec![0.01, 0.05],
+            thin: None,
         };
         let topts = skin_export::textured::TexturedOptions {
             nodes: 2,

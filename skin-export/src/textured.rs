@@ -40,6 +40,19 @@ pub struct ChromophoreTexture {
     pub eumelanin: Vec<f32>,
     /// Hemoglobin fraction C_h per texel, (0, 1].
     pub hemoglobin: Vec<f32>,
+    /// The texels under a thinner epidermis than the base skin's (`maps.exr`'s `thin_epidermis`
+    /// channel), `None` when every texel has the base skin's.
+    pub thin: Option<ThinTexels>,
+}
+
+/// Texels whose skin has a thinner epidermis than the base skin (the lip vermilion of
+/// docs/physics.md §18, "Thin epidermis").
+#[derive(Debug, Clone, PartialEq)]
+pub struct ThinTexels {
+    /// The thin epidermis' thickness, mm (within `SkinParams`' epidermis range).
+    pub epidermis_mm: f64,
+    /// Per texel, row-major from the top row: whether it has the thin epidermis.
+    pub texels: Vec<bool>,
 }
 
 impl ChromophoreTexture {
@@ -83,7 +96,25 @@ impl ChromophoreTexture {
                 ));
             }
         }
+        if let Some(thin) = &self.thin
+            && thin.texels.len() != n
+        {
+            return Err(texture_error(
+                "thin_epidermis",
+                format!(
+                    "{} flags for {}×{} texels",
+                    thin.texels.len(),
+                    self.width,
+                    self.height
+                ),
+            ));
+        }
         Ok(())
+    }
+
+    /// Whether texel `k` has the thin epidermis.
+    fn is_thin(&self, k: usize) -> bool {
+        self.thin.as_ref().is_some_and(|t| t.texels[k])
     }
 }
 
@@ -353,58 +384,118 @@ fn fitted_export(
             f64::from(texture.eumelanin[k]),
         )
     };
-    let axes = [
-        Axis::over((0..n).map(|k| coords(k).0), topts.nodes),
-        Axis::over((0..n).map(|k| coords(k).1), topts.nodes),
-        Axis::over((0..n).map(|k| coords(k).2), 3),
-    ];
-    let total = axes.iter().map(|a| a.n).product::<usize>();
+    // One grid per epidermis: the texels under the thin one take their own base skin, so that
+    // each texel is fitted as the scalar export fits its own skin.
+    let thin_base = match &texture.thin {
+        Some(t) if t.texels.iter().any(|&b| b) => Some(
+            base.with_epidermis_thickness_mm(t.epidermis_mm)
+                .map_err(|e| texture_error("thin_epidermis_mm", e.to_string()))?,
+        ),
+        _ => None,
+    };
+    let groups: Vec<(SkinParams, Vec<usize>)> =
+        [(false, *base), (true, thin_base.unwrap_or(*base))]
+            .into_iter()
+            .filter(|(thin, _)| !thin || thin_base.is_some())
+            .map(|(thin, skin)| {
+                (
+                    skin,
+                    (0..n).filter(|&k| texture.is_thin(k) == thin).collect(),
+                )
+            })
+            .filter(|(_, texels): &(SkinParams, Vec<usize>)| !texels.is_empty())
+            .collect();
+    let axes_of = |texels: &[usize]| {
+        [
+            Axis::over(texels.iter().map(|&k| coords(k).0), topts.nodes),
+            Axis::over(texels.iter().map(|&k| coords(k).1), topts.nodes),
+            Axis::over(texels.iter().map(|&k| coords(k).2), 3),
+        ]
+    };
+    let all_axes: Vec<[Axis; 3]> = groups.iter().map(|(_, t)| axes_of(t)).collect();
+    let total: usize = all_axes
+        .iter()
+        .map(|a| a.iter().map(|x| x.n).product::<usize>())
+        .sum();
     let done = std::sync::atomic::AtomicUsize::new(0);
-    let nodes = (0..total)
-        .into_par_iter()
-        .map(|idx| {
-            let (i, j, k) = (
-                idx % axes[0].n,
-                (idx / axes[0].n) % axes[1].n,
-                idx / (axes[0].n * axes[1].n),
-            );
-            let skin = skin_at(
-                base,
-                melanin_of(axes[0].node(i)),
-                axes[2].node(k),
-                axes[1].node(j).exp(),
-            )?;
-            let (colour, length) = fit_skin(format, &skin, opts)?;
-            let d = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
-            progress(d, total);
-            Ok((colour, length.map(f64::ln)))
-        })
-        .collect::<Result<Vec<_>, ExportError>>()?;
-    let grid = Grid { axes, nodes };
-    let fitted: Vec<Fitted> = (0..n)
-        .into_par_iter()
-        .map(|k| {
-            let (u, v, b) = coords(k);
-            grid.at(u, v, b)
-        })
-        .collect();
-    let check = interpolation_error(format, base, texture, opts, topts.checks, &fitted)?;
+    let mut fitted: Vec<Fitted> = vec![([0.0; 3], [0.0; 3]); n];
+    let mut grids = Vec::with_capacity(groups.len());
+    let mut check = (0, 0.0f64, 0.0f64);
+    for ((skin, texels), axes) in groups.iter().zip(all_axes) {
+        let cells = axes.iter().map(|a| a.n).product::<usize>();
+        let nodes = (0..cells)
+            .into_par_iter()
+            .map(|idx| {
+                let (i, j, k) = (
+                    idx % axes[0].n,
+                    (idx / axes[0].n) % axes[1].n,
+                    idx / (axes[0].n * axes[1].n),
+                );
+                let node = skin_at(
+                    skin,
+                    melanin_of(axes[0].node(i)),
+                    axes[2].node(k),
+                    axes[1].node(j).exp(),
+                )?;
+                let (colour, length) = fit_skin(format, &node, opts)?;
+                let d = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+                progress(d, total);
+                Ok((colour, length.map(f64::ln)))
+            })
+            .collect::<Result<Vec<_>, ExportError>>()?;
+        let grid = Grid { axes, nodes };
+        let values: Vec<Fitted> = texels
+            .par_iter()
+            .map(|&k| {
+                let (u, v, b) = coords(k);
+                grid.at(u, v, b)
+            })
+            .collect();
+        for (&k, f) in texels.iter().zip(values) {
+            fitted[k] = f;
+        }
+        let c = interpolation_error(format, skin, texture, texels, opts, topts.checks, &fitted)?;
+        check = (check.0 + c.0, check.1.max(c.1), check.2.max(c.2));
+        grids.push(grid);
+    }
     let to_space = |v: [f64; 3]| opts.colour_space.from_rec709(v);
     let surface = Surface::of(base);
     let space = opts.colour_space.materialx_name();
+    let describe = |axes: &[Axis; 3]| {
+        format!(
+            "{}×{}×{} grid over C_m {:.4}–{:.4}, C_h {:.4}–{:.4}, β_m {:.3}–{:.3}",
+            axes[0].n,
+            axes[1].n,
+            axes[2].n,
+            melanin_of(axes[0].lo),
+            melanin_of(axes[0].hi),
+            axes[1].lo.exp(),
+            axes[1].hi.exp(),
+            axes[2].lo,
+            axes[2].hi,
+        )
+    };
+    let grid_text = if thin_base.is_none() {
+        describe(&grids[0].axes)
+    } else {
+        groups
+            .iter()
+            .zip(&grids)
+            .map(|((skin, texels), grid)| {
+                format!(
+                    "{} for the {} texels under a {:.3} mm epidermis",
+                    describe(&grid.axes),
+                    texels.len(),
+                    skin.epidermis_thickness_mm()
+                )
+            })
+            .collect::<Vec<_>>()
+            .join(" and a ")
+    };
     let grid_note = format!(
-        "texture: {}×{} texels from the chromophore maps, top row first (the albedo texture's orientation); each texel fitted by the scalar export's rules through a {}×{}×{} grid over C_m {:.4}–{:.4}, C_h {:.4}–{:.4}, β_m {:.3}–{:.3} (Catmull–Rom in ln(1 + C_m/0.005), ln C_h, β_m; lengths through their logarithm); measured against the scalar fit at {} texels off the nodes: colour within {:.2} %, length within {:.2} % (largest over channels)",
+        "texture: {}×{} texels from the chromophore maps, top row first (the albedo texture's orientation); each texel fitted by the scalar export's rules through a {grid_text} (Catmull–Rom in ln(1 + C_m/0.005), ln C_h, β_m; lengths through their logarithm); measured against the scalar fit at {} texels off the nodes: colour within {:.2} %, length within {:.2} % (largest over channels)",
         texture.width,
         texture.height,
-        axes[0].n,
-        axes[1].n,
-        axes[2].n,
-        melanin_of(axes[0].lo),
-        melanin_of(axes[0].hi),
-        axes[1].lo.exp(),
-        axes[1].hi.exp(),
-        axes[2].lo,
-        axes[2].hi,
         check.0,
         100.0 * check.1,
         100.0 * check.2,
@@ -458,14 +549,16 @@ fn fitted_export(
             })
         }
         _ => {
-            // One profile per material: the fit at the texels' median skin.
+            // One profile per material: the fit at the median skin of the texels under the
+            // material's own epidermis (or of all, when every texel is thin).
+            let (mid_base, mid_texels) = &groups[0];
             let median = |v: &[f32]| {
-                let mut s: Vec<f32> = v.to_vec();
+                let mut s: Vec<f32> = mid_texels.iter().map(|&k| v[k]).collect();
                 s.sort_by(f32::total_cmp);
                 f64::from(s[s.len() / 2])
             };
             let mid = skin_at(
-                base,
+                mid_base,
                 median(&texture.melanin),
                 median(&texture.eumelanin),
                 median(&texture.hemoglobin),
@@ -505,19 +598,20 @@ fn fitted_export(
     }
 }
 
-/// The interpolant against the scalar fit at `checks` texels spread over the texture: (texels
-/// checked, largest colour error, largest length error), relative.
+/// The interpolant against the scalar fit of `base` at `checks` texels spread over `texels`:
+/// (texels checked, largest colour error, largest length error), relative.
 fn interpolation_error(
     format: Format,
     base: &SkinParams,
     texture: &ChromophoreTexture,
+    texels: &[usize],
     opts: &ExportOptions,
     checks: usize,
     fitted: &[Fitted],
 ) -> Result<(usize, f64, f64), ExportError> {
-    let n = fitted.len();
+    let n = texels.len();
     let picks: Vec<usize> = (0..checks.min(n))
-        .map(|i| (i * 2 + 1) * n / (2 * checks.min(n)))
+        .map(|i| texels[(i * 2 + 1) * n / (2 * checks.min(n))])
         .collect();
     let errors = picks
         .par_iter()
@@ -563,6 +657,7 @@ mod tests {
             melanin: v.iter().map(|t| t[0]).collect(),
             eumelanin: v.iter().map(|t| t[1]).collect(),
             hemoglobin: v.iter().map(|t| t[2]).collect(),
+            thin: None,
         }
     }
 
@@ -687,6 +782,41 @@ mod tests {
         assert_eq!(out.images[0].rgb.len(), 64);
     }
 
+    /// Texels flagged thin are fitted under their own epidermis: with one skin per group (a
+    /// one-node grid each, exact to 1e-6), the thin texel holds the scalar fit of the skin under
+    /// the thin epidermis and the other texel that under the base skin's, which differ by more
+    /// than 1 % (less melanin in the light's way).
+    #[test]
+    fn thin_texels_take_the_fit_of_their_own_epidermis() {
+        let opts = quick();
+        let base = SkinParams::default();
+        let mut tex = texture(2, 1, |_| [0.1, 0.6, 0.05]);
+        tex.thin = Some(ThinTexels {
+            epidermis_mm: 0.06,
+            texels: vec![true, false],
+        });
+        let topts = TexturedOptions {
+            nodes: 4,
+            checks: 1,
+        };
+        let out = fitted_export(Format::OpenPbr, &base, &tex, &opts, &topts, &|_, _| {}).unwrap();
+        let skin = skin_at(&base, 0.1, 0.6, 0.05).unwrap();
+        let thin_skin = skin.with_epidermis_thickness_mm(0.06).unwrap();
+        let (thick, _) = fit_skin(Format::OpenPbr, &skin, &opts).unwrap();
+        let (thin, _) = fit_skin(Format::OpenPbr, &thin_skin, &opts).unwrap();
+        let close =
+            |a: [f32; 3], b: [f64; 3]| (0..3).all(|c| (f64::from(a[c]) / b[c] - 1.0).abs() < 1e-6);
+        let rgb = &out.images[0].rgb;
+        assert!(close(rgb[0], thin), "{:?} {thin:?}", rgb[0]);
+        assert!(close(rgb[1], thick), "{:?} {thick:?}", rgb[1]);
+        assert!((0..3).any(|c| (thin[c] / thick[c] - 1.0).abs() > 0.01));
+        let note = out.notes.iter().find(|n| n.contains("grid over")).unwrap();
+        assert!(
+            note.contains("for the 1 texels under a 0.060 mm epidermis"),
+            "{note}"
+        );
+    }
+
     #[test]
     fn bad_textures_and_options_name_the_key() {
         let base = SkinParams::default();
@@ -717,5 +847,18 @@ mod tests {
         assert!(run(Format::OpenPbr, &short, 4).starts_with("eumelanin: 3 values for 2×2"));
         assert!(run(Format::Pbrt, &good, 4).contains("takes no textures"));
         assert!(run(Format::OpenPbr, &good, 1).contains("texture grid nodes = 1 outside [2, 33]"));
+        let mut flags = good.clone();
+        flags.thin = Some(ThinTexels {
+            epidermis_mm: 0.05,
+            texels: vec![true],
+        });
+        assert!(run(Format::OpenPbr, &flags, 4).starts_with("thin_epidermis: 1 flags for 2×2"));
+        let mut thick = good.clone();
+        thick.thin = Some(ThinTexels {
+            epidermis_mm: 50.0,
+            texels: vec![true, false, false, false],
+        });
+        let e = run(Format::OpenPbr, &thick, 4);
+        assert!(e.starts_with("thin_epidermis_mm: "), "{e}");
     }
 }
