@@ -10,6 +10,10 @@
 //! Writes OUT/hetero_head.csv and OUT/hetero_head.png (the four images with the regions boxed,
 //! and the differences as bars with ±1σ whiskers).
 //!
+//! With `LIGHT=sky` the quad light is replaced by a uniform D65 sky of luminance 1 (every exit of
+//! the walk then sees the light, so its region means are far quieter), and `SURFACES=oily` keeps
+//! only the default surface.
+//!
 //!     cargo run --release -p validation --features studies --example hetero_head -- OUT [SPP_VOL] [SPP_BSSRDF]
 
 use render::film::Film;
@@ -142,8 +146,19 @@ fn main() -> anyhow::Result<()> {
     );
     let mut images = Vec::new();
     let mut bars = Vec::new();
-    for (surface, key) in [("oily", ""), ("smooth", "surface = \"smooth\"")] {
-        let text = HEAD.replace("{surface}", key);
+    let sky = std::env::var("LIGHT").is_ok_and(|v| v == "sky");
+    let surfaces: &[(&str, &str)] = if std::env::var("SURFACES").is_ok_and(|v| v == "oily") {
+        &[("oily", "")]
+    } else {
+        &[("oily", ""), ("smooth", "surface = \"smooth\"")]
+    };
+    for &(surface, key) in surfaces {
+        let mut text = HEAD.replace("{surface}", key);
+        if sky {
+            let lights = text.find("[[lights]]").expect("the quad light");
+            text.truncate(lights);
+            text = text.replace("intensity = 0.01", "intensity = 1.0");
+        }
         let scene = Scene::from_toml(&text, "hetero_head.toml", None, &SkinKnobs::default())?;
         let (bss, bss_cpu) = render(&scene, IntegratorKind::Bssrdf, spp_bss, 1)?;
         let (vol, vol_cpu) = render(&scene, IntegratorKind::Volumetric, spp_vol, 2)?;
@@ -210,10 +225,10 @@ fn main() -> anyhow::Result<()> {
         }
     }
     chart = chart.with_series(Series::dashed("", vec![(0.4, 0.0), (4.6, 0.0)]).with_color([0; 3]));
-    // The four images (oily BSSRDF, oily walk, smooth BSSRDF, smooth walk), each twice its size,
+    // The images (BSSRDF and walk per surface: oily, then smooth), each twice its size,
     // above the chart.
     let scale = 2;
-    let (w, ih, ch) = (4 * SIDE * scale, SIDE * scale, 500);
+    let (w, ih, ch) = (images.len() * SIDE * scale, SIDE * scale, 500);
     let plot = render_rgb(&[Panel::Line(chart)], w as u32, ch as u32)?;
     let mut png = image::RgbImage::new(w as u32, (ih + ch) as u32);
     for (k, img) in images.iter().enumerate() {

@@ -149,6 +149,7 @@ pub struct MapInputs {
 pub struct ChromophoreMaps {
     texels: Texture,
     range: [[f32; 2]; 3],
+    typical: [f32; 3],
     thin: Option<ThinEpidermisMap>,
 }
 
@@ -292,14 +293,38 @@ impl ChromophoreMaps {
             Some(t) => thin_map(t, &values, width, height)?,
             None => None,
         };
+        let under_material = |i: usize| {
+            thin.is_none() || inputs.thin.as_ref().is_none_or(|t| t.image.values[i] < 0.5)
+        };
+        let typical = std::array::from_fn(|k| {
+            let mut v: Vec<f32> = (0..n)
+                .filter(|&i| under_material(i))
+                .map(|i| values[k][i])
+                .collect();
+            if v.is_empty() {
+                v.clone_from(&values[k]);
+            }
+            let mid = v.len() / 2;
+            *v.select_nth_unstable_by(mid, f32::total_cmp).1
+        });
         let texels = (0..n)
             .map(|i| [values[0][i], values[1][i], values[2][i]])
             .collect();
         Ok(Some(Self {
             texels: Texture::from_texels(width, height, texels),
             range,
+            typical,
             thin,
         }))
+    }
+
+    /// The typical skin of the maps: each parameter's median over the texels under the
+    /// material's own epidermis (C_m, β_m, C_h). The material's scalar skin takes it, so that
+    /// what reads one skin per material (profile extent, level of detail, the thin-part
+    /// criterion, the curvature term) reads skin like the maps'.
+    #[must_use]
+    pub fn typical(&self) -> [f32; 3] {
+        self.typical
     }
 
     /// Where the skin has a thin epidermis (`None`: nowhere).
@@ -645,6 +670,43 @@ mod tests {
                 .thin()
                 .is_none()
         );
+    }
+
+    /// The typical skin is each parameter's median over the texels under the material's
+    /// epidermis, after the edits: melanin 0.4, 0.1, 0.9, 0.3, 0.2 plus 0.05 has the median
+    /// 0.35; with texels 3 and 4 (0.35, 0.25) thin, the median of the other three is 0.45.
+    /// Scalars are their own median.
+    #[test]
+    fn the_typical_skin_is_the_median_of_the_material_epidermis_texels() {
+        let mut i = inputs(
+            ValueImage {
+                width: 5,
+                height: 1,
+                values: vec![0.4, 0.1, 0.9, 0.3, 0.2],
+            },
+            Edit {
+                scale: 1.0,
+                offset: 0.05,
+            },
+        );
+        let close = |a: [f32; 3], b: [f32; 3]| (0..3).all(|k| (a[k] - b[k]).abs() < 1e-6);
+        let typical = ChromophoreMaps::assemble(i.clone())
+            .unwrap()
+            .unwrap()
+            .typical();
+        assert!(close(typical, [0.35, 0.5, 0.02]), "{typical:?}");
+        i.thin = Some(ThinInput {
+            key: "materials.s.maps".into(),
+            path: "maps.exr".into(),
+            image: ValueImage {
+                width: 5,
+                height: 1,
+                values: vec![0.0, 0.0, 0.0, 1.0, 1.0],
+            },
+            thickness_mm: 0.05,
+        });
+        let typical = ChromophoreMaps::assemble(i).unwrap().unwrap().typical();
+        assert!(close(typical, [0.45, 0.5, 0.02]), "{typical:?}");
     }
 
     /// Scalars fill the parameters without a map; the edit v' = s v + o applies everywhere without

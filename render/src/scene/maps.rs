@@ -14,6 +14,7 @@ use crate::material::maps::{
 };
 use crate::material::{SkinBuildError, SkinKnobs, SkinMaterial};
 use crate::texture::Texture;
+use skin_optics::SkinParams;
 use std::path::PathBuf;
 
 /// The map keys of one skin material, as parsed.
@@ -36,16 +37,17 @@ pub(super) struct MapKeys<'a> {
 }
 
 impl Loader<'_> {
-    /// `skin` with the maps its keys give (unchanged when there are none).
+    /// `skin` with `maps`, the maps its keys gave (`skin` unchanged when there are none).
     pub(super) fn skin_with_maps(
         &self,
         key: &str,
         skin: SkinMaterial,
+        maps: Option<ChromophoreMaps>,
         keys: &MapKeys<'_>,
         knobs: &SkinKnobs,
     ) -> Result<SkinMaterial, RenderError> {
         let edited = keys.edits.iter().any(|(s, o)| s.is_some() || o.is_some());
-        let Some(maps) = self.chromophore_maps(key, &skin, keys)? else {
+        let Some(maps) = maps else {
             let thin = keys.thin_epidermis.0.is_some() || keys.thin_epidermis.1.is_some();
             if edited || keys.profile_blend.is_some() || keys.map_profile_error.is_some() || thin {
                 return Err(self.err(
@@ -77,12 +79,13 @@ impl Loader<'_> {
             .map_err(|e: SkinBuildError| self.err(key, e.to_string()))
     }
 
-    /// The maps of `skin`'s keys: each given file read and decoded, the scalars filling the
-    /// parameters without one, the edits applied; `None` when no map or mask is given.
-    fn chromophore_maps(
+    /// The maps of a skin's keys over its scalar skin `params`: each given file read and
+    /// decoded, the scalars filling the parameters without one, the edits applied; `None` when
+    /// no map or mask is given.
+    pub(super) fn chromophore_maps(
         &self,
         key: &str,
-        skin: &SkinMaterial,
+        params: &SkinParams,
         keys: &MapKeys<'_>,
     ) -> Result<Option<ChromophoreMaps>, RenderError> {
         let read = |name: &str, spec: &str| -> Result<(Vec<u8>, PathBuf), RenderError> {
@@ -111,7 +114,7 @@ impl Loader<'_> {
         let thin_mm_key = format!("{key}.thin_epidermis_mm");
         // The thickness of a thin epidermis: (0, 10] mm as SkinParams takes it.
         let check_mm = |mm: f64| -> Result<f32, String> {
-            skin.params
+            params
                 .with_epidermis_thickness_mm(mm)
                 .map(|_| mm as f32)
                 .map_err(|e| e.to_string())
@@ -180,9 +183,9 @@ impl Loader<'_> {
             exr_source = Some(("fit_maps", source));
         }
         let scalars = [
-            skin.params.melanin(),
-            skin.params.eumelanin_blend(),
-            skin.params.hemoglobin(),
+            params.melanin(),
+            params.eumelanin_blend(),
+            params.hemoglobin(),
         ];
         let mut sources: [Source; 3] = scalars.map(Source::Scalar);
         for (k, param) in Parameter::ALL.iter().enumerate() {

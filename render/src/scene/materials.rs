@@ -89,11 +89,6 @@ impl Loader<'_> {
                     let mut knobs = self.skin_knobs(knobs, &key, *phase_g, surface.as_deref())?;
                     knobs.fidelity.smallest_footprint_mm =
                         footprints_mm.get(index).copied().flatten();
-                    let skin =
-                        SkinMaterial::build(params, m_rough, tex, &knobs).map_err(|e| match e {
-                            SkinBuildError::Surface(e) => rough_err(e),
-                            other => self.err(&key, other.to_string()),
-                        })?;
                     let map_keys = MapKeys {
                         maps,
                         fit_maps,
@@ -108,7 +103,26 @@ impl Loader<'_> {
                         map_profile_error,
                         thin_epidermis: (thin_epidermis, thin_epidermis_mm),
                     };
-                    let skin = self.skin_with_maps(&key, skin, &map_keys, &knobs)?;
+                    let maps = self.chromophore_maps(&key, &params, &map_keys)?;
+                    // With maps, the scalar skin is the maps' typical skin
+                    // (`ChromophoreMaps::typical`), not the material's default.
+                    let params = match &maps {
+                        Some(m) => {
+                            let [c_m, beta_m, c_h] = m.typical().map(f64::from);
+                            params
+                                .with_melanin(c_m)
+                                .and_then(|p| p.with_eumelanin_blend(beta_m))
+                                .and_then(|p| p.with_hemoglobin(c_h.max(f64::MIN_POSITIVE)))
+                                .map_err(|e| self.err(&key, e.to_string()))?
+                        }
+                        None => params,
+                    };
+                    let skin =
+                        SkinMaterial::build(params, m_rough, tex, &knobs).map_err(|e| match e {
+                            SkinBuildError::Surface(e) => rough_err(e),
+                            other => self.err(&key, other.to_string()),
+                        })?;
+                    let skin = self.skin_with_maps(&key, skin, maps, &map_keys, &knobs)?;
                     Material::Skin(skin)
                 }
                 MaterialDesc::Diffuse {
