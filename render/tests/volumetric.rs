@@ -204,6 +204,59 @@ fn white_furnace_sphere_conserves_energy() {
     }
 }
 
+/// White furnace with light passing from one body into another: two 2-mm spheres of
+/// non-absorbing skin 0.2 mm apart under a sky of radiance 1, seen across their gap, where much of
+/// the light leaving one sphere enters the other. However many stretches of skin a path walks, it
+/// leaves with weight 1, so the image is 1 (3σ, plus 1e-4 for f32 rounding; paths cut at the
+/// 16-bounce limit are below 1e-4 of the light). Cut after two walks (`max_depth` 3) the image
+/// lies between the image cut after one walk (`max_depth` 2: every term is positive) and 1 (the
+/// whole sum), and the one-walk image is more than 5σ below 1, so the pair does pass light through
+/// a second walk: the hero wavelength takes the other lanes' shares once per path, and scaling
+/// them again at the second walk would lift the two-walk image above the sky.
+#[test]
+fn white_furnace_sphere_pair_conserves_energy_across_walks() {
+    let text = "[camera]\nposition_mm = [0, 0, 30]\nlook_at_mm = [0, 0, 0]\nfov_deg = 4\n\
+                [environment]\nspectral_radiance = 1\n\
+                [materials.skin]\ntype = \"skin\"\nsurface = \"smooth\"\n\
+                [[meshes]]\nshape = \"sphere\"\nmaterial = \"skin\"\nunits_mm = 2\n\
+                translate_mm = [-2.1, 0, 0]\n\
+                [[meshes]]\nshape = \"sphere\"\nmaterial = \"skin\"\nunits_mm = 2\n\
+                translate_mm = [2.1, 0, 0]\n";
+    let scene = Scene::from_toml(text, "pair.toml", None, &SkinKnobs::default()).unwrap();
+    let body = constant_body(&scene, [0.0, 20.0], [0.0, 10.0]);
+    let render_cut = |max_depth: u32| {
+        let mut opts = RenderOptions {
+            width: 6,
+            height: 6,
+            spp: 200,
+            seed: 7,
+            wavelength_nm: Some(NM),
+            ..Default::default()
+        };
+        opts.path.max_depth = max_depth;
+        let film = render_with(&scene, &body, &opts.validate().unwrap(), None)
+            .unwrap()
+            .0;
+        mean_and_sigma(&film)
+    };
+    let (one, s1) = render_cut(2);
+    let (two, s2) = render_cut(3);
+    let (all, s) = render_cut(16);
+    eprintln!("pair: one walk {one} ± {s1}, two {two} ± {s2}, all {all} ± {s}");
+    assert!(
+        one < 1.0 - 5.0 * s1,
+        "one walk per path {one} ± {s1}: the pair must pass light between its spheres"
+    );
+    assert!(
+        two >= one - 3.0 * s1.hypot(s2) && two <= 1.0 + 3.0 * s2 + 1e-4,
+        "two walks per path {two} ± {s2}: between one walk's {one} ± {s1} and 1"
+    );
+    assert!(
+        (all - 1.0).abs() <= 3.0 * s + 1e-4,
+        "furnace pair {all} ± {s}"
+    );
+}
+
 /// Exact Fresnel reflectance of a dielectric of index 1.4 at incidence cosine `c`.
 fn fresnel(c: f64) -> f64 {
     brdf::fresnel::dielectric_reflectance(c, 1.4)

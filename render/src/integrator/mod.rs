@@ -230,6 +230,9 @@ struct Path {
     travelled_mm: f32,
     depth: u32,
     n_lights: usize,
+    /// Whether a walk has already kept the hero wavelength alone (its lane then carries all N
+    /// shares, so a later walk on the same path must not scale it again).
+    hero_alone: bool,
 }
 
 impl Path {
@@ -292,6 +295,7 @@ impl PathTracer<'_> {
             travelled_mm: 0.0,
             depth: 0,
             n_lights,
+            hero_alone: false,
         };
         for depth in 0..self.settings.max_depth {
             path.depth = depth;

@@ -46,7 +46,15 @@ impl PathTracer<'_> {
         let Some(exit) = walk.exit else {
             return Step::Stop;
         };
-        let beta_exit = volumetric::hero_only(path.beta) * (exit.weight * t_o);
+        // The hero takes the other lanes' shares once per path: a second walk (light that left
+        // one stretch of skin and entered another) finds them already ended.
+        let beta_hero = if path.hero_alone {
+            path.beta
+        } else {
+            path.hero_alone = true;
+            volumetric::hero_only(path.beta)
+        };
+        let beta_exit = beta_hero * (exit.weight * t_o);
         let thin = matches!(self.body, BodyIntegrator::Bssrdf(_));
         if thin && self.settings.thin_exit == ThinExit::LightSampled {
             // The walk chose to leave here (with probability T(θ) at its own direction): its
