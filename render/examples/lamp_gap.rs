@@ -44,7 +44,10 @@ fn main() -> anyhow::Result<()> {
         "oily" => String::new(),
         s => format!("surface = \"{s}\"\n"),
     };
-    let knobs = SkinKnobs::default();
+    let knobs = SkinKnobs {
+        azimuth: Azimuth::Harmonics,
+        ..SkinKnobs::default()
+    };
     let dir = tempfile::tempdir()?;
     let obj = dir.path().join("box.obj");
     // SPHERE=R: an icosphere of radius R mm with its top where the box's is (z = 10 mm).
@@ -76,13 +79,23 @@ fn main() -> anyhow::Result<()> {
                 d * t.sin() * p.sin(),
                 10.0 + d * t.cos(),
             ];
+            // CAM_DEG: the camera's angle from the normal (default 45°), its field narrowed
+            // with the cosine so that the frame stays on the box.
+            let cam = std::env::var("CAM_DEG")
+                .ok()
+                .and_then(|s| s.parse::<f32>().ok())
+                .unwrap_or(45.0)
+                .to_radians();
+            let fov = 5.0 * cam.cos() / std::f32::consts::FRAC_1_SQRT_2;
             let toml = format!(
-                "[camera]\nposition_mm = [212, 0, 222]\nlook_at_mm = [0, 0, 10]\nfov_deg = 5\n\
+                "[camera]\nposition_mm = [{}, 0, {}]\nlook_at_mm = [0, 0, 10]\nfov_deg = {fov}\n\
                  [environment]\nspectrum = \"d65\"\nintensity = 0.005\n\
                  [materials.skin]\ntype = \"skin\"\npreset = \"{preset}\"\n{surface_key}\
                  [[meshes]]\nfile = \"{}\"\nmaterial = \"skin\"\n{place}[[lights]]\ntype = \"sphere\"\n\
                  center_mm = [{}, {}, {}]\nradius_mm = 25\nspectrum = \"blackbody\"\n\
                  temperature_k = 5000\nintensity = 400\n",
+                300.0 * cam.sin(),
+                10.0 + 300.0 * cam.cos(),
                 obj.display(),
                 lamp[0],
                 lamp[1],
@@ -144,7 +157,37 @@ fn ear(side: usize, spp: u32, ref_spp: u32) -> anyhow::Result<()> {
         })
         .collect::<Vec<_>>()
         .join("\n");
-    let knobs = SkinKnobs::default();
+    // LAMP_SCALE=k: the back light's radius × k and its luminance ÷ k² (the same power; the
+    // walk's refracted exits find it k² times as often).
+    let k: f32 = std::env::var("LAMP_SCALE")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(1.0);
+    let toml = if k == 1.0 {
+        toml
+    } else {
+        let mut back = false;
+        toml.lines()
+            .map(|l| {
+                if l.starts_with("center_mm = [-110, 60, -220]") {
+                    back = true;
+                }
+                match l.trim() {
+                    "radius_mm = 25" if back => format!("radius_mm = {}", 25.0 * k),
+                    "intensity = 400" if back => {
+                        back = false;
+                        format!("intensity = {}", 400.0 / (k * k))
+                    }
+                    _ => l.to_string(),
+                }
+            })
+            .collect::<Vec<_>>()
+            .join("\n")
+    };
+    let knobs = SkinKnobs {
+        azimuth: Azimuth::Harmonics,
+        ..SkinKnobs::default()
+    };
     let separable = SkinKnobs {
         azimuth: Azimuth::Separable,
         ..SkinKnobs::default()
@@ -328,7 +371,18 @@ fn pixels(
     nm: Option<f32>,
 ) -> anyhow::Result<(Vec<(f64, f64)>, f64)> {
     let body = BodyIntegrator::build(scene, kind);
+    // DEPTH=n: paths of at most n surface hits under the BSSRDF, n + 1 under the walk (whose
+    // exit finds the lamp one ray later): DEPTH=1 keeps the light that reaches the camera
+    // through one stretch of skin from a light or the sky, and nothing that bounced before.
+    let mut path = render::integrator::PathSettings::default();
+    if let Some(n) = std::env::var("DEPTH")
+        .ok()
+        .and_then(|s| s.parse::<u32>().ok())
+    {
+        path.max_depth = n + u32::from(kind == IntegratorKind::Volumetric);
+    }
     let opts = RenderOptions {
+        path,
         width: side,
         height: side,
         spp,
