@@ -7,8 +7,10 @@
 //!
 //! `cargo run --release -p render --features studies --example lamp_gap -- SIDE SPP REF_SPP
 //! [THETA_DEG,...] [PHI_DEG,...]`; environment: `SURFACE` (`smooth` (default) or `oily`), `NM` (one
-//! wavelength, nm; default the full spectrum), `PRESET` (default `light`), `LOBE` (the
-//! subsurface's forward lobe: `off` for the separable form alone).
+//! wavelength, nm; default the full spectrum), `PRESET` (default `light`), `CAM_DEG` (the camera's
+//! angle from the normal, default 45), `DEPTH` (paths of at most that many surface hits; the walk
+//! one more), `LAMP_SCALE` (`ear`: the back light's radius × k, luminance ÷ k²). "Lobe" is
+//! `Azimuth::Harmonics`, "separable" the default.
 
 use render::bssrdf::Azimuth;
 use render::integrator::{BodyIntegrator, IntegratorKind};
