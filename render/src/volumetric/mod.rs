@@ -187,7 +187,8 @@ impl Volumetric {
 
 /// The throughput kept by a walk traced at the hero wavelength alone: the other lanes end (0) and
 /// the hero carries all N shares, which keeps the spectral estimate unbiased (the same as
-/// `SampledWavelengths::terminate_secondary` for the film's estimator).
+/// `SampledWavelengths::terminate_secondary` for the film's estimator). Once per path: a later
+/// walk on the same path keeps the hero's throughput as it is (docs/physics.md §15.2).
 #[must_use]
 pub fn hero_only(beta: SampledSpectrum) -> SampledSpectrum {
     let mut out = SampledSpectrum::zero();
