@@ -324,6 +324,10 @@ pub enum MaterialDesc {
         /// Offset o of the melanin edit (default 0).
         #[serde(default, deserialize_with = "opt_finite_f64")]
         melanin_offset: Option<f64>,
+        /// ITA° of the maps' typical skin (docs/physics.md §19), [−90, 90]: the melanin offset
+        /// that brings it there is solved at load, instead of `melanin_offset`.
+        #[serde(default, deserialize_with = "opt_finite_f64")]
+        melanin_ita_deg: Option<f64>,
         /// Scale of the hemoglobin edit (default 1).
         #[serde(default, deserialize_with = "opt_finite_f64")]
         hemoglobin_scale: Option<f64>,

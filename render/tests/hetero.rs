@@ -349,3 +349,54 @@ fn fit_maps_fits_the_albedo_texture() {
         );
     }
 }
+
+/// `melanin_ita_deg` shifts every texel's melanin by the one offset that gives the maps' typical
+/// skin (each parameter's median over the texels) that ITA°: on a map of C_m 0.01–0.04 asked for
+/// −34°, the material's skin reads −34° in the exact model's colour within 0.01° (its C_m is
+/// stored in f32), and its C_m is the median texel's plus the offset, so the offset moved it
+/// (the unshifted median, 0.03, reads far lighter). The key's errors name it: beside
+/// `melanin_offset`, outside [−90, 90], beyond what leaves every texel in [0, 1], without a map.
+#[test]
+fn melanin_ita_deg_gives_the_typical_skin_that_ita() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(
+        d.join("m.exr"),
+        exr_bytes(4, 1, vec![("melanin", vec![0.01, 0.04, 0.02, 0.03])]),
+    )
+    .unwrap();
+    let scene = strip_scene(d, 1.0, 4, "melanin_map = \"m.exr\"\nmelanin_ita_deg = -34");
+    let render::material::Material::Skin(skin) = &scene.materials[0] else {
+        panic!("a skin");
+    };
+    let model = skin_fit::ColourModel::new(10.0, multipole::Method::Exact, skin.params).unwrap();
+    let ita = |p: &SkinParams| model.lab(p).unwrap().ita_deg();
+    assert!(
+        (ita(&skin.params) + 34.0).abs() < 0.01,
+        "{}",
+        ita(&skin.params)
+    );
+    let unshifted = skin.params.with_melanin(0.03).unwrap();
+    assert!(ita(&unshifted) > 0.0, "{}", ita(&unshifted));
+    for (keys, want) in [
+        (
+            "melanin_map = \"m.exr\"\nmelanin_offset = 0.1\nmelanin_ita_deg = 0",
+            "not both",
+        ),
+        (
+            "melanin_map = \"m.exr\"\nmelanin_ita_deg = 95",
+            "outside [-90, 90]",
+        ),
+        (
+            "melanin_map = \"m.exr\"\nmelanin_ita_deg = 89",
+            "reaches with every texel",
+        ),
+        ("melanin_ita_deg = 0", "need a map"),
+    ] {
+        let (_, m) = load_error(d, keys);
+        assert!(
+            m.contains("materials.skin") && m.contains("melanin_ita_deg") && m.contains(want),
+            "{keys}: {m}"
+        );
+    }
+}

@@ -29,6 +29,8 @@ pub(super) struct MapKeys<'a> {
     pub per_parameter: [&'a Option<String>; 3],
     /// (scale, offset) of melanin, then of hemoglobin.
     pub edits: [(&'a Option<f64>, &'a Option<f64>); 2],
+    /// `melanin_ita_deg`: the ITA° the melanin offset brings the typical skin to.
+    pub melanin_ita_deg: &'a Option<f64>,
     pub edit_mask: &'a Option<String>,
     pub profile_blend: &'a Option<String>,
     pub map_profile_error: &'a Option<f32>,
@@ -46,14 +48,15 @@ impl Loader<'_> {
         keys: &MapKeys<'_>,
         knobs: &SkinKnobs,
     ) -> Result<SkinMaterial, RenderError> {
-        let edited = keys.edits.iter().any(|(s, o)| s.is_some() || o.is_some());
+        let edited = keys.edits.iter().any(|(s, o)| s.is_some() || o.is_some())
+            || keys.melanin_ita_deg.is_some();
         let Some(maps) = maps else {
             let thin = keys.thin_epidermis.0.is_some() || keys.thin_epidermis.1.is_some();
             if edited || keys.profile_blend.is_some() || keys.map_profile_error.is_some() || thin {
                 return Err(self.err(
                     key,
-                    "the edits, profile_blend, map_profile_error, thin_epidermis and \
-                     thin_epidermis_mm need a map (maps, fit_maps, melanin_map, eumelanin_map, \
+                    "the edits, melanin_ita_deg, profile_blend, map_profile_error, \
+                     thin_epidermis and thin_epidermis_mm need a map (maps, fit_maps, melanin_map, eumelanin_map, \
                      hemoglobin_map or edit_mask)",
                 ));
             }
@@ -222,7 +225,7 @@ impl Loader<'_> {
             scale: scale.unwrap_or(1.0),
             offset: offset.unwrap_or(0.0),
         };
-        ChromophoreMaps::assemble(MapInputs {
+        let mut inputs = MapInputs {
             material_key: key.to_string(),
             sources,
             edits: [
@@ -231,6 +234,70 @@ impl Loader<'_> {
             ],
             mask,
             thin,
-        })
+        };
+        if let Some(target) = *keys.melanin_ita_deg {
+            let ita_key = format!("{key}.melanin_ita_deg");
+            if keys.edits[0].1.is_some() {
+                return Err(self.err(ita_key, "give melanin_offset or melanin_ita_deg, not both"));
+            }
+            if inputs.mask.is_some() {
+                return Err(self.err(
+                    ita_key,
+                    "an edit_mask shifts texels by different amounts, so no one offset sets the \
+                     typical skin's ITA°: give melanin_offset with the mask",
+                ));
+            }
+            let unshifted = ChromophoreMaps::assemble(inputs.clone())?;
+            if let Some(maps) = unshifted {
+                let offset =
+                    offset_for_ita(params, &maps, target).map_err(|e| self.err(&ita_key, e))?;
+                inputs.edits[0].1.offset = offset;
+            }
+        }
+        ChromophoreMaps::assemble(inputs)
     }
+}
+
+/// The melanin offset o that gives the typical skin of `maps` (on `params`' other constants)
+/// the ITA° `target_deg` ([`skin_optics::lab::Lab::ita_deg`], the exact model's colour under
+/// D65 every 10 nm): without a mask every texel moves by o, and so does the median C_m, so o is
+/// C_m* − C_m,typical, where C_m* solves ITA°(C_m*) = target by bisection (ITA° falls as C_m
+/// rises). o is kept within what leaves every texel in [0, 1]; a target beyond that range is an
+/// error naming the reachable ITA°.
+fn offset_for_ita(
+    params: &SkinParams,
+    maps: &ChromophoreMaps,
+    target_deg: f64,
+) -> Result<f64, String> {
+    if !(-90.0..=90.0).contains(&target_deg) {
+        return Err(format!("{target_deg} outside [-90, 90] degrees"));
+    }
+    let [c_m, beta_m, c_h] = maps.typical().map(f64::from);
+    let [lo, hi] = maps.range()[0].map(f64::from);
+    let model = skin_fit::ColourModel::new(10.0, multipole::Method::Exact, *params)
+        .map_err(|e| e.to_string())?;
+    let ita = |melanin: f64| -> Result<f64, String> {
+        let skin = model
+            .skin(melanin, beta_m, c_h.max(f64::MIN_POSITIVE))
+            .map_err(|e| e.to_string())?;
+        Ok(model.lab(&skin).map_err(|e| e.to_string())?.ita_deg())
+    };
+    // The typical C_m can move from c_m − lo (the lightest texel at 0) to c_m + 1 − hi.
+    let (mut a, mut b) = (c_m - lo, c_m + 1.0 - hi);
+    let (ita_a, ita_b) = (ita(a)?, ita(b)?);
+    if !(ita_b..=ita_a).contains(&target_deg) {
+        return Err(format!(
+            "{target_deg} outside the ITA° the maps' typical skin reaches with every texel in \
+             [0, 1]: [{ita_b:.1}, {ita_a:.1}]"
+        ));
+    }
+    for _ in 0..40 {
+        let mid = 0.5 * (a + b);
+        if ita(mid)? > target_deg {
+            a = mid;
+        } else {
+            b = mid;
+        }
+    }
+    Ok(0.5 * (a + b) - c_m)
 }
