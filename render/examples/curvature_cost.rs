@@ -1,5 +1,5 @@
 //! The curvature term's cost and noise on the default three-head scene (docs/physics.md §8.2):
-//! renders `builtin:three-heads` at fixed samples with `Curvature::Planar` and the default
+//! renders `builtin:three-heads-uniform` at fixed samples with `Curvature::Planar` and the default
 //! `Curvature::FirstOrder`, seeds 1 and 2 each, one thread, interleaved so both see the same
 //! machine load; prints each variant's CPU seconds (the two renders), the two-seed relative
 //! luminance noise over the lit pixels (`render::noise`) and noise · √CPU-s (lower is better).
@@ -25,7 +25,7 @@ fn main() {
                 curvature,
                 ..SkinKnobs::default()
             };
-            let scene = Scene::load("builtin:three-heads", &knobs).unwrap();
+            let scene = Scene::load("builtin:three-heads-uniform", &knobs).unwrap();
             let body = BodyIntegrator::build(&scene, IntegratorKind::Bssrdf);
             (scene, body)
         })

@@ -5,18 +5,21 @@
 /// Prefix that names a built-in asset or scene instead of a file.
 pub const PREFIX: &str = "builtin:";
 
-/// The default scene: the head three times (light, medium, dark skin), key, fill and rim lights.
+/// The default scene: the head three times with per-texel skin (chromophore maps fitted at load
+/// to the head's texture; the second and third head's melanin shifted to tan and dark skin), key,
+/// fill and rim lights.
 pub const THREE_HEADS: &str = include_str!("../assets/scenes/three_heads.toml");
+
+/// The default scene's heads with uniform skin: one chromophore set per head (measured light, tan
+/// and dark cheeks), the texture scaling its brightness.
+pub const THREE_HEADS_UNIFORM: &str = include_str!("../assets/scenes/three_heads_uniform.toml");
+
 /// A close-up of one ear lit from behind (for transmitted light through thin skin).
 pub const EAR: &str = include_str!("../assets/scenes/ear.toml");
 
 /// Fifteen small heads (about 40 pixels tall at 768×384) seen from 10 m: where the level of
 /// detail has most to gain.
 pub const THREE_HEADS_FAR: &str = include_str!("../assets/scenes/three_heads_far.toml");
-
-/// The default scene's heads with chromophore maps fitted at load to the head's texture, the
-/// melanin shifted to medium and dark skin on the second and third head.
-pub const THREE_HEADS_MAPS: &str = include_str!("../assets/scenes/three_heads_maps.toml");
 
 /// A close-up of one face with chromophore maps fitted at load (lips, cheeks, stubble).
 pub const FACE_MAPS: &str = include_str!("../assets/scenes/face_maps.toml");
@@ -27,9 +30,9 @@ pub const FACE: &str = include_str!("../assets/scenes/face.toml");
 /// Built-in scene names, the first is the default.
 pub const SCENES: [&str; 6] = [
     "three-heads",
+    "three-heads-uniform",
     "ear",
     "three-heads-far",
-    "three-heads-maps",
     "face-maps",
     "face",
 ];
@@ -38,10 +41,11 @@ pub const SCENES: [&str; 6] = [
 #[must_use]
 pub fn scene(name: &str) -> Option<&'static str> {
     match name {
-        "three-heads" => Some(THREE_HEADS),
+        // `three-heads-maps` is the default scene's earlier name, which scene files may still use.
+        "three-heads" | "three-heads-maps" => Some(THREE_HEADS),
+        "three-heads-uniform" => Some(THREE_HEADS_UNIFORM),
         "ear" => Some(EAR),
         "three-heads-far" => Some(THREE_HEADS_FAR),
-        "three-heads-maps" => Some(THREE_HEADS_MAPS),
         "face-maps" => Some(FACE_MAPS),
         "face" => Some(FACE),
         _ => None,

@@ -18,8 +18,9 @@ use std::time::{Duration, Instant};
 /// Arguments of `skin render`.
 #[derive(Args, Debug, Clone)]
 pub struct RenderArgs {
-    /// Scene file (TOML), or a built-in scene: builtin:three-heads (default), builtin:ear,
-    /// builtin:three-heads-far, builtin:three-heads-maps, builtin:face-maps, builtin:face.
+    /// Scene file (TOML), or a built-in scene: builtin:three-heads (default, per-texel skin),
+    /// builtin:three-heads-uniform, builtin:ear, builtin:three-heads-far, builtin:face-maps,
+    /// builtin:face.
     #[arg(long, value_name = "FILE", default_value = "builtin:three-heads")]
     pub scene: String,
     /// Output folder for render.exr and render.png.

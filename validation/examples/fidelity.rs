@@ -23,7 +23,7 @@
 //! level of detail uses, docs/physics.md §16.3), and the
 //! ratio of the pixel footprint at the skin's mean camera distance to each.
 //!
-//! The default scene (`builtin:three-heads`, three cells, one head each) at SPP_DEFAULT: full,
+//! The default scene's uniform heads (`builtin:three-heads-uniform`, three cells, one head each) at SPP_DEFAULT: full,
 //! auto, and auto with the 500,000-photon shape table (SPP_DEFAULT 0 skips it).
 //!
 //! `cargo run --release -p render --features studies --example fidelity -- [OUT] [SPP_FAR] [SPP_EAR] [NOISE] [MAX_SPP]
@@ -360,7 +360,12 @@ fn main() {
             far_configs(spp_far, noise, max_spp),
         ),
         ("builtin:ear", 1, 1, ear_configs(spp_ear)),
-        ("builtin:three-heads", 3, 1, default_configs(spp_default)),
+        (
+            "builtin:three-heads-uniform",
+            3,
+            1,
+            default_configs(spp_default),
+        ),
     ]
     .into_iter()
     .filter(|(_, _, _, c)| c.iter().all(|c| c.spp > 0))

@@ -1,6 +1,6 @@
 //! The built-in head's lips before and after the renderer reads the thin epidermis of their texels
 //! (docs/physics.md §19): one head with its maps fitted at load (`fit_maps = "auto-rgb"`, as
-//! `builtin:three-heads-maps`), under a uniform D65 sky of luminance 1 (a white diffuser renders as
+//! `builtin:three-heads`), under a uniform D65 sky of luminance 1 (a white diffuser renders as
 //! linear sRGB (1, 1, 1)), seen close up along the lips' mean normal. Renders with
 //! `thin_epidermis = false` (every texel under the material's 0.25 mm epidermis: the renderer
 //! before) and with the flag read (0.05 mm under the lips), with the default integrator. The lip

@@ -20,7 +20,7 @@ fn main() -> anyhow::Result<()> {
     let spp: u32 = args.get(1).map_or(Ok(32), |s| s.parse())?;
     let seed: u64 = args.get(2).map_or(Ok(1), |s| s.parse())?;
     let (w, h) = (768, 384);
-    let scene = Scene::load("builtin:three-heads", &SkinKnobs::default())?;
+    let scene = Scene::load("builtin:three-heads-uniform", &SkinKnobs::default())?;
     let skin = Passes::first_hit(&scene, w, h).skin;
     let settings = RenderOptions {
         width: w,

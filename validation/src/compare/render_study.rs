@@ -258,7 +258,7 @@ fn builtin_cases(side: usize) -> Vec<Case> {
     cases.push(Case {
         name: "head, default lights".into(),
         tone: "all three",
-        toml: untextured(render::builtin::THREE_HEADS),
+        toml: untextured(render::builtin::THREE_HEADS_UNIFORM),
         width: 4 * side,
         height: 2 * side,
         builtin: true,
