@@ -484,14 +484,7 @@ fn thin_epidermis_texels_carry_their_thickness() {
         .arg(out.join("maps.exr"))
         .arg("--out")
         .arg(&mtlx)
-        .args([
-            "--escapes",
-            "500",
-            "--volume-photons",
-            "2000",
-            "--step",
-            "20",
-        ])
+        .args(crate::common::QUICK_EXPORT)
         .env("SKIN_CACHE_DIR", cache_dir())
         .output()
         .unwrap();

@@ -923,19 +923,10 @@ fn maps_become_texture_images_beside_the_document() {
     let texels: Vec<[f32; 3]> = (0..8).map(|k| if k % 2 == 0 { a } else { b }).collect();
     write_maps_exr(&maps, 4, 2, &texels, "");
     let out = tmp.path().join("mat").join("skin.mtlx");
-    let quick = [
-        "--escapes",
-        "500",
-        "--volume-photons",
-        "2000",
-        "--step",
-        "20",
-        "--texture-nodes",
-        "3",
-    ];
     let mut args = vec!["export", "openpbr", "--maps", maps.to_str().unwrap()];
     args.extend(["--out", out.to_str().unwrap()]);
-    args.extend(quick);
+    args.extend(crate::common::QUICK_EXPORT);
+    args.extend(["--texture-nodes", "3"]);
     let (ok, stderr) = skin_cmd(&args);
     assert!(ok, "{stderr}");
     let text = std::fs::read_to_string(&out).unwrap();
