@@ -1,14 +1,18 @@
 //! The disk cache of built tables (docs/physics.md §16.5). An entry is one file in [`cache_dir`]
-//! (`$SKIN_CACHE_DIR`, else `$XDG_CACHE_HOME/skin`, else `~/.cache/skin`) named by a hash of its key, the text of everything the tables depend on (the
-//! skin's parameters, the method, every knob and [`CACHE_VERSION`]). The file holds a header line
-//! (format, body length, checksum), the key and the body (JSON, which writes every f32 so that it
-//! reads back to the same bits). An entry is used only when the key is the one asked for, the
-//! length is whole and the checksum matches; otherwise it is rebuilt and rewritten. Files are
-//! written through `crate::atomic`, so a reader never sees half of one.
+//! (`$SKIN_CACHE_DIR`, else `$XDG_CACHE_HOME/skin`, else `~/.cache/skin`) named by a hash of its
+//! key, the text of everything the tables depend on (the skin's parameters, the method, every
+//! knob and the versions of what builds them). The file holds a header line (format, body length,
+//! CRC-32 of key and body), the key and the body ([postcard], which keeps every f32 as its four
+//! bytes, so it reads back to the same bits). An entry is used only when the key is the one asked
+//! for, the length is whole, the checksum matches and the body decodes to its last byte;
+//! otherwise it is rebuilt and rewritten. Files are written through `crate::atomic`, so a reader
+//! never sees half of one.
 //!
 //! The folder is bounded: after each write the entries beyond [`DEFAULT_MAX_BYTES`] (or
 //! `$SKIN_CACHE_MAX_MIB` MiB) are removed, least recently used first (a hit refreshes its file's
-//! modification time), never the entry just written and never a file that is not an entry.
+//! modification time), never the entry just written and never a file that is not an entry. An
+//! entry of the former JSON format (`.json`, [`CACHE_VERSION`] 2) counts as an entry: it is
+//! removed when its key is rewritten, and otherwise ages out as the least recently used.
 
 use serde::Serialize;
 use serde::de::DeserializeOwned;
@@ -16,7 +20,7 @@ use std::path::{Path, PathBuf};
 
 /// Version of an entry's file format (header, key, body); what a key builds is versioned by the
 /// key itself.
-pub const CACHE_VERSION: u32 = 2;
+pub const CACHE_VERSION: u32 = 3;
 /// First word of an entry's header.
 const MAGIC: &str = "skin-tables";
 /// Largest total size of the entries in the folder, bytes (2 GiB; `$SKIN_CACHE_MAX_MIB`
@@ -26,6 +30,10 @@ const MAGIC: &str = "skin-tables";
 pub const DEFAULT_MAX_BYTES: u64 = 2 << 30;
 /// Prefix of an entry's file name.
 const PREFIX: &str = "skin-tables-";
+/// Suffix of an entry's file name.
+const SUFFIX: &str = ".bin";
+/// Suffix of an entry of the former JSON format.
+const LEGACY_SUFFIX: &str = ".json";
 
 /// Where cached tables are kept between runs: `$SKIN_CACHE_DIR`, else `$XDG_CACHE_HOME/skin`,
 /// else `$HOME/.cache/skin`; `None` when none is set (tables then live only in memory).
@@ -91,8 +99,8 @@ impl std::fmt::Display for CacheOutcome {
     }
 }
 
-/// 64-bit FNV-1a of `bytes` (the checksum and the file name's hash; not cryptographic: the key
-/// stored in the file decides, the hash only finds it).
+/// 64-bit FNV-1a of `bytes` (the file name's hash; not cryptographic: the key stored in the file
+/// decides, the hash only finds it).
 #[must_use]
 pub fn fnv1a(bytes: &[u8]) -> u64 {
     bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
@@ -100,16 +108,28 @@ pub fn fnv1a(bytes: &[u8]) -> u64 {
     })
 }
 
+/// The CRC-32 (IEEE) of `bytes`: an entry's checksum. It detects every burst error up to 32 bits,
+/// and `crc32fast` folds 64 bytes a step with carry-less multiplies, where FNV-1a waits on one
+/// multiply per byte: a skin with chromophore maps reads hundreds of MiB of entries per load.
+#[must_use]
+pub fn checksum(bytes: &[u8]) -> u32 {
+    crc32fast::hash(bytes)
+}
+
 /// The file of `key` in `dir`.
 #[must_use]
 pub fn entry_path(dir: &Path, key: &str) -> PathBuf {
-    dir.join(format!("{PREFIX}{:016x}.json", fnv1a(key.as_bytes())))
+    dir.join(format!("{PREFIX}{:016x}{SUFFIX}", fnv1a(key.as_bytes())))
 }
 
-/// Whether `name` is the name of an entry (`skin-tables-` + 16 hex digits + `.json`).
+/// Whether `name` is the name of an entry (`skin-tables-` + 16 hex digits + `.bin`, or `.json`
+/// for the former format).
 fn is_entry_name(name: &str) -> bool {
     name.strip_prefix(PREFIX)
-        .and_then(|rest| rest.strip_suffix(".json"))
+        .and_then(|rest| {
+            rest.strip_suffix(SUFFIX)
+                .or_else(|| rest.strip_suffix(LEGACY_SUFFIX))
+        })
         .is_some_and(|hex| hex.len() == 16 && hex.bytes().all(|b| b.is_ascii_hexdigit()))
 }
 
@@ -150,9 +170,9 @@ fn encode(key: &str, body: &[u8]) -> Vec<u8> {
     checked.push(b'\n');
     checked.extend_from_slice(body);
     let header = format!(
-        "{MAGIC} v{CACHE_VERSION} {} {:016x}\n",
+        "{MAGIC} v{CACHE_VERSION} {} {:08x}\n",
         body.len(),
-        fnv1a(&checked)
+        checksum(&checked)
     );
     let mut out = header.into_bytes();
     out.extend_from_slice(&checked);
@@ -161,7 +181,12 @@ fn encode(key: &str, body: &[u8]) -> Vec<u8> {
 
 /// The value stored in `bytes` for `key`, or why it is not trusted.
 fn decode<T: DeserializeOwned>(bytes: &[u8], key: &str) -> Result<T, &'static str> {
-    let nl = bytes.iter().position(|&b| b == b'\n').ok_or("no header")?;
+    // The header is short: look for its end in its first bytes only, not through a binary body.
+    let nl = bytes
+        .iter()
+        .take(128)
+        .position(|&b| b == b'\n')
+        .ok_or("no header")?;
     let header = std::str::from_utf8(&bytes[..nl]).map_err(|_| "bad header")?;
     let fields: Vec<&str> = header.split(' ').collect();
     let [magic, version, len, sum] = fields[..] else {
@@ -171,18 +196,21 @@ fn decode<T: DeserializeOwned>(bytes: &[u8], key: &str) -> Result<T, &'static st
         return Err("other format version");
     }
     let len: usize = len.parse().map_err(|_| "bad header")?;
-    let sum = u64::from_str_radix(sum, 16).map_err(|_| "bad header")?;
+    let sum = u32::from_str_radix(sum, 16).map_err(|_| "bad header")?;
     let checked = &bytes[nl + 1..];
     if checked.len() != key.len() + 1 + len {
         return Err("truncated or overlong");
     }
-    if fnv1a(checked) != sum {
+    if checksum(checked) != sum {
         return Err("checksum mismatch");
     }
     if &checked[..key.len()] != key.as_bytes() || checked[key.len()] != b'\n' {
         return Err("key mismatch");
     }
-    serde_json::from_slice(&checked[key.len() + 1..]).map_err(|_| "unreadable body")
+    match postcard::take_from_bytes(&checked[key.len() + 1..]) {
+        Ok((value, [])) => Ok(value),
+        _ => Err("unreadable body"),
+    }
 }
 
 /// The value of `key`: read from `dir` when a trusted entry is there, else built by `build` and
@@ -216,7 +244,9 @@ where
         Err(_) => None,
     };
     let value = build()?;
-    let stored = serde_json::to_vec(&value)
+    // The same key's entry in the former format is replaced by this one.
+    let _ = std::fs::remove_file(path.with_extension(&LEGACY_SUFFIX[1..]));
+    let stored = postcard::to_stdvec(&value)
         .map_err(|e| e.to_string())
         .and_then(|body| {
             crate::atomic::write_bytes(&path, &encode(key, &body)).map_err(|e| e.to_string())
@@ -262,11 +292,18 @@ mod tests {
         let mut flipped = good.clone();
         let last = flipped.len() - 3;
         flipped[last] ^= 0x01;
-        let cases: [(&str, Vec<u8>); 4] = [
+        let body = postcard::to_stdvec(&a).unwrap();
+        let mut overlong = body.clone();
+        overlong.push(0);
+        let older = String::from_utf8_lossy(&good).replacen(" v3 ", " v2 ", 1);
+        let cases: [(&str, Vec<u8>); 7] = [
             ("checksum mismatch", flipped),
             ("truncated or overlong", good[..good.len() - 5].to_vec()),
             ("no header", b"garbage".to_vec()),
-            ("key mismatch", encode("test kez", b"[1.0]")),
+            ("key mismatch", encode("test kez", &body)),
+            ("unreadable body", encode(key, &body[..body.len() - 1])),
+            ("unreadable body", encode(key, &overlong)),
+            ("other format version", older.into_bytes()),
         ];
         for (want, bytes) in cases {
             std::fs::write(&path, bytes).unwrap();
@@ -314,7 +351,26 @@ mod tests {
         put("e", 1);
         assert!(there("e") && !there("a") && !there("d"));
         assert!(stranger.exists(), "a file that is not an entry was removed");
+        assert!(is_entry_name("skin-tables-00112233445566ff.bin"));
         assert!(is_entry_name("skin-tables-00112233445566ff.json"));
-        assert!(!is_entry_name("skin-tables-0011.json") && !is_entry_name(".tmpXYZ"));
+        assert!(!is_entry_name("skin-tables-0011.bin") && !is_entry_name(".tmpXYZ"));
+    }
+
+    /// An entry of the former JSON format is replaced when its key is rewritten, and another
+    /// key's former entry counts against the limit (it is the least recently used).
+    #[test]
+    fn entries_of_the_former_format_are_replaced_and_evicted() {
+        let dir = tempfile::tempdir().unwrap();
+        let d = dir.path();
+        let calls = std::cell::Cell::new(0);
+        let legacy = |key: &str| entry_path(d, key).with_extension("json");
+        std::fs::write(legacy("a"), vec![b'x'; 100]).unwrap();
+        std::fs::write(legacy("b"), vec![b'x'; 100]).unwrap();
+        let (_, o) = load_or_build(Some(d), DEFAULT_MAX_BYTES, "a", || build(&calls)).unwrap();
+        assert!(matches!(o, CacheOutcome::Built(_)), "{o:?}");
+        assert!(!legacy("a").exists() && legacy("b").exists());
+        let size = std::fs::metadata(entry_path(d, "a")).unwrap().len();
+        load_or_build(Some(d), size, "c", || build(&calls)).unwrap();
+        assert!(!legacy("b").exists() && entry_path(d, "c").exists());
     }
 }
