@@ -244,22 +244,29 @@ where
         Err(_) => None,
     };
     let value = build()?;
-    // The same key's entry in the former format is replaced by this one.
-    let _ = std::fs::remove_file(path.with_extension(&LEGACY_SUFFIX[1..]));
-    let stored = postcard::to_stdvec(&value)
-        .map_err(|e| e.to_string())
-        .and_then(|body| {
-            crate::atomic::write_bytes(&path, &encode(key, &body)).map_err(|e| e.to_string())
-        });
-    if stored.is_ok() {
-        evict(dir, max_bytes, &path);
-    }
-    let outcome = match (stored, distrust) {
+    let outcome = match (store(dir, max_bytes, key, &value), distrust) {
         (Err(why), _) => CacheOutcome::Unwritten(path, why),
-        (Ok(()), Some(why)) => CacheOutcome::Rebuilt(path, why),
-        (Ok(()), None) => CacheOutcome::Built(path),
+        (Ok(path), Some(why)) => CacheOutcome::Rebuilt(path, why),
+        (Ok(path), None) => CacheOutcome::Built(path),
     };
     Ok((value, outcome))
+}
+
+/// Write `value` as the entry of `key` in `dir`, replacing any (and the same key's entry in the
+/// former format), then trim the folder to `max_bytes` ([`evict`]); the entry's file, or why it
+/// could not be written.
+pub fn store<T: Serialize>(
+    dir: &Path,
+    max_bytes: u64,
+    key: &str,
+    value: &T,
+) -> Result<PathBuf, String> {
+    let path = entry_path(dir, key);
+    let _ = std::fs::remove_file(path.with_extension(&LEGACY_SUFFIX[1..]));
+    let body = postcard::to_stdvec(value).map_err(|e| e.to_string())?;
+    crate::atomic::write_bytes(&path, &encode(key, &body)).map_err(|e| e.to_string())?;
+    evict(dir, max_bytes, &path);
+    Ok(path)
 }
 
 #[cfg(test)]

@@ -2,16 +2,26 @@
 //! over the box of parameters its maps use, each built as a scalar skin's table is
 //! ([`super::tables::skin_table`], through the disk cache), at a resolution chosen from the
 //! interpolation error measured against directly built tables at the cells' centres.
+//!
+//! The choice is kept in the disk cache too, as a small record (the node counts and the measured
+//! error) under a key of everything it depends on ([`super::key::grid_key`]): a load that finds
+//! the record reads only the chosen grid's tables, not the coarser grids' and the cells' centres'
+//! of the refinement. A record that is missing, not trusted or out of range is replaced by a new
+//! refinement's.
 
 use super::FidelityKnobs;
-use super::tables::skin_table;
+use super::key::grid_key;
+use super::tables::{cache_folder, first_table_key, skin_table};
 use crate::bssrdf::grid::{AXIS_KNEES, unwarp, warp};
 use crate::bssrdf::{Corners, ProfileGrid, ProfileTable};
 use crate::media::SkinMedia;
 use multipole::{Method, MultipoleError};
 use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use skin_io::cache::{self, CacheOutcome};
 use skin_optics::SkinParams;
 use std::collections::HashMap;
+use std::path::Path;
 use std::sync::{Arc, Mutex};
 
 /// Default target of the grid's interpolation error: the relative L1 error of the radial energy
@@ -57,12 +67,8 @@ pub struct GridSettings<'a> {
 type Memo = Mutex<HashMap<[u32; 3], Arc<ProfileTable>>>;
 
 impl GridSettings<'_> {
-    /// The table at parameters `p` = (C_m, β_m, C_h), built once.
-    fn table(&self, memo: &Memo, p: [f32; 3]) -> Result<Arc<ProfileTable>, MultipoleError> {
-        let key = p.map(f32::to_bits);
-        if let Some(t) = memo.lock().expect("no panics while held").get(&key) {
-            return Ok(t.clone());
-        }
+    /// The skin at parameters `p` = (C_m, β_m, C_h) and its layers.
+    fn node(&self, p: [f32; 3]) -> Result<(SkinParams, SkinMedia), MultipoleError> {
         let params = self
             .params
             .with_melanin(f64::from(p[0]))?
@@ -71,6 +77,16 @@ impl GridSettings<'_> {
         let media = SkinMedia::new(&params, self.phase_g)
             .map_err(|e| e.source)?
             .with_surface(self.surface);
+        Ok((params, media))
+    }
+
+    /// The table at parameters `p` = (C_m, β_m, C_h), built once.
+    fn table(&self, memo: &Memo, p: [f32; 3]) -> Result<Arc<ProfileTable>, MultipoleError> {
+        let key = p.map(f32::to_bits);
+        if let Some(t) = memo.lock().expect("no panics while held").get(&key) {
+            return Ok(t.clone());
+        }
+        let (params, media) = self.node(p)?;
         let (table, _) = skin_table(
             &params,
             &media,
@@ -84,6 +100,74 @@ impl GridSettings<'_> {
             .insert(key, table.clone());
         Ok(table)
     }
+
+    /// The key of the record of the grid over `range` ([`grid_key`]).
+    fn record_key(&self, range: [[f32; 2]; 3]) -> Result<String, MultipoleError> {
+        let (params, media) = self.node(range.map(|[lo, _]| lo))?;
+        let (node, photons) = first_table_key(
+            &params,
+            &media,
+            self.method,
+            self.shape_escapes,
+            self.fidelity,
+        )?;
+        let refinement: Vec<f64> = [
+            MAX_NODES_PER_AXIS as f64,
+            MAX_GRID_TABLES as f64,
+            MAX_PROBED_CELLS as f64,
+        ]
+        .into_iter()
+        .chain(AXIS_KNEES.map(|k| k.map_or(-1.0, f64::from)))
+        .chain(ERROR_NM.map(f64::from))
+        .collect();
+        Ok(grid_key(
+            &node,
+            photons,
+            self.shape_escapes,
+            range,
+            self.target,
+            &refinement,
+        ))
+    }
+}
+
+/// What the cache keeps of a grid: its node counts per axis and its measured error.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+struct GridRecord {
+    nodes: [u32; 3],
+    max_error: f32,
+}
+
+impl GridRecord {
+    /// The node counts when the refinement over `range` could have chosen them (1 on a
+    /// one-value axis, else 2^k + 1 up to [`MAX_NODES_PER_AXIS`], at most [`MAX_GRID_TABLES`]
+    /// in all) and the error is a number ≥ 0; else `None`.
+    fn nodes_within(&self, range: [[f32; 2]; 3]) -> Option<[usize; 3]> {
+        let nodes = self.nodes.map(|n| n as usize);
+        let fits = (0..3).all(|k| {
+            let n = nodes[k];
+            if range[k][1] > range[k][0] {
+                (2..=MAX_NODES_PER_AXIS).contains(&n) && (n - 1).is_power_of_two()
+            } else {
+                n == 1
+            }
+        });
+        (fits
+            && nodes.iter().product::<usize>() <= MAX_GRID_TABLES
+            && self.max_error >= 0.0
+            && self.max_error.is_finite())
+        .then_some(nodes)
+    }
+}
+
+/// How a grid was found: its record's cache outcome and how many distinct tables it took.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GridLoad {
+    /// The record: a hit reads only the grid's own tables; otherwise the refinement ran.
+    pub record: CacheOutcome,
+    /// Tables read or built: the grid's nodes, plus on a refinement the coarser grids' and the
+    /// probed cells' centres.
+    pub tables: usize,
 }
 
 /// The relative L1 error of `grid`'s interpolated 2πr R(r) against `direct`'s, on `direct`'s
@@ -114,38 +198,89 @@ pub fn interpolation_error(grid: &Corners<'_>, direct: &ProfileTable) -> f32 {
 /// The grid over `range` (per axis [lo, hi]; lo = hi gives one node): 2 nodes per varying axis,
 /// doubled in resolution until the error at the cells' centres is at most `settings.target`, an
 /// axis has [`MAX_NODES_PER_AXIS`] nodes or the next grid would hold more than
-/// [`MAX_GRID_TABLES`] tables.
+/// [`MAX_GRID_TABLES`] tables; the resolution chosen before with the same inputs is read from
+/// the disk cache ([`profile_grid_traced`]).
 pub fn profile_grid(
     settings: &GridSettings<'_>,
     range: [[f32; 2]; 3],
 ) -> Result<ProfileGrid, MultipoleError> {
+    profile_grid_traced(settings, range).map(|(grid, _)| grid)
+}
+
+/// [`profile_grid`] and how it was found: the record of its resolution is kept in the cache
+/// folder of the node tables (none under `--no-cache`).
+pub fn profile_grid_traced(
+    settings: &GridSettings<'_>,
+    range: [[f32; 2]; 3],
+) -> Result<(ProfileGrid, GridLoad), MultipoleError> {
+    let (dir, max_bytes) = cache_folder(settings.fidelity)?;
+    profile_grid_in(settings, range, dir.as_deref(), max_bytes)
+}
+
+/// [`profile_grid_traced`] with the record kept in `dir` (`None`: no record), the folder
+/// bounded to `max_bytes`.
+pub fn profile_grid_in(
+    settings: &GridSettings<'_>,
+    range: [[f32; 2]; 3],
+    dir: Option<&Path>,
+    max_bytes: u64,
+) -> Result<(ProfileGrid, GridLoad), MultipoleError> {
     let memo: Memo = Mutex::new(HashMap::new());
+    let Some(dir) = dir else {
+        let grid = refine(settings, range, &memo)?;
+        let tables = memo.lock().expect("no panics while held").len();
+        let record = CacheOutcome::Off;
+        return Ok((grid, GridLoad { record, tables }));
+    };
+    let key = settings.record_key(range)?;
+    let (record, outcome) = cache::load_or_build(Some(dir), max_bytes, &key, || {
+        refine(settings, range, &memo).map(|grid| GridRecord {
+            nodes: grid.axes().clone().map(|a| a.len() as u32),
+            max_error: grid.max_error,
+        })
+    })?;
+    let (grid, outcome) = match (record.nodes_within(range), outcome) {
+        (Some(nodes), outcome) => {
+            let axes = node_axes(range, nodes);
+            let tables = node_tables(settings, &memo, &axes)?;
+            (ProfileGrid::new(axes, tables, record.max_error), outcome)
+        }
+        (None, outcome) => {
+            let grid = refine(settings, range, &memo)?;
+            let record = GridRecord {
+                nodes: grid.axes().clone().map(|a| a.len() as u32),
+                max_error: grid.max_error,
+            };
+            let outcome = match (cache::store(dir, max_bytes, &key, &record), outcome) {
+                (Err(why), _) => CacheOutcome::Unwritten(cache::entry_path(dir, &key), why),
+                (Ok(path), CacheOutcome::Hit(_)) => {
+                    CacheOutcome::Rebuilt(path, "node counts out of range")
+                }
+                (Ok(_), other) => other,
+            };
+            (grid, outcome)
+        }
+    };
+    let tables = memo.lock().expect("no panics while held").len();
+    Ok((
+        grid,
+        GridLoad {
+            record: outcome,
+            tables,
+        },
+    ))
+}
+
+/// The refinement of [`profile_grid`], every table through `memo`.
+fn refine(
+    settings: &GridSettings<'_>,
+    range: [[f32; 2]; 3],
+    memo: &Memo,
+) -> Result<ProfileGrid, MultipoleError> {
     let mut nodes = range.map(|[lo, hi]| if hi > lo { 2 } else { 1 });
     loop {
-        let axes: [Vec<f32>; 3] = std::array::from_fn(|k| {
-            let [lo, hi] = range[k];
-            let n = nodes[k];
-            if n == 1 {
-                return vec![lo];
-            }
-            let (wl, wh) = (warp(AXIS_KNEES[k], lo), warp(AXIS_KNEES[k], hi));
-            (0..n)
-                .map(|i| match i {
-                    0 => lo,
-                    _ if i == n - 1 => hi,
-                    _ => unwarp(AXIS_KNEES[k], wl + (wh - wl) * i as f32 / (n - 1) as f32)
-                        .clamp(lo, hi),
-                })
-                .collect()
-        });
-        let points: Vec<[f32; 3]> = (0..nodes[2])
-            .flat_map(|c| (0..nodes[1]).flat_map(move |b| (0..nodes[0]).map(move |a| [a, b, c])))
-            .map(|[a, b, c]| [axes[0][a], axes[1][b], axes[2][c]])
-            .collect();
-        let tables = points
-            .par_iter()
-            .map(|&p| settings.table(&memo, p))
-            .collect::<Result<Vec<_>, _>>()?;
+        let axes = node_axes(range, nodes);
+        let tables = node_tables(settings, memo, &axes)?;
         let mut grid = ProfileGrid::new(axes.clone(), tables, 0.0);
         let centres = cell_centres(&axes);
         let step = centres.len().div_ceil(MAX_PROBED_CELLS).max(1);
@@ -153,7 +288,7 @@ pub fn profile_grid(
         let errors = probed
             .par_iter()
             .map(|&p| {
-                let direct = settings.table(&memo, p)?;
+                let direct = settings.table(memo, p)?;
                 Ok(interpolation_error(&grid.corners(p), &direct))
             })
             .collect::<Result<Vec<f32>, MultipoleError>>()?;
@@ -166,6 +301,46 @@ pub fn profile_grid(
         }
         nodes = next;
     }
+}
+
+/// The node values of the grid over `range` with `nodes` nodes per axis: even in each axis's
+/// warped coordinate, the ends exactly `lo` and `hi`.
+fn node_axes(range: [[f32; 2]; 3], nodes: [usize; 3]) -> [Vec<f32>; 3] {
+    std::array::from_fn(|k| {
+        let [lo, hi] = range[k];
+        let n = nodes[k];
+        if n == 1 {
+            return vec![lo];
+        }
+        let (wl, wh) = (warp(AXIS_KNEES[k], lo), warp(AXIS_KNEES[k], hi));
+        (0..n)
+            .map(|i| match i {
+                0 => lo,
+                _ if i == n - 1 => hi,
+                _ => {
+                    unwarp(AXIS_KNEES[k], wl + (wh - wl) * i as f32 / (n - 1) as f32).clamp(lo, hi)
+                }
+            })
+            .collect()
+    })
+}
+
+/// The table of every node of `axes`, C_m fastest.
+fn node_tables(
+    settings: &GridSettings<'_>,
+    memo: &Memo,
+    axes: &[Vec<f32>; 3],
+) -> Result<Vec<Arc<ProfileTable>>, MultipoleError> {
+    let points: Vec<[f32; 3]> = (0..axes[2].len())
+        .flat_map(|c| {
+            (0..axes[1].len()).flat_map(move |b| (0..axes[0].len()).map(move |a| [a, b, c]))
+        })
+        .map(|[a, b, c]| [axes[0][a], axes[1][b], axes[2][c]])
+        .collect();
+    points
+        .par_iter()
+        .map(|&p| settings.table(memo, p))
+        .collect()
 }
 
 /// The centre of every cell of the grid with node values `axes`, midway in each axis's warped
@@ -192,4 +367,95 @@ fn cell_centres(axes: &[Vec<f32>; 3]) -> Vec<[f32; 3]> {
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use skin_optics::Preset;
+
+    fn nodes(grid: &ProfileGrid) -> usize {
+        grid.axes().iter().map(Vec::len).product()
+    }
+
+    /// The grid a record gives is the refinement's, bit for bit.
+    fn assert_same(a: &ProfileGrid, b: &ProfileGrid) {
+        assert_eq!(a.axes(), b.axes());
+        assert_eq!(a.max_error.to_bits(), b.max_error.to_bits());
+        assert!(a.tables().iter().zip(b.tables()).all(|(x, y)| x == y));
+    }
+
+    /// A second load reads the recorded resolution and only the grid's own tables (no coarser
+    /// grid, no cell centre); a corrupted record, another grid's record under this key's name
+    /// and a record whose node counts the refinement could not have chosen are each refined
+    /// again and rewritten.
+    #[test]
+    fn a_grid_record_is_reused_and_a_bad_one_refined_again() {
+        let dir = tempfile::tempdir().unwrap();
+        let d = Some(dir.path());
+        let max = cache::DEFAULT_MAX_BYTES;
+        let params = SkinParams::preset(Preset::Light);
+        // The node tables themselves are built every time: only the record is cached here.
+        let fidelity = FidelityKnobs {
+            wavelength_step_nm: Some(20.0),
+            cache: false,
+            ..FidelityKnobs::default()
+        };
+        let settings = |target: f32| GridSettings {
+            params: &params,
+            phase_g: multipole::DEFAULT_G,
+            surface: multipole::Surface::Fresnel,
+            method: Method::Multipole,
+            shape_escapes: None,
+            fidelity: &fidelity,
+            target,
+        };
+        let range = [[0.02, 0.3], [0.5, 0.5], [0.01, 0.01]];
+        let s = settings(0.05);
+        let (fresh, load) = profile_grid_in(&s, range, d, max).unwrap();
+        assert!(matches!(load.record, CacheOutcome::Built(_)), "{load:?}");
+        assert!(nodes(&fresh) > 2, "one refinement step at least");
+        assert!(load.tables > nodes(&fresh), "{load:?}");
+        let (again, load) = profile_grid_in(&s, range, d, max).unwrap();
+        assert!(matches!(load.record, CacheOutcome::Hit(_)), "{load:?}");
+        assert_eq!(load.tables, nodes(&fresh));
+        assert_same(&again, &fresh);
+
+        let path = cache::entry_path(dir.path(), &s.record_key(range).unwrap());
+        let good = std::fs::read(&path).unwrap();
+        let mut flipped = good.clone();
+        *flipped.last_mut().unwrap() ^= 0x10;
+        let coarse = settings(f32::MAX);
+        profile_grid_in(&coarse, range, d, max).unwrap();
+        let other = std::fs::read(cache::entry_path(
+            dir.path(),
+            &coarse.record_key(range).unwrap(),
+        ))
+        .unwrap();
+        for (bytes, why) in [(flipped, "checksum mismatch"), (other, "key mismatch")] {
+            std::fs::write(&path, bytes).unwrap();
+            let (grid, load) = profile_grid_in(&s, range, d, max).unwrap();
+            assert_eq!(load.record, CacheOutcome::Rebuilt(path.clone(), why));
+            assert!(load.tables > nodes(&fresh), "{load:?}");
+            assert_same(&grid, &fresh);
+        }
+        for nodes_out in [[64, 1, 1], [4, 1, 1], [5, 3, 1]] {
+            let bad = GridRecord {
+                nodes: nodes_out,
+                max_error: 0.0,
+            };
+            cache::store(dir.path(), max, &s.record_key(range).unwrap(), &bad).unwrap();
+            let (grid, load) = profile_grid_in(&s, range, d, max).unwrap();
+            assert_eq!(
+                load.record,
+                CacheOutcome::Rebuilt(path.clone(), "node counts out of range")
+            );
+            assert_same(&grid, &fresh);
+        }
+        let (_, load) = profile_grid_in(&s, range, d, max).unwrap();
+        assert!(matches!(load.record, CacheOutcome::Hit(_)), "{load:?}");
+        let (grid, load) = profile_grid_in(&s, range, None, max).unwrap();
+        assert_eq!(load.record, CacheOutcome::Off);
+        assert_same(&grid, &fresh);
+    }
 }

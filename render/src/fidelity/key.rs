@@ -1,6 +1,7 @@
-//! The disk-cache key of a skin's tables: the canonical bytes of everything the tables depend on
-//! (the skin's parameters, the method, the table and profile knobs, the wavelength choice and
-//! the format versions), rendered as hex. Numbers enter as their IEEE-754 bits (little-endian),
+//! The disk-cache keys of a skin's tables and of a profile grid's record: the canonical bytes of
+//! everything they depend on (the skin's parameters, the method, the table and profile knobs, the
+//! wavelength choice and the format versions; for a grid, also its box, error target and
+//! refinement constants), rendered as hex. Numbers enter as their IEEE-754 bits (little-endian),
 //! choices as a fixed tag per variant, optional values behind a presence byte, so two inputs get
 //! the same key exactly when every input is the same, on any machine and across releases that
 //! keep [`KEY_FORMAT`].
@@ -11,7 +12,7 @@
 //! every accessor and every physiology extension, and a test checks that each number its `Debug`
 //! shows is in the key.
 
-use super::StepChoice;
+use super::{PhotonPolicy, StepChoice};
 use crate::bssrdf::TableOptions;
 use multipole::diffusion::slab::Poles;
 use multipole::diffusion::spatial::DiffusionOptions;
@@ -25,6 +26,10 @@ pub const KEY_FORMAT: u32 = 1;
 /// Version of what a key builds: bump it whenever the same inputs give other tables (the exact
 /// shape table's construction, a profile's sampling, ...).
 pub const TABLES_VERSION: u32 = 3;
+
+/// Version of what a grid record's key chooses: bump it whenever the same inputs and refinement
+/// constants would choose another resolution (the error measure, the refinement's order, ...).
+pub const GRID_VERSION: u32 = 1;
 
 /// Canonical bytes, appended field by field.
 #[derive(Debug, Default)]
@@ -93,6 +98,41 @@ pub fn table_key(
         } => b.tag(1).f64(max_delta_e).f64(max_luminance_error),
     };
     format!("skin-tables {}", b.hex())
+}
+
+/// The cache key of the record of a profile grid (`super::grid`) over the parameter box `range`
+/// (per axis [lo, hi]) at error target `target`: `node`, the key of the first tables of its
+/// lowest node (`super::tables::first_table_key`: the skin, method and every table knob), the
+/// photon policy and shape escapes that pick each node's further tables, and the refinement's
+/// constants `refinement`.
+#[must_use]
+pub fn grid_key(
+    node: &str,
+    photons: PhotonPolicy,
+    shape_escapes: Option<u64>,
+    range: [[f32; 2]; 3],
+    target: f32,
+    refinement: &[f64],
+) -> String {
+    let mut b = Bytes::default();
+    b.u64(u64::from(KEY_FORMAT)).u64(u64::from(GRID_VERSION));
+    match photons {
+        PhotonPolicy::Fixed => b.tag(0),
+        PhotonPolicy::Override(n) => b.tag(1).u64(n),
+        PhotonPolicy::Footprint(mm) => b.tag(2).f64(f64::from(mm)),
+    };
+    match shape_escapes {
+        None => b.tag(0),
+        Some(n) => b.tag(1).u64(n),
+    };
+    for [lo, hi] in range {
+        b.f64(f64::from(lo)).f64(f64::from(hi));
+    }
+    b.f64(f64::from(target)).u64(refinement.len() as u64);
+    for &x in refinement {
+        b.f64(x);
+    }
+    format!("skin-grid {} {node}", b.hex())
 }
 
 fn skin(b: &mut Bytes, p: &SkinParams) {
@@ -257,6 +297,59 @@ mod tests {
         ];
         for (i, a) in keys.iter().enumerate() {
             assert_ne!(a, &k, "input {i}");
+            for b in &keys[i + 1..] {
+                assert_ne!(a, b);
+            }
+        }
+    }
+
+    /// Each input of a grid record moves its key; equal inputs give equal keys.
+    #[test]
+    fn each_grid_input_changes_the_grid_key() {
+        let node = key_of(
+            &SkinParams::preset(skin_optics::Preset::Medium),
+            &TableOptions::default(),
+        );
+        let range = [[0.01, 0.4], [0.6, 0.6], [0.001, 0.2]];
+        let grid = |node: &str, photons, escapes, range, target, refinement: &[f64]| {
+            grid_key(node, photons, escapes, range, target, refinement)
+        };
+        let base = grid(&node, PhotonPolicy::Fixed, None, range, 0.02, &[33.0]);
+        assert_eq!(
+            base,
+            grid(&node, PhotonPolicy::Fixed, None, range, 0.02, &[33.0])
+        );
+        let mut wider = range;
+        wider[2][1] = 0.25;
+        let other_node = key_of(
+            &SkinParams::preset(skin_optics::Preset::Light),
+            &TableOptions::default(),
+        );
+        let keys = [
+            grid(&other_node, PhotonPolicy::Fixed, None, range, 0.02, &[33.0]),
+            grid(
+                &node,
+                PhotonPolicy::Footprint(1.5),
+                None,
+                range,
+                0.02,
+                &[33.0],
+            ),
+            grid(
+                &node,
+                PhotonPolicy::Override(50_000),
+                None,
+                range,
+                0.02,
+                &[33.0],
+            ),
+            grid(&node, PhotonPolicy::Fixed, Some(1000), range, 0.02, &[33.0]),
+            grid(&node, PhotonPolicy::Fixed, None, wider, 0.02, &[33.0]),
+            grid(&node, PhotonPolicy::Fixed, None, range, 0.03, &[33.0]),
+            grid(&node, PhotonPolicy::Fixed, None, range, 0.02, &[17.0]),
+        ];
+        for (i, a) in keys.iter().enumerate() {
+            assert_ne!(a, &base, "input {i}");
             for b in &keys[i + 1..] {
                 assert_ne!(a, b);
             }

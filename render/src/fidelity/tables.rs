@@ -13,6 +13,7 @@ use multipole::{Method, MultipoleError};
 use serde::{Deserialize, Serialize};
 use skin_io::cache;
 use skin_optics::SkinParams;
+use std::path::PathBuf;
 use std::time::Instant;
 
 /// What a cache entry holds: the table and the wavelength choice that sized it.
@@ -71,21 +72,8 @@ pub fn skin_table(
 ) -> Result<(ProfileTable, SkinChoices), MultipoleError> {
     let t0 = Instant::now();
     let phase_g = media.phase_g;
-    let resolved = knobs.resolve().map_err(|e| MultipoleError::InvalidOption {
-        name: e.name,
-        value: e.value,
-        range: e.range,
-    })?;
-    let dir = knobs
-        .cache
-        .then(skin_io::cache::cache_dir)
-        .flatten()
-        .map(|d| d.join("tables"));
-    let max_bytes = cache::max_bytes().map_err(|e| MultipoleError::InvalidOption {
-        name: "SKIN_CACHE_MAX_MIB",
-        value: e.value.parse().unwrap_or(f64::NAN),
-        range: "a whole number of MiB in [1, 1048576]",
-    })?;
+    let resolved = resolve(knobs)?;
+    let (dir, max_bytes) = cache_folder(knobs)?;
     let get = |shapes: Shapes| {
         // The key holds the options before the wavelength choice (the choice is part of the value).
         let probe = table_options(&resolved, shapes, media, 10.0);
@@ -108,20 +96,20 @@ pub fn skin_table(
         })?;
         Ok::<_, MultipoleError>((stored, outcome, probe))
     };
+    let first = first_shapes(method, resolved.photons, shape_escapes);
     let (stored, outcome, probe, photon_choice) = match (method, resolved.photons) {
         (Method::Multipole, _) | (_, PhotonPolicy::Fixed) => {
-            let shapes = shape_escapes.map_or(Shapes::Table(None), Shapes::Escapes);
-            let (stored, outcome, probe) = get(shapes)?;
+            let (stored, outcome, probe) = get(first)?;
             (stored, outcome, probe, PhotonChoice::Fixed)
         }
-        (_, PhotonPolicy::Override(n)) => {
-            let (stored, outcome, probe) = get(Shapes::Table(Some(n)))?;
+        (_, PhotonPolicy::Override(_)) => {
+            let (stored, outcome, probe) = get(first)?;
             (stored, outcome, probe, PhotonChoice::Override)
         }
         (_, PhotonPolicy::Footprint(footprint_mm)) => {
             // The share the footprint can see, from the cheapest table (`photons` module doc).
             let cheapest = photons::TABLE_PHOTON_LAW[0].0;
-            let first = get(Shapes::Table(Some(cheapest)))?;
+            let first = get(first)?;
             let (n, choice) = photons::choose(&first.0.table, footprint_mm, shape_escapes);
             let shapes = if shape_escapes.is_some() {
                 Shapes::Escapes(n)
@@ -166,6 +154,64 @@ pub fn skin_table(
         maps: None,
     };
     Ok((table, choices))
+}
+
+/// The choices of `knobs`, a knob out of range as the profile error naming it.
+fn resolve(knobs: &FidelityKnobs) -> Result<Resolved, MultipoleError> {
+    knobs.resolve().map_err(|e| MultipoleError::InvalidOption {
+        name: e.name,
+        value: e.value,
+        range: e.range,
+    })
+}
+
+/// The cache folder of skin tables under `knobs` (`None`: `--no-cache`, or no folder) and its
+/// size limit, bytes.
+pub(super) fn cache_folder(
+    knobs: &FidelityKnobs,
+) -> Result<(Option<PathBuf>, u64), MultipoleError> {
+    let dir = knobs
+        .cache
+        .then(cache::cache_dir)
+        .flatten()
+        .map(|d| d.join("tables"));
+    let max_bytes = cache::max_bytes().map_err(|e| MultipoleError::InvalidOption {
+        name: "SKIN_CACHE_MAX_MIB",
+        value: e.value.parse().unwrap_or(f64::NAN),
+        range: "a whole number of MiB in [1, 1048576]",
+    })?;
+    Ok((dir, max_bytes))
+}
+
+/// The shapes of the first tables [`skin_table`] asks for: the fixed ones, the override, or the
+/// cheapest table a footprint's choice is read from.
+fn first_shapes(method: Method, photons: PhotonPolicy, shape_escapes: Option<u64>) -> Shapes {
+    match (method, photons) {
+        (Method::Multipole, _) | (_, PhotonPolicy::Fixed) => {
+            shape_escapes.map_or(Shapes::Table(None), Shapes::Escapes)
+        }
+        (_, PhotonPolicy::Override(n)) => Shapes::Table(Some(n)),
+        (_, PhotonPolicy::Footprint(_)) => Shapes::Table(Some(photons::TABLE_PHOTON_LAW[0].0)),
+    }
+}
+
+/// The cache key of the first tables [`skin_table`] asks for with these inputs. With the photon
+/// policy and the shape escapes (which pick any further tables from the first), it names every
+/// table `skin_table` can return.
+pub(super) fn first_table_key(
+    params: &SkinParams,
+    media: &SkinMedia,
+    method: Method,
+    shape_escapes: Option<u64>,
+    knobs: &FidelityKnobs,
+) -> Result<(String, PhotonPolicy), MultipoleError> {
+    let resolved = resolve(knobs)?;
+    let shapes = first_shapes(method, resolved.photons, shape_escapes);
+    let probe = table_options(&resolved, shapes, media, 10.0);
+    Ok((
+        table_key(params, method, &probe, resolved.step),
+        resolved.photons,
+    ))
 }
 
 /// Where the profile shapes come from, in words.
