@@ -10,8 +10,9 @@
 //! refinement's.
 
 use super::FidelityKnobs;
+use super::PhotonPolicy;
 use super::key::grid_key;
-use super::tables::{cache_folder, first_table_key, skin_table};
+use super::tables::{Shapes, cache_folder, first_table_key, may_choose, node_table};
 use crate::bssrdf::grid::{AXIS_KNEES, unwarp, warp};
 use crate::bssrdf::{Corners, ProfileGrid, ProfileTable};
 use crate::media::SkinMedia;
@@ -63,8 +64,8 @@ pub struct GridSettings<'a> {
     pub target: f32,
 }
 
-/// Tables built so far, keyed by their parameters' bits.
-type Memo = Mutex<HashMap<[u32; 3], Arc<ProfileTable>>>;
+/// Tables built so far and their shapes, keyed by their parameters' bits.
+type Memo = Mutex<HashMap<[u32; 3], (Arc<ProfileTable>, Shapes)>>;
 
 impl GridSettings<'_> {
     /// The skin at parameters `p` = (C_m, β_m, C_h) and its layers.
@@ -80,29 +81,37 @@ impl GridSettings<'_> {
         Ok((params, media))
     }
 
-    /// The table at parameters `p` = (C_m, β_m, C_h), built once.
-    fn table(&self, memo: &Memo, p: [f32; 3]) -> Result<Arc<ProfileTable>, MultipoleError> {
+    /// The table at parameters `p` = (C_m, β_m, C_h), built once; with the shapes `known`
+    /// from a record, without reading the table a footprint's photon choice is made from.
+    fn table(
+        &self,
+        memo: &Memo,
+        p: [f32; 3],
+        known: Option<Shapes>,
+    ) -> Result<Arc<ProfileTable>, MultipoleError> {
         let key = p.map(f32::to_bits);
-        if let Some(t) = memo.lock().expect("no panics while held").get(&key) {
+        if let Some((t, _)) = memo.lock().expect("no panics while held").get(&key) {
             return Ok(t.clone());
         }
         let (params, media) = self.node(p)?;
-        let (table, _) = skin_table(
+        let (table, shapes) = node_table(
             &params,
             &media,
             self.method,
             self.shape_escapes,
             self.fidelity,
+            known,
         )?;
         let table = Arc::new(table);
         memo.lock()
             .expect("no panics while held")
-            .insert(key, table.clone());
+            .insert(key, (table.clone(), shapes));
         Ok(table)
     }
 
-    /// The key of the record of the grid over `range` ([`grid_key`]).
-    fn record_key(&self, range: [[f32; 2]; 3]) -> Result<String, MultipoleError> {
+    /// The key of the record of the grid over `range` ([`grid_key`]) and the photon policy of
+    /// its tables.
+    fn record_key(&self, range: [[f32; 2]; 3]) -> Result<(String, PhotonPolicy), MultipoleError> {
         let (params, media) = self.node(range.map(|[lo, _]| lo))?;
         let (node, photons) = first_table_key(
             &params,
@@ -120,29 +129,51 @@ impl GridSettings<'_> {
         .chain(AXIS_KNEES.map(|k| k.map_or(-1.0, f64::from)))
         .chain(ERROR_NM.map(f64::from))
         .collect();
-        Ok(grid_key(
+        let key = grid_key(
             &node,
             photons,
             self.shape_escapes,
             range,
             self.target,
             &refinement,
-        ))
+        );
+        Ok((key, photons))
     }
 }
 
-/// What the cache keeps of a grid: its node counts per axis and its measured error.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+/// What the cache keeps of a grid: its node counts per axis, its measured error and the shapes
+/// each node's table was chosen with (C_m fastest).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 struct GridRecord {
     nodes: [u32; 3],
     max_error: f32,
+    shapes: Vec<Shapes>,
 }
 
 impl GridRecord {
+    /// The record of `grid`, whose tables and their shapes are in `memo`.
+    fn of(grid: &ProfileGrid, memo: &Memo) -> Self {
+        let memo = memo.lock().expect("no panics while held");
+        Self {
+            nodes: grid.axes().clone().map(|a| a.len() as u32),
+            max_error: grid.max_error,
+            shapes: node_points(grid.axes())
+                .iter()
+                .map(|p| memo[&p.map(f32::to_bits)].1)
+                .collect(),
+        }
+    }
+
     /// The node counts when the refinement over `range` could have chosen them (1 on a
     /// one-value axis, else 2^k + 1 up to [`MAX_NODES_PER_AXIS`], at most [`MAX_GRID_TABLES`]
-    /// in all) and the error is a number ≥ 0; else `None`.
-    fn nodes_within(&self, range: [[f32; 2]; 3]) -> Option<[usize; 3]> {
+    /// in all), the error is a number ≥ 0 and each node's shapes are ones `settings`' photon
+    /// policy `photons` can choose; else `None`.
+    fn nodes_within(
+        &self,
+        range: [[f32; 2]; 3],
+        settings: &GridSettings<'_>,
+        photons: PhotonPolicy,
+    ) -> Option<[usize; 3]> {
         let nodes = self.nodes.map(|n| n as usize);
         let fits = (0..3).all(|k| {
             let n = nodes[k];
@@ -152,11 +183,18 @@ impl GridRecord {
                 n == 1
             }
         });
+        let count = nodes.iter().product::<usize>();
+        let shapes = self.shapes.len() == count
+            && self
+                .shapes
+                .iter()
+                .all(|&s| may_choose(settings.method, photons, settings.shape_escapes, s));
         (fits
-            && nodes.iter().product::<usize>() <= MAX_GRID_TABLES
+            && count <= MAX_GRID_TABLES
             && self.max_error >= 0.0
-            && self.max_error.is_finite())
-        .then_some(nodes)
+            && self.max_error.is_finite()
+            && shapes)
+            .then_some(nodes)
     }
 }
 
@@ -232,29 +270,23 @@ pub fn profile_grid_in(
         let record = CacheOutcome::Off;
         return Ok((grid, GridLoad { record, tables }));
     };
-    let key = settings.record_key(range)?;
+    let (key, photons) = settings.record_key(range)?;
     let (record, outcome) = cache::load_or_build(Some(dir), max_bytes, &key, || {
-        refine(settings, range, &memo).map(|grid| GridRecord {
-            nodes: grid.axes().clone().map(|a| a.len() as u32),
-            max_error: grid.max_error,
-        })
+        refine(settings, range, &memo).map(|grid| GridRecord::of(&grid, &memo))
     })?;
-    let (grid, outcome) = match (record.nodes_within(range), outcome) {
+    let (grid, outcome) = match (record.nodes_within(range, settings, photons), outcome) {
         (Some(nodes), outcome) => {
             let axes = node_axes(range, nodes);
-            let tables = node_tables(settings, &memo, &axes)?;
+            let tables = node_tables(settings, &memo, &axes, Some(&record.shapes))?;
             (ProfileGrid::new(axes, tables, record.max_error), outcome)
         }
         (None, outcome) => {
             let grid = refine(settings, range, &memo)?;
-            let record = GridRecord {
-                nodes: grid.axes().clone().map(|a| a.len() as u32),
-                max_error: grid.max_error,
-            };
+            let record = GridRecord::of(&grid, &memo);
             let outcome = match (cache::store(dir, max_bytes, &key, &record), outcome) {
                 (Err(why), _) => CacheOutcome::Unwritten(cache::entry_path(dir, &key), why),
                 (Ok(path), CacheOutcome::Hit(_)) => {
-                    CacheOutcome::Rebuilt(path, "node counts out of range")
+                    CacheOutcome::Rebuilt(path, "nodes or shapes out of range")
                 }
                 (Ok(_), other) => other,
             };
@@ -280,7 +312,7 @@ fn refine(
     let mut nodes = range.map(|[lo, hi]| if hi > lo { 2 } else { 1 });
     loop {
         let axes = node_axes(range, nodes);
-        let tables = node_tables(settings, memo, &axes)?;
+        let tables = node_tables(settings, memo, &axes, None)?;
         let mut grid = ProfileGrid::new(axes.clone(), tables, 0.0);
         let centres = cell_centres(&axes);
         let step = centres.len().div_ceil(MAX_PROBED_CELLS).max(1);
@@ -288,7 +320,7 @@ fn refine(
         let errors = probed
             .par_iter()
             .map(|&p| {
-                let direct = settings.table(memo, p)?;
+                let direct = settings.table(memo, p, None)?;
                 Ok(interpolation_error(&grid.corners(p), &direct))
             })
             .collect::<Result<Vec<f32>, MultipoleError>>()?;
@@ -325,21 +357,28 @@ fn node_axes(range: [[f32; 2]; 3], nodes: [usize; 3]) -> [Vec<f32>; 3] {
     })
 }
 
-/// The table of every node of `axes`, C_m fastest.
-fn node_tables(
-    settings: &GridSettings<'_>,
-    memo: &Memo,
-    axes: &[Vec<f32>; 3],
-) -> Result<Vec<Arc<ProfileTable>>, MultipoleError> {
-    let points: Vec<[f32; 3]> = (0..axes[2].len())
+/// The parameters of every node of `axes`, C_m fastest.
+fn node_points(axes: &[Vec<f32>; 3]) -> Vec<[f32; 3]> {
+    (0..axes[2].len())
         .flat_map(|c| {
             (0..axes[1].len()).flat_map(move |b| (0..axes[0].len()).map(move |a| [a, b, c]))
         })
         .map(|[a, b, c]| [axes[0][a], axes[1][b], axes[2][c]])
-        .collect();
-    points
-        .par_iter()
-        .map(|&p| settings.table(memo, p))
+        .collect()
+}
+
+/// The table of every node of `axes`, C_m fastest; with each node's shapes `known` from a
+/// record.
+fn node_tables(
+    settings: &GridSettings<'_>,
+    memo: &Memo,
+    axes: &[Vec<f32>; 3],
+    known: Option<&[Shapes]>,
+) -> Result<Vec<Arc<ProfileTable>>, MultipoleError> {
+    let points = node_points(axes);
+    (0..points.len())
+        .into_par_iter()
+        .map(|i| settings.table(memo, points[i], known.map(|k| k[i])))
         .collect()
 }
 
@@ -421,7 +460,7 @@ mod tests {
         assert_eq!(load.tables, nodes(&fresh));
         assert_same(&again, &fresh);
 
-        let path = cache::entry_path(dir.path(), &s.record_key(range).unwrap());
+        let path = cache::entry_path(dir.path(), &s.record_key(range).unwrap().0);
         let good = std::fs::read(&path).unwrap();
         let mut flipped = good.clone();
         *flipped.last_mut().unwrap() ^= 0x10;
@@ -429,7 +468,7 @@ mod tests {
         profile_grid_in(&coarse, range, d, max).unwrap();
         let other = std::fs::read(cache::entry_path(
             dir.path(),
-            &coarse.record_key(range).unwrap(),
+            &coarse.record_key(range).unwrap().0,
         ))
         .unwrap();
         for (bytes, why) in [(flipped, "checksum mismatch"), (other, "key mismatch")] {
@@ -439,16 +478,26 @@ mod tests {
             assert!(load.tables > nodes(&fresh), "{load:?}");
             assert_same(&grid, &fresh);
         }
-        for nodes_out in [[64, 1, 1], [4, 1, 1], [5, 3, 1]] {
+        let n = nodes(&fresh);
+        let fixed = Shapes::Table(None);
+        let bad_records = [
+            ([64, 1, 1], vec![fixed; 64]),
+            ([4, 1, 1], vec![fixed; 4]),
+            ([5, 3, 1], vec![fixed; 15]),
+            ([n as u32, 1, 1], vec![fixed; n - 1]),
+            ([n as u32, 1, 1], vec![Shapes::Table(Some(50_000)); n]),
+        ];
+        for (nodes_out, shapes) in bad_records {
             let bad = GridRecord {
                 nodes: nodes_out,
                 max_error: 0.0,
+                shapes,
             };
-            cache::store(dir.path(), max, &s.record_key(range).unwrap(), &bad).unwrap();
+            cache::store(dir.path(), max, &s.record_key(range).unwrap().0, &bad).unwrap();
             let (grid, load) = profile_grid_in(&s, range, d, max).unwrap();
             assert_eq!(
                 load.record,
-                CacheOutcome::Rebuilt(path.clone(), "node counts out of range")
+                CacheOutcome::Rebuilt(path.clone(), "nodes or shapes out of range")
             );
             assert_same(&grid, &fresh);
         }

@@ -25,9 +25,11 @@ struct Stored {
 
 /// Where the shapes' photons come from: run-time escapes, or the universal table's photons
 /// (`None`: the default table).
-#[derive(Debug, Clone, Copy, PartialEq)]
-enum Shapes {
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub(super) enum Shapes {
+    /// This many escapes per Monte Carlo shape.
     Escapes(u64),
+    /// The universal table of this many photons (`None`: the default).
     Table(Option<u64>),
 }
 
@@ -60,6 +62,121 @@ fn table_options(
     opts
 }
 
+/// Where a skin's tables are looked up: its inputs, resolved, and the cache folder.
+struct Lookup<'a> {
+    params: &'a SkinParams,
+    media: &'a SkinMedia,
+    method: Method,
+    resolved: Resolved,
+    dir: Option<PathBuf>,
+    max_bytes: u64,
+}
+
+/// Tables found through the cache: the entry, what the cache did, the options before the
+/// wavelength choice, and the shapes they were built with.
+struct Found {
+    stored: Stored,
+    outcome: cache::CacheOutcome,
+    probe: TableOptions,
+    shapes: Shapes,
+}
+
+impl<'a> Lookup<'a> {
+    fn new(
+        params: &'a SkinParams,
+        media: &'a SkinMedia,
+        method: Method,
+        knobs: &FidelityKnobs,
+    ) -> Result<Self, MultipoleError> {
+        let resolved = resolve(knobs)?;
+        let (dir, max_bytes) = cache_folder(knobs)?;
+        Ok(Self {
+            params,
+            media,
+            method,
+            resolved,
+            dir,
+            max_bytes,
+        })
+    }
+
+    /// The tables with shapes `shapes`, read or built and stored.
+    fn get(&self, shapes: Shapes) -> Result<Found, MultipoleError> {
+        let (params, method, resolved) = (self.params, self.method, &self.resolved);
+        // The key holds the options before the wavelength choice (the choice is part of the value).
+        let probe = table_options(resolved, shapes, self.media, 10.0);
+        let key = table_key(params, method, &probe, resolved.step);
+        let (stored, outcome) =
+            cache::load_or_build(self.dir.as_deref(), self.max_bytes, &key, || {
+                let wavelengths = match resolved.step {
+                    StepChoice::Fixed(step_nm) => WavelengthChoice::fixed(step_nm),
+                    StepChoice::Colour {
+                        max_delta_e,
+                        max_luminance_error,
+                    } => wavelengths::choose_step(
+                        &wavelengths::totals_1nm(params, method, self.media.phase_g)?,
+                        max_delta_e,
+                        max_luminance_error,
+                    ),
+                };
+                let opts = table_options(resolved, shapes, self.media, wavelengths.step_nm);
+                let table = ProfileTable::build(params, method, &opts)?;
+                Ok::<_, MultipoleError>(Stored { table, wavelengths })
+            })?;
+        Ok(Found {
+            stored,
+            outcome,
+            probe,
+            shapes,
+        })
+    }
+
+    /// The tables the photon policy chooses, and the record of the choice.
+    fn choose(&self, shape_escapes: Option<u64>) -> Result<(Found, PhotonChoice), MultipoleError> {
+        let first = first_shapes(self.method, self.resolved.photons, shape_escapes);
+        match (self.method, self.resolved.photons) {
+            (Method::Multipole, _) | (_, PhotonPolicy::Fixed) => {
+                Ok((self.get(first)?, PhotonChoice::Fixed))
+            }
+            (_, PhotonPolicy::Override(_)) => Ok((self.get(first)?, PhotonChoice::Override)),
+            (_, PhotonPolicy::Footprint(footprint_mm)) => {
+                // The share the footprint can see, from the cheapest table (`photons` module doc).
+                let first = self.get(first)?;
+                let (n, choice) = photons::choose(&first.stored.table, footprint_mm, shape_escapes);
+                let shapes = if shape_escapes.is_some() {
+                    Shapes::Escapes(n)
+                } else {
+                    Shapes::Table(Some(n))
+                };
+                if shapes == first.shapes {
+                    Ok((first, choice))
+                } else {
+                    Ok((self.get(shapes)?, choice))
+                }
+            }
+        }
+    }
+}
+
+/// The table of one node of a profile grid (`super::grid`): [`skin_table`]'s, without the record
+/// of choices, and the shapes it was built with. With `known` shapes (a grid record's) only that
+/// entry is read: a footprint's choice needs the cheapest table read first.
+pub(super) fn node_table(
+    params: &SkinParams,
+    media: &SkinMedia,
+    method: Method,
+    shape_escapes: Option<u64>,
+    knobs: &FidelityKnobs,
+    known: Option<Shapes>,
+) -> Result<(ProfileTable, Shapes), MultipoleError> {
+    let lookup = Lookup::new(params, media, method, knobs)?;
+    let found = match known {
+        Some(shapes) => lookup.get(shapes)?,
+        None => lookup.choose(shape_escapes)?.0,
+    };
+    Ok((found.stored.table, found.shapes))
+}
+
 /// Build (or read from the cache) the profile table of `params` (whose layers at their
 /// Henyey–Greenstein g are `media`) with `method`, the shape knob and the fidelity `knobs`, and
 /// record the choices.
@@ -71,59 +188,17 @@ pub fn skin_table(
     knobs: &FidelityKnobs,
 ) -> Result<(ProfileTable, SkinChoices), MultipoleError> {
     let t0 = Instant::now();
-    let phase_g = media.phase_g;
-    let resolved = resolve(knobs)?;
-    let (dir, max_bytes) = cache_folder(knobs)?;
-    let get = |shapes: Shapes| {
-        // The key holds the options before the wavelength choice (the choice is part of the value).
-        let probe = table_options(&resolved, shapes, media, 10.0);
-        let key = table_key(params, method, &probe, resolved.step);
-        let (stored, outcome) = cache::load_or_build(dir.as_deref(), max_bytes, &key, || {
-            let wavelengths = match resolved.step {
-                StepChoice::Fixed(step_nm) => WavelengthChoice::fixed(step_nm),
-                StepChoice::Colour {
-                    max_delta_e,
-                    max_luminance_error,
-                } => wavelengths::choose_step(
-                    &wavelengths::totals_1nm(params, method, phase_g)?,
-                    max_delta_e,
-                    max_luminance_error,
-                ),
-            };
-            let opts = table_options(&resolved, shapes, media, wavelengths.step_nm);
-            let table = ProfileTable::build(params, method, &opts)?;
-            Ok::<_, MultipoleError>(Stored { table, wavelengths })
-        })?;
-        Ok::<_, MultipoleError>((stored, outcome, probe))
-    };
-    let first = first_shapes(method, resolved.photons, shape_escapes);
-    let (stored, outcome, probe, photon_choice) = match (method, resolved.photons) {
-        (Method::Multipole, _) | (_, PhotonPolicy::Fixed) => {
-            let (stored, outcome, probe) = get(first)?;
-            (stored, outcome, probe, PhotonChoice::Fixed)
-        }
-        (_, PhotonPolicy::Override(_)) => {
-            let (stored, outcome, probe) = get(first)?;
-            (stored, outcome, probe, PhotonChoice::Override)
-        }
-        (_, PhotonPolicy::Footprint(footprint_mm)) => {
-            // The share the footprint can see, from the cheapest table (`photons` module doc).
-            let cheapest = photons::TABLE_PHOTON_LAW[0].0;
-            let first = get(first)?;
-            let (n, choice) = photons::choose(&first.0.table, footprint_mm, shape_escapes);
-            let shapes = if shape_escapes.is_some() {
-                Shapes::Escapes(n)
-            } else {
-                Shapes::Table(Some(n))
-            };
-            if shapes == Shapes::Table(Some(cheapest)) {
-                (first.0, first.1, first.2, choice)
-            } else {
-                let (stored, outcome, probe) = get(shapes)?;
-                (stored, outcome, probe, choice)
-            }
-        }
-    };
+    let lookup = Lookup::new(params, media, method, knobs)?;
+    let resolved = lookup.resolved;
+    let (
+        Found {
+            stored,
+            outcome,
+            probe,
+            ..
+        },
+        photon_choice,
+    ) = lookup.choose(shape_escapes)?;
     let table = stored.table;
     let r99_mm = table.largest_radius_for_energy_mm(0.99);
     let choices = SkinChoices {
@@ -192,6 +267,28 @@ fn first_shapes(method: Method, photons: PhotonPolicy, shape_escapes: Option<u64
         }
         (_, PhotonPolicy::Override(n)) => Shapes::Table(Some(n)),
         (_, PhotonPolicy::Footprint(_)) => Shapes::Table(Some(photons::TABLE_PHOTON_LAW[0].0)),
+    }
+}
+
+/// Whether the photon policy `photons` could choose `shapes` for some skin, with the shape
+/// escapes `shape_escapes` and `method` (a grid record's shapes are checked against it).
+pub(super) fn may_choose(
+    method: Method,
+    photons: PhotonPolicy,
+    shape_escapes: Option<u64>,
+    shapes: Shapes,
+) -> bool {
+    match (method, photons, shape_escapes, shapes) {
+        (Method::Multipole, ..) | (_, PhotonPolicy::Fixed | PhotonPolicy::Override(_), ..) => {
+            shapes == first_shapes(method, photons, shape_escapes)
+        }
+        (_, PhotonPolicy::Footprint(_), Some(asked), Shapes::Escapes(n)) => {
+            (photons::MIN_ESCAPES.min(asked)..=asked).contains(&n)
+        }
+        (_, PhotonPolicy::Footprint(_), None, Shapes::Table(Some(n))) => {
+            photons::TABLE_PHOTON_LAW.iter().any(|&(p, _)| p == n)
+        }
+        _ => false,
     }
 }
 
@@ -293,6 +390,66 @@ mod tests {
                 cache::load_or_build(Some(dir), cache::DEFAULT_MAX_BYTES, &k, build).unwrap();
             assert!(matches!(o, CacheOutcome::Rebuilt(..)), "{o:?}");
             assert_eq!(bits(&again.table), bits(&fresh.table));
+        }
+    }
+
+    /// A grid record's shapes are trusted only where the policy could choose them: the fixed
+    /// and overridden policies their one choice, a footprint a rung of the photon law (table) or
+    /// a count between the least escapes and those asked for.
+    #[test]
+    fn recorded_shapes_are_checked_against_the_policy() {
+        use PhotonPolicy::{Fixed, Footprint, Override};
+        let (exact, mp) = (Method::Exact, Method::Multipole);
+        let table = |n| Shapes::Table(Some(n));
+        let cases = [
+            (exact, Fixed, None, Shapes::Table(None), true),
+            (exact, Fixed, None, table(50_000), false),
+            (exact, Fixed, Some(1000), Shapes::Escapes(1000), true),
+            (exact, Fixed, Some(1000), Shapes::Escapes(999), false),
+            (exact, Override(77_000), None, table(77_000), true),
+            (exact, Override(77_000), None, table(50_000), false),
+            (mp, Footprint(1.0), None, Shapes::Table(None), true),
+            (mp, Footprint(1.0), None, table(50_000), false),
+            (exact, Footprint(1.0), None, table(50_000), true),
+            (exact, Footprint(1.0), None, table(200_000), true),
+            (exact, Footprint(1.0), None, table(60_000), false),
+            (exact, Footprint(1.0), None, Shapes::Table(None), false),
+            (
+                exact,
+                Footprint(1.0),
+                Some(5000),
+                Shapes::Escapes(5000),
+                true,
+            ),
+            (
+                exact,
+                Footprint(1.0),
+                Some(5000),
+                Shapes::Escapes(100),
+                true,
+            ),
+            (
+                exact,
+                Footprint(1.0),
+                Some(5000),
+                Shapes::Escapes(99),
+                false,
+            ),
+            (
+                exact,
+                Footprint(1.0),
+                Some(5000),
+                Shapes::Escapes(5001),
+                false,
+            ),
+            (exact, Footprint(1.0), Some(5000), table(50_000), false),
+        ];
+        for (method, policy, escapes, shapes, want) in cases {
+            assert_eq!(
+                may_choose(method, policy, escapes, shapes),
+                want,
+                "{method:?} {policy:?} {escapes:?} {shapes:?}"
+            );
         }
     }
 
