@@ -60,10 +60,17 @@ pub(super) fn fit(
         .flatten()
         .flat_map(|c| c.to_le_bytes())
         .collect();
+    // Where the cache is and how large it may grow change no texel: left out of the key, so
+    // another cache folder or limit finds the same entry instead of fitting again.
+    let fitted_by = MapsOptions {
+        cache_dir: None,
+        cache_max_bytes: 0,
+        ..opts.clone()
+    };
     let key = format!(
-        "fitted-chromophore-maps v2; {width}x{height}; texels {:016x}; options {:016x}",
+        "fitted-chromophore-maps v3; {width}x{height}; texels {:016x}; options {:016x}",
         skin_io::cache::fnv1a(&bytes),
-        skin_io::cache::fnv1a(format!("{opts:?}").as_bytes()),
+        skin_io::cache::fnv1a(format!("{fitted_by:?}").as_bytes()),
     );
     let build = || -> Result<Stored, String> {
         let model = MapsModel::load(&opts).map_err(|e| e.to_string())?;
