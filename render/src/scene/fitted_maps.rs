@@ -42,6 +42,27 @@ fn options(exposure: Exposure, thin_epidermis_mm: Option<f64>) -> Result<MapsOpt
     })
 }
 
+/// The cache key of the maps of `texels` (`width` × `height`) fitted with `opts`. Where the
+/// cache is and how large it may grow change no texel: they are left out, so another cache
+/// folder or limit finds the same entry instead of fitting again.
+fn entry_key(width: usize, height: usize, texels: &[[f32; 3]], opts: &MapsOptions) -> String {
+    let bytes: Vec<u8> = texels
+        .iter()
+        .flatten()
+        .flat_map(|c| c.to_le_bytes())
+        .collect();
+    let fitted_by = MapsOptions {
+        cache_dir: None,
+        cache_max_bytes: 0,
+        ..opts.clone()
+    };
+    format!(
+        "fitted-chromophore-maps v3; {width}x{height}; texels {:016x}; options {:016x}",
+        skin_io::cache::fnv1a(&bytes),
+        skin_io::cache::fnv1a(format!("{fitted_by:?}").as_bytes()),
+    )
+}
+
 /// The maps (melanin, eumelanin, hemoglobin, thin epidermis) of `texture` fitted under the
 /// exposure `spec` (`1`, `auto`, `auto-rgb`, `G` or `R,G,B`, as `skin maps --exposure`), texels
 /// out of gamut fitted again under an epidermis `thin_epidermis_mm` thick (none: `None`), from the
@@ -55,23 +76,7 @@ pub(super) fn fit(
     let opts = options(exposure, thin_epidermis_mm)?;
     let (width, height) = texture.size();
     let texels = texture.texels();
-    let bytes: Vec<u8> = texels
-        .iter()
-        .flatten()
-        .flat_map(|c| c.to_le_bytes())
-        .collect();
-    // Where the cache is and how large it may grow change no texel: left out of the key, so
-    // another cache folder or limit finds the same entry instead of fitting again.
-    let fitted_by = MapsOptions {
-        cache_dir: None,
-        cache_max_bytes: 0,
-        ..opts.clone()
-    };
-    let key = format!(
-        "fitted-chromophore-maps v3; {width}x{height}; texels {:016x}; options {:016x}",
-        skin_io::cache::fnv1a(&bytes),
-        skin_io::cache::fnv1a(format!("{fitted_by:?}").as_bytes()),
-    );
+    let key = entry_key(width, height, texels, &opts);
     let build = || -> Result<Stored, String> {
         let model = MapsModel::load(&opts).map_err(|e| e.to_string())?;
         let maps = model
@@ -117,4 +122,28 @@ pub(super) fn fit(
             .zip(opts.thin_epidermis_mm)
             .map(|(v, mm)| (image(v), mm)),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The key follows the texels and the fit's options, not the cache's folder or limit.
+    #[test]
+    fn the_maps_key_leaves_out_the_cache_folder() {
+        let texels = [[0.5, 0.4, 0.3], [0.6, 0.45, 0.35]];
+        let opts = options(Exposure::Auto, Some(0.05)).unwrap();
+        let key = entry_key(2, 1, &texels, &opts);
+        let elsewhere = MapsOptions {
+            cache_dir: Some("/elsewhere".into()),
+            cache_max_bytes: 1 << 20,
+            ..opts.clone()
+        };
+        assert_eq!(entry_key(2, 1, &texels, &elsewhere), key);
+        let other_fit = options(Exposure::WhiteBalance, Some(0.05)).unwrap();
+        let other_texel = [[0.5, 0.4, 0.3], [0.6, 0.45, 0.36]];
+        assert_ne!(entry_key(2, 1, &texels, &other_fit), key);
+        assert_ne!(entry_key(2, 1, &other_texel, &opts), key);
+        assert_ne!(entry_key(1, 2, &texels, &opts), key);
+    }
 }
