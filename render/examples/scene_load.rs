@@ -4,7 +4,7 @@
 //! holds on a loaded machine; the wall time does not.
 //!
 //! `SKIN_CACHE_DIR=DIR cargo run --release -p render --features studies --example scene_load --
-//! [SCENE] [HEIGHT] [REPEATS]` (default `builtin:three-heads-maps`, 384 pixels, 2 loads).
+//! [SCENE] [HEIGHT] [REPEATS]` (default `builtin:three-heads`, 384 pixels, 2 loads).
 
 use render::integrator::{BodyIntegrator, IntegratorKind};
 use render::material::SkinKnobs;
@@ -12,9 +12,7 @@ use render::scene::Scene;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let scene = args
-        .first()
-        .map_or("builtin:three-heads-maps", String::as_str);
+    let scene = args.first().map_or("builtin:three-heads", String::as_str);
     let height: u32 = args.get(1).map_or(Ok(384), |s| s.parse())?;
     let repeats: usize = args.get(2).map_or(Ok(2), |s| s.parse())?;
     let mut knobs = SkinKnobs::default();

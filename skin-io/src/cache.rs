@@ -25,7 +25,7 @@ pub const CACHE_VERSION: u32 = 3;
 const MAGIC: &str = "skin-tables";
 /// Largest total size of the entries in the folder, bytes (2 GiB; `$SKIN_CACHE_MAX_MIB`
 /// overrides): a light-skin table at full fidelity is about 0.1 MiB, and one skin with chromophore
-/// maps keeps a grid of a few hundred (the three heads of `builtin:three-heads-maps` about 220 MiB
+/// maps keeps a grid of a few hundred (the three heads of `builtin:three-heads` about 220 MiB
 /// at 768×384, 700 MiB in the former JSON), which must fit or every load rebuilds what the last one
 /// evicted.
 pub const DEFAULT_MAX_BYTES: u64 = 2 << 30;
