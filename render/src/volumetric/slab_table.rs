@@ -10,6 +10,9 @@ use multipole::MultipoleError;
 use multipole::exact::adding_doubling::{self, AddingDoublingOptions};
 use multipole::skin::thin_slab;
 use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use skin_io::cache;
+use std::path::Path;
 
 /// Thickness step of the table, mm. Against adding-doubling at 24 points at every half step from
 /// 0.25 mm to the table's end, the largest errors, at the midpoints of the first millimetre (where the luminance
@@ -25,8 +28,12 @@ pub const STEP_MM: f64 = 0.25;
 /// threshold needs percent, not 10⁻⁴; the error is in the interpolation test's bound).
 const QUADRATURE_POINTS: usize = 12;
 
+/// Version of what [`SlabTable::build`] computes from its inputs: bump it whenever the same media
+/// would give another table (the weighting, the grid, the solver's options).
+const SLAB_TABLE_VERSION: u32 = 1;
+
 /// The luminance of a skin slab's diffuse reflectance and transmittance over its thickness.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SlabTable {
     /// R(d_i) at d_i = i · STEP_MM, i = 0..n (R(0) = 0).
     reflectance: Vec<f32>,
@@ -37,6 +44,26 @@ pub struct SlabTable {
 }
 
 impl SlabTable {
+    /// [`SlabTable::build`] through the disk cache in `dir` (`None`: built in memory), keyed by
+    /// every layered medium it reads (coefficients, thicknesses, indices and surface, every 10
+    /// nm), g, the table's constants, `t_floor` and `max_mm`.
+    pub fn cached(
+        media: &SkinMedia,
+        t_floor: f64,
+        max_mm: f64,
+        dir: Option<&Path>,
+    ) -> Result<Self, MultipoleError> {
+        let rows: Vec<(f64, &multipole::LayeredMedium)> = media.every_10nm().collect();
+        let key = format!(
+            "slab-table v{SLAB_TABLE_VERSION} step {STEP_MM:?} points {QUADRATURE_POINTS} g {:?} \
+             floor {t_floor:?} max {max_mm:?} rows {rows:?}",
+            media.phase_g
+        );
+        let max_bytes = cache::max_bytes().unwrap_or(cache::DEFAULT_MAX_BYTES);
+        cache::load_or_build(dir, max_bytes, &key, || Self::build(media, t_floor, max_mm))
+            .map(|(table, _)| table)
+    }
+
     /// The table of `media` from 0 to the first node where T falls below `t_floor` · R∞ (at most
     /// `max_mm`), from adding-doubling at every 10 nm (in parallel over wavelengths).
     pub fn build(media: &SkinMedia, t_floor: f64, max_mm: f64) -> Result<Self, MultipoleError> {
@@ -141,6 +168,26 @@ mod tests {
             w += k;
         }
         (r / w, t / w)
+    }
+
+    /// Through the cache the table is the one built directly, to the bit; a second load reads
+    /// the entry the first wrote (one file); another skin or another floor is another entry.
+    #[test]
+    fn the_cached_table_is_the_built_one_and_is_keyed_by_its_inputs() {
+        let dir = tempfile::tempdir().unwrap();
+        let files = || std::fs::read_dir(dir.path()).unwrap().count();
+        let light = media(Preset::Light);
+        let built = SlabTable::build(&light, 5e-5, 4.0).unwrap();
+        let first = SlabTable::cached(&light, 5e-5, 4.0, Some(dir.path())).unwrap();
+        assert_eq!(first, built);
+        assert_eq!(files(), 1);
+        let second = SlabTable::cached(&light, 5e-5, 4.0, Some(dir.path())).unwrap();
+        assert_eq!(second, built);
+        assert_eq!(files(), 1);
+        let dark = SlabTable::cached(&media(Preset::Dark), 5e-5, 4.0, Some(dir.path())).unwrap();
+        assert_ne!(dark, built);
+        SlabTable::cached(&light, 1e-4, 4.0, Some(dir.path())).unwrap();
+        assert_eq!(files(), 3);
     }
 
     /// Between nodes (at the midpoints, where linear interpolation errs most) and at nodes, the

@@ -89,10 +89,20 @@ impl ThinParts {
                 parts.push(None);
                 continue;
             };
-            let slab = match SlabTable::build(
+            // Cached beside the material's tables, unless they were not (`--no-cache`).
+            let cached = skin
+                .choices
+                .as_ref()
+                .is_some_and(|c| !matches!(c.cache, skin_io::cache::CacheOutcome::Off));
+            let dir = cached
+                .then(skin_io::cache::cache_dir)
+                .flatten()
+                .map(|d| d.join("tables"));
+            let slab = match SlabTable::cached(
                 &skin.media,
                 f64::from(OMISSION_SHARE / MAX_FAR_TO_NEAR),
                 MAX_PROBE_MM,
+                dir.as_deref(),
             ) {
                 Ok(t) => t,
                 Err(e) => {
