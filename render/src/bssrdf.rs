@@ -59,7 +59,7 @@ pub use grid::{Corners, ProfileGrid};
 pub use incidence::{Incidence, IncidenceGain};
 pub use sampling::{Probe, ProbeAxes, ProbeFrame, RadiusWavelength, pdf_exit, probe};
 pub use separable::{Directional, EnergySplit, texture_modulation};
-pub use table::{ProfileTable, RENDER_SHAPE_STEP_NM, RowsAt, TableOptions};
+pub use table::{ProfileTable, RENDER_SHAPE_STEP_NM, RowPlace, RowsAt, TableOptions};
 
 use crate::geometry::SurfaceHit;
 use crate::spectrum::{N_WAVELENGTHS, SampledSpectrum, SampledWavelengths};

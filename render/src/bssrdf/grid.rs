@@ -4,6 +4,7 @@
 //! `crate::fidelity::grid`, which chooses its resolution from the interpolation error it measures.
 
 use super::ProfileTable;
+use super::table::RowPlace;
 use crate::spectrum::{N_WAVELENGTHS, SampledSpectrum, SampledWavelengths};
 use std::sync::Arc;
 
@@ -37,12 +38,21 @@ pub struct ProfileGrid {
     /// The largest relative L1 error of the interpolated radial energy 2πr R(r) against directly
     /// built profiles, measured at the cells' centres when the grid was built.
     pub max_error: f32,
+    /// Every node's R_tot at each of its tabulation rows, node after node, `rows` per node, when
+    /// all nodes share their rows (§19.2; else empty): the totals at a hit read them without
+    /// resolving each table's rows.
+    totals: Vec<f32>,
+    /// Rows per node in `totals` (0 when the nodes' rows differ).
+    rows: usize,
 }
 
-/// Up to eight tables and their multilinear weights (those of weight 0 left out).
+/// Up to eight nodes of a grid and their multilinear weights (those of weight 0 left out).
 #[derive(Debug, Clone, Copy)]
 pub struct Corners<'a> {
-    tables: [Option<(&'a ProfileTable, f32)>; 8],
+    grid: &'a ProfileGrid,
+    /// Node index and weight of each corner, the first `n` used.
+    nodes: [(u32, f32); 8],
+    n: usize,
 }
 
 impl ProfileGrid {
@@ -60,11 +70,20 @@ impl ProfileGrid {
         );
         let warped =
             std::array::from_fn(|k| axes[k].iter().map(|&v| warp(AXIS_KNEES[k], v)).collect());
+        let shared = tables.iter().all(|t| t.same_rows(&tables[0]));
+        let (totals, rows) = if shared {
+            let totals = tables.iter().flat_map(|t| t.row_totals()).collect();
+            (totals, tables[0].wavelengths())
+        } else {
+            (Vec::new(), 0)
+        };
         Self {
             axes,
             warped,
             tables,
             max_error,
+            totals,
+            rows,
         }
     }
 
@@ -103,8 +122,9 @@ impl ProfileGrid {
         };
         let at = [0, 1, 2].map(|k| locate(k, p[k]));
         let (n0, n1) = (self.axes[0].len(), self.axes[1].len());
-        let mut tables = [None; 8];
-        for (c, slot) in tables.iter_mut().enumerate() {
+        let mut nodes = [(0u32, 0.0f32); 8];
+        let mut n = 0;
+        for c in 0..8 {
             let bits = [c & 1, (c >> 1) & 1, (c >> 2) & 1];
             let mut w = 1.0;
             let mut index = [0usize; 3];
@@ -114,14 +134,27 @@ impl ProfileGrid {
                 index[k] = i + bits[k];
             }
             if w > 0.0 {
-                *slot = Some((&*self.tables[index[0] + n0 * (index[1] + n1 * index[2])], w));
+                nodes[n] = ((index[0] + n0 * (index[1] + n1 * index[2])) as u32, w);
+                n += 1;
             }
         }
-        Corners { tables }
+        Corners {
+            grid: self,
+            nodes,
+            n,
+        }
     }
 }
 
-impl Corners<'_> {
+impl<'a> Corners<'a> {
+    /// The corners' tables and weights.
+    fn tables(&self) -> impl Iterator<Item = (&'a ProfileTable, f32)> + Clone + '_ {
+        let tables = &self.grid.tables;
+        self.nodes[..self.n]
+            .iter()
+            .map(move |&(i, w)| (&*tables[i as usize], w))
+    }
+
     /// The multilinear interpolation of ln v over the corners' values `v` (weights `w`):
     /// ∏ v_c^{w_c}, exact where v is exponential in the parameters (an absorbing layer's
     /// filter, §19.2); linear where a corner's value is 0 (beyond its profile's end).
@@ -134,50 +167,203 @@ impl Corners<'_> {
         }
     }
 
+    /// Where each active lane of `wl` falls on the first corner's rows, for every corner when
+    /// the grid's nodes share their rows (`None` for terminated lanes, and for every lane when
+    /// the rows differ: each table then places it on its own).
+    fn places(&self, wl: &SampledWavelengths) -> [Option<RowPlace>; N_WAVELENGTHS] {
+        let first = &self.grid.tables[self.nodes[0].0 as usize];
+        std::array::from_fn(|k| {
+            (self.grid.rows > 0 && wl.pdf()[k] > 0.0).then(|| first.place_lane(wl, k))
+        })
+    }
+
     /// R(r) at `r_mm` for each active lane of `wl` (0 for terminated lanes), mm⁻².
     #[must_use]
     pub fn eval(&self, wl: &SampledWavelengths, r_mm: f32) -> SampledSpectrum {
+        let places = self.places(wl);
         let mut at = [[(0.0f32, 0.0f32); 8]; N_WAVELENGTHS];
-        let mut n = 0;
-        for (table, w) in self.tables.iter().flatten() {
-            let lanes: [_; N_WAVELENGTHS] =
-                std::array::from_fn(|k| (wl.pdf()[k] > 0.0).then(|| table.at_lane(wl, k)));
+        for (c, (table, w)) in self.tables().enumerate() {
+            let lanes: [_; N_WAVELENGTHS] = std::array::from_fn(|k| match places[k] {
+                Some(place) => Some(table.at_place(place)),
+                None => (self.grid.rows == 0 && wl.pdf()[k] > 0.0).then(|| table.at_lane(wl, k)),
+            });
             let r = table.eval_each(&lanes, r_mm);
             for k in 0..N_WAVELENGTHS {
-                at[k][n] = (r[k], *w);
+                at[k][c] = (r[k], w);
             }
-            n += 1;
         }
         SampledSpectrum(std::array::from_fn(|k| {
-            Self::blend(at[k][..n].iter().copied())
+            Self::blend(at[k][..self.n].iter().copied())
         }))
     }
 
     /// R(r) at one wavelength `nm`, mm⁻².
     #[must_use]
     pub fn eval_nm(&self, nm: f32, r_mm: f32) -> f32 {
-        Self::blend(
-            self.tables
-                .iter()
-                .flatten()
-                .map(|(t, w)| (t.eval(nm, r_mm), *w)),
-        )
+        Self::blend(self.tables().map(|(t, w)| (t.eval(nm, r_mm), w)))
     }
 
     /// The total diffuse reflectance R_tot at `nm`, interpolated alike.
     #[must_use]
     pub fn total(&self, nm: f32) -> f32 {
-        Self::blend(self.tables.iter().flatten().map(|(t, w)| (t.total(nm), *w)))
+        Self::blend(self.tables().map(|(t, w)| (t.total(nm), w)))
     }
 
-    /// [`Self::total`] at the path's wavelength `k`.
+    /// [`Self::total`] at the path's wavelength `k`, through each table's rows.
     #[must_use]
     pub fn total_lane(&self, wl: &SampledWavelengths, k: usize) -> f32 {
-        Self::blend(
-            self.tables
+        Self::blend(self.tables().map(|(t, w)| (t.at_lane(wl, k).total(), w)))
+    }
+
+    /// [`Self::total_lane`] at every lane of `wl` (terminated ones too), each wavelength placed
+    /// once for all corners and the totals read from the grid's own array of them.
+    #[must_use]
+    pub fn totals(&self, wl: &SampledWavelengths) -> SampledSpectrum {
+        let rows = self.grid.rows;
+        if rows == 0 {
+            return SampledSpectrum(std::array::from_fn(|k| self.total_lane(wl, k)));
+        }
+        let first = &self.grid.tables[self.nodes[0].0 as usize];
+        let totals = &self.grid.totals;
+        SampledSpectrum(std::array::from_fn(|k| {
+            let (lower, upper, t) = first.place_lane(wl, k).rows(rows);
+            let mut at = [(0.0f32, 0.0f32); 8];
+            for (slot, &(node, w)) in at.iter_mut().zip(&self.nodes[..self.n]) {
+                let base = node as usize * rows;
+                // As `ProfileTable::at_lane(..).total()`: the rows' totals mixed in this order.
+                *slot = (
+                    (1.0 - t) * totals[base + lower] + t * totals[base + upper],
+                    w,
+                );
+            }
+            Self::blend(at[..self.n].iter().copied())
+        }))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::TableOptions;
+    use super::*;
+    use multipole::Method;
+    use rand::{Rng, SeedableRng};
+    use rand_xoshiro::Xoshiro256PlusPlus;
+    use rayon::prelude::*;
+    use skin_optics::{Preset, SkinParams};
+
+    /// Two nodes per axis: C_m, β_m, C_h.
+    const BOX: [[f32; 2]; 3] = [[0.02, 0.3], [0.3, 0.8], [0.005, 0.1]];
+
+    /// The diffusion tables at the box's corners (C_m fastest), on 10-nm rows, or on 20-nm rows
+    /// at the lowest node when `mixed_rows`.
+    fn corner_tables(mixed_rows: bool) -> Vec<Arc<ProfileTable>> {
+        let base = SkinParams::preset(Preset::Light);
+        (0..8)
+            .into_par_iter()
+            .map(|c| {
+                let v = |k: usize| f64::from(BOX[k][(c >> k) & 1]);
+                let params = base
+                    .with_melanin(v(0))
+                    .and_then(|p| p.with_eumelanin_blend(v(1)))
+                    .and_then(|p| p.with_hemoglobin(v(2)))
+                    .unwrap();
+                let opts = TableOptions {
+                    step_nm: if mixed_rows && c == 0 { 20.0 } else { 10.0 },
+                    radii: 64,
+                    ..TableOptions::default()
+                };
+                Arc::new(ProfileTable::build(&params, Method::Multipole, &opts).unwrap())
+            })
+            .collect()
+    }
+
+    /// The corners' blend against each table evaluated on its own: at random parameters in the
+    /// box, random path wavelengths (some with the secondary lanes terminated) and random radii,
+    /// R(r) and R_tot per lane are ∏ v_c^{w_c} of the tables' own values (linear Σ w_c v_c where
+    /// a corner's profile has ended), with the weights computed here in f64, linear in the warped
+    /// coordinates, within 2·10⁻⁵ relative (f32 rounding of a sum of up to eight logarithms of
+    /// values down to 10⁻⁶, |ln v| ≤ 14: a few ulp each). Both the grid whose nodes share their
+    /// rows (totals read from the grid's array) and one whose nodes do not (each table places the
+    /// wavelength itself) are checked; where the rows are shared, the totals of every lane at
+    /// once equal the per-lane, per-table path bit for bit.
+    #[test]
+    fn corner_blend_is_the_product_of_each_tables_values() {
+        let axes = BOX.map(|a| a.to_vec());
+        for mixed in [false, true] {
+            let grid = ProfileGrid::new(axes.clone(), corner_tables(mixed), 0.0);
+            assert_eq!(grid.rows == 0, mixed);
+            let r_max = grid
+                .tables()
                 .iter()
-                .flatten()
-                .map(|(t, w)| (t.at_lane(wl, k).total(), *w)),
-        )
+                .map(|t| *t.radii_mm().last().unwrap())
+                .fold(0.0f32, f32::max);
+            let mut rng = Xoshiro256PlusPlus::seed_from_u64(7);
+            let (mut linear, mut geometric) = (0, 0);
+            for trial in 0..400 {
+                let p: [f32; 3] = std::array::from_fn(|k| rng.random_range(BOX[k][0]..BOX[k][1]));
+                let mut wl = SampledWavelengths::sample_visible(rng.random());
+                if trial % 4 == 0 {
+                    wl.terminate_secondary();
+                }
+                let r_mm = (rng.random_range((1e-3f32).ln()..r_max.ln())).exp();
+                let t: [f64; 3] = std::array::from_fn(|k| {
+                    let w = |v: f32| f64::from(warp(AXIS_KNEES[k], v));
+                    (w(p[k]) - w(BOX[k][0])) / (w(BOX[k][1]) - w(BOX[k][0]))
+                });
+                let corners: Vec<(&ProfileTable, f64)> = (0..8)
+                    .map(|c| {
+                        let w = (0..3)
+                            .map(|k| if (c >> k) & 1 == 1 { t[k] } else { 1.0 - t[k] })
+                            .product::<f64>();
+                        (&*grid.tables()[c], w)
+                    })
+                    .collect();
+                let blend = |v: &dyn Fn(&ProfileTable) -> f32| -> (f64, bool) {
+                    let vals: Vec<(f64, f64)> = corners
+                        .iter()
+                        .map(|&(table, w)| (f64::from(v(table)), w))
+                        .collect();
+                    if vals.iter().all(|&(v, _)| v > 0.0) {
+                        (
+                            vals.iter().map(|(v, w)| w * v.ln()).sum::<f64>().exp(),
+                            true,
+                        )
+                    } else {
+                        (vals.iter().map(|(v, w)| w * v).sum(), false)
+                    }
+                };
+                let at = grid.corners(p);
+                let (totals, profile) = (at.totals(&wl), at.eval(&wl, r_mm));
+                for k in 0..N_WAVELENGTHS {
+                    let nm = wl.nm(k);
+                    let (want, _) = blend(&|table| table.total(nm));
+                    let got = f64::from(totals.0[k]);
+                    assert!(
+                        (got / want - 1.0).abs() < 2e-5,
+                        "{p:?} {nm} nm: R_tot {got} against {want}"
+                    );
+                    if !mixed {
+                        assert_eq!(totals.0[k].to_bits(), at.total_lane(&wl, k).to_bits());
+                    }
+                    let got = f64::from(profile.0[k]);
+                    if wl.pdf()[k] == 0.0 {
+                        assert_eq!(got, 0.0);
+                        continue;
+                    }
+                    let (want, positive) = blend(&|table| table.eval(nm, r_mm));
+                    if positive {
+                        geometric += 1;
+                    } else {
+                        linear += 1;
+                    }
+                    assert!(
+                        (got - want).abs() <= 2e-5 * want.abs().max(1e-30),
+                        "{p:?} {nm} nm {r_mm} mm: R {got} against {want}"
+                    );
+                }
+            }
+            // Both branches of the blend were exercised.
+            assert!(linear > 20 && geometric > 200, "{linear} {geometric}");
+        }
     }
 }

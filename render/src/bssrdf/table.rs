@@ -116,11 +116,22 @@ impl RowsAt<'_> {
     }
 }
 
-/// A wavelength between two rows: lower row index and weight of the upper one.
+/// A wavelength between two rows of a table: lower row index and weight of the upper one. Tables
+/// with the same rows ([`ProfileTable::same_rows`]) place a wavelength alike, so one place serves
+/// them all.
 #[derive(Debug, Clone, Copy)]
-struct Lerp {
+pub struct RowPlace {
     j: usize,
     t: f32,
+}
+
+impl RowPlace {
+    /// The lower and upper row indices and the upper row's weight on a table of `rows` rows.
+    #[must_use]
+    #[inline]
+    pub fn rows(self, rows: usize) -> (usize, usize, f32) {
+        (self.j, (self.j + 1).min(rows - 1), self.t)
+    }
 }
 
 impl ProfileTable {
@@ -239,10 +250,10 @@ impl ProfileTable {
         &self.radii_mm
     }
 
-    fn lerp(&self, nm: f32) -> Lerp {
+    fn lerp(&self, nm: f32) -> RowPlace {
         let x = ((nm - self.from_nm) / self.step_nm).clamp(0.0, (self.rows.len() - 1) as f32);
         let j = (x as usize).min(self.rows.len().saturating_sub(2));
-        Lerp {
+        RowPlace {
             j,
             t: if self.rows.len() == 1 {
                 0.0
@@ -257,9 +268,22 @@ impl ProfileTable {
         self.mix_at(self.lerp(nm))
     }
 
-    fn mix_at(&self, l: Lerp) -> [(&Row, f32); 2] {
-        let upper = (l.j + 1).min(self.rows.len() - 1);
-        [(&self.rows[l.j], 1.0 - l.t), (&self.rows[upper], l.t)]
+    fn mix_at(&self, l: RowPlace) -> [(&Row, f32); 2] {
+        let (lower, upper, t) = l.rows(self.rows.len());
+        [(&self.rows[lower], 1.0 - t), (&self.rows[upper], t)]
+    }
+
+    /// Whether `other` has the same tabulation wavelengths (so places on the rows are shared).
+    #[must_use]
+    pub fn same_rows(&self, other: &Self) -> bool {
+        self.rows.len() == other.rows.len()
+            && self.from_nm == other.from_nm
+            && self.step_nm == other.step_nm
+    }
+
+    /// R_tot of each tabulation row, dimensionless.
+    pub fn row_totals(&self) -> impl Iterator<Item = f32> + '_ {
+        self.rows.iter().map(|row| row.total)
     }
 
     /// Whether the rows are the path's 10-nm grid (380–780 nm every 10 nm, the default).
@@ -284,14 +308,29 @@ impl ProfileTable {
     /// [`Self::at`] the path's wavelength `k` (on the 10-nm grid its row was found once per path).
     #[must_use]
     pub fn at_lane(&self, wl: &SampledWavelengths, k: usize) -> RowsAt<'_> {
+        self.at_place(self.place_lane(wl, k))
+    }
+
+    /// Where the path's wavelength `k` falls on the rows (on the 10-nm grid, found once per path).
+    #[must_use]
+    #[inline]
+    pub fn place_lane(&self, wl: &SampledWavelengths, k: usize) -> RowPlace {
         if !self.on_10nm_grid() {
-            return self.at(wl.nm(k));
+            return self.lerp(wl.nm(k));
         }
         let at = wl.on_10nm(k);
-        Self::rows_at(self.mix_at(Lerp {
+        RowPlace {
             j: at.index(),
             t: at.weight(),
-        }))
+        }
+    }
+
+    /// The table resolved at a wavelength placed on its rows ([`Self::place_lane`] of this table
+    /// or of one with the same rows).
+    #[must_use]
+    #[inline]
+    pub fn at_place(&self, place: RowPlace) -> RowsAt<'_> {
+        Self::rows_at(self.mix_at(place))
     }
 
     fn rows_at(rows: [(&Row, f32); 2]) -> RowsAt<'_> {

@@ -256,8 +256,7 @@ impl SkinMaps {
     /// The total diffuse reflectance R_tot per lane at the texel of `uv`.
     #[must_use]
     pub fn totals(&self, wl: &SampledWavelengths, uv: Vec2) -> SampledSpectrum {
-        let corners = self.corners(uv);
-        SampledSpectrum(std::array::from_fn(|k| corners.total_lane(wl, k)))
+        self.corners(uv).totals(wl)
     }
 }
 
