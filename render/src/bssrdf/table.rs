@@ -410,28 +410,32 @@ impl ProfileTable {
     #[must_use]
     pub fn eval_each<const N: usize>(&self, at: &[Option<RowsAt<'_>>; N], r_mm: f32) -> [f32; N] {
         let r = r_mm.max(0.5 * R_MIN_MM);
-        let i = self.radii_mm.partition_point(|&x| x < r);
+        let radii = &self.radii_mm;
+        let i = radii.partition_point(|&x| x < r);
+        // Where r falls between two grid radii, shared by every row (beyond the grid every row
+        // has ended; below its first radius the density rises linearly from 0).
+        let t = (i > 0 && i < radii.len()).then(|| (r - radii[i - 1]) / (radii[i] - radii[i - 1]));
         at.map(|at| {
             at.map_or(0.0, |at| {
                 let [(a, wa), (b, wb)] = at.rows;
-                (wa * self.row_p_at(a, i, r) + wb * self.row_p_at(b, i, r)) / (2.0 * PI * r)
+                (wa * self.row_p_at(a, i, t, r) + wb * self.row_p_at(b, i, t, r)) / (2.0 * PI * r)
             })
         })
     }
 
     /// Density p(r) = 2πr R(r) of one row at `r_mm`, mm⁻¹ (0 beyond the row), as
     /// `multipole::sampling::density` on the row, with the grid index `i` (the first grid
-    /// radius ≥ `r_mm`) given.
-    fn row_p_at(&self, row: &Row, i: usize, r_mm: f32) -> f32 {
+    /// radius ≥ `r_mm`) and the weight `t` of radius `i` against radius `i − 1` given.
+    #[inline]
+    fn row_p_at(&self, row: &Row, i: usize, t: Option<f32>, r_mm: f32) -> f32 {
         let radii = &self.radii_mm;
         if r_mm.is_nan() || r_mm < 0.0 || r_mm > radii[row.len - 1] {
             return 0.0;
         }
-        if i == 0 {
-            return row.p[0] * r_mm / radii[0];
+        match t {
+            None => row.p[0] * r_mm / radii[0],
+            Some(t) => row.p[i - 1] + t * (row.p[i] - row.p[i - 1]),
         }
-        let t = (r_mm - radii[i - 1]) / (radii[i] - radii[i - 1]);
-        row.p[i - 1] + t * (row.p[i] - row.p[i - 1])
     }
 
     /// Density of [`ProfileTable::sample_radius`] at `nm` per unit *area* of the plane at distance

@@ -221,8 +221,7 @@ impl SkinMaps {
         uv_o: Vec2,
         r_mm: f32,
     ) -> SampledSpectrum {
-        let at_o = self.corners(uv_o).eval(wl, r_mm);
-        let at_i = self.corners(uv_i).eval(wl, r_mm);
+        let [at_o, at_i] = self.corners(uv_o).eval_pair(&self.corners(uv_i), wl, r_mm);
         SampledSpectrum(std::array::from_fn(|k| {
             self.blend.combine(at_i.0[k], at_o.0[k])
         }))
