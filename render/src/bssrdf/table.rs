@@ -268,6 +268,7 @@ impl ProfileTable {
         self.mix_at(self.lerp(nm))
     }
 
+    #[inline]
     fn mix_at(&self, l: RowPlace) -> [(&Row, f32); 2] {
         let (lower, upper, t) = l.rows(self.rows.len());
         [(&self.rows[lower], 1.0 - t), (&self.rows[upper], t)]
@@ -287,6 +288,7 @@ impl ProfileTable {
     }
 
     /// Whether the rows are the path's 10-nm grid (380–780 nm every 10 nm, the default).
+    #[inline]
     fn on_10nm_grid(&self) -> bool {
         self.rows.len() == GRID_10NM_NODES
             && self.from_nm == LAMBDA_MIN_NM
@@ -307,6 +309,7 @@ impl ProfileTable {
 
     /// [`Self::at`] the path's wavelength `k` (on the 10-nm grid its row was found once per path).
     #[must_use]
+    #[inline]
     pub fn at_lane(&self, wl: &SampledWavelengths, k: usize) -> RowsAt<'_> {
         self.at_place(self.place_lane(wl, k))
     }
@@ -333,6 +336,7 @@ impl ProfileTable {
         Self::rows_at(self.mix_at(place))
     }
 
+    #[inline]
     fn rows_at(rows: [(&Row, f32); 2]) -> RowsAt<'_> {
         RowsAt {
             rows,
