@@ -78,6 +78,17 @@ pub const ARC_SEGMENTS: usize = 8;
 /// The profile table resolved at a path's wavelengths, one entry per lane.
 type Lanes<'a> = [Option<RowsAt<'a>>; N_WAVELENGTHS];
 
+/// Share of the radii the wide profile draws where a skin samples from a narrower one
+/// ([`Subsurface::wide`]): light entering far from a strongly absorbing exit otherwise comes
+/// with weights up to the two profiles' ratio (700× across the split slab of
+/// `the_geometric_rule_is_reciprocal_on_the_split_slab`, whose far side reads 1.7σ from 0 with
+/// no share, 2σ with 0.1 and 3σ with 0.25). The default image's skin noise at 60 s for each
+/// share: BENCHMARKS.md, "The default image: noise in 60 s".
+pub const WIDE_SHARE: f32 = 0.5;
+
+/// The largest f32 below 1: a uniform rescaled from part of [0, 1) stays below 1.
+const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;
+
 /// The subsurface model of one skin material.
 #[derive(Debug, Clone)]
 pub struct Subsurface {
@@ -89,6 +100,10 @@ pub struct Subsurface {
     pub curvature: Option<CurvatureGain>,
     /// The azimuthal lobe (`None`: the separable form alone, [`Azimuth::Separable`]).
     pub azimuth: Option<Arc<AzimuthalLobe>>,
+    /// A wider profile that draws the share [`WIDE_SHARE`] of the radii (`None`: `table` draws
+    /// them all): a defensive mixture ([Hes95], docs/physics.md §19.3), so that no weight
+    /// exceeds 1 / [`WIDE_SHARE`] times what the wide profile alone would give.
+    pub wide: Option<Arc<ProfileTable>>,
 }
 
 /// Where a subsurface path leaves the skin toward the entry point.
@@ -116,6 +131,8 @@ pub struct ProbeSample<'a> {
     pub segment: Probe,
     lanes: Lanes<'a>,
     c: [f32; N_WAVELENGTHS],
+    /// The wide profile's lanes and lane probabilities, when it draws half the radii.
+    wide: Option<(Lanes<'a>, [f32; N_WAVELENGTHS])>,
     /// Each lane's curvature κ, mm⁻¹ (0 without the curvature term).
     kappa: [f32; N_WAVELENGTHS],
 }
@@ -156,6 +173,7 @@ impl Subsurface {
             directional,
             curvature: None,
             azimuth: None,
+            wide: None,
         }
     }
 
@@ -191,9 +209,27 @@ impl Subsurface {
         }))
     }
 
-    /// Σ_j c_j pdf_area_j(r_mm): the mixture of the lanes' planar densities, mm⁻² (spectral MIS).
-    fn mixture(&self, lanes: &Lanes<'_>, c: &[f32; N_WAVELENGTHS], r_mm: f32) -> f32 {
-        let r = self.table.eval_each(lanes, r_mm);
+    /// The planar density of radius `r_mm` under `probe`'s strategies, mm⁻²: the lanes' mixture
+    /// of the table, averaged with the wide profile's where it draws half the radii.
+    fn density(&self, probe: &ProbeSample<'_>, r_mm: f32) -> f32 {
+        let own = Self::mixture(&self.table, &probe.lanes, &probe.c, r_mm);
+        match (&self.wide, &probe.wide) {
+            (Some(wide), Some((lanes, c))) => {
+                (1.0 - WIDE_SHARE) * own + WIDE_SHARE * Self::mixture(wide, lanes, c, r_mm)
+            }
+            _ => own,
+        }
+    }
+
+    /// Σ_j c_j pdf_area_j(r_mm): the mixture of `table`'s lanes' planar densities, mm⁻²
+    /// (spectral MIS).
+    fn mixture(
+        table: &ProfileTable,
+        lanes: &Lanes<'_>,
+        c: &[f32; N_WAVELENGTHS],
+        r_mm: f32,
+    ) -> f32 {
+        let r = table.eval_each(lanes, r_mm);
         (0..N_WAVELENGTHS)
             .filter_map(|k| {
                 let total = lanes[k]?.total();
@@ -226,15 +262,34 @@ impl Subsurface {
         let (axis, u_lane) = axes.choose(u[0]);
         let lanes = self.lanes(wl);
         let c = Self::lane_probabilities(wl, &lanes, radius);
+        let wide = self.wide.as_ref().map(|t| {
+            let lanes: Lanes<'_> =
+                std::array::from_fn(|k| (wl.pdf()[k] > 0.0).then(|| t.at_lane(wl, k)));
+            let c = Self::lane_probabilities(wl, &lanes, radius);
+            (lanes, c)
+        });
+        // The wide profile's share of the radii (the radius uniform split in two keeps its
+        // stratification).
+        let own = 1.0 - WIDE_SHARE;
+        let (table, strategy_c, u_radius) = match (&self.wide, &wide) {
+            (Some(t), Some((_, wc))) if u[1] >= own => {
+                (&**t, wc, ((u[1] - own) / WIDE_SHARE).min(ONE_MINUS_EPSILON))
+            }
+            (Some(_), Some(_)) => (&*self.table, &c, (u[1] / own).min(ONE_MINUS_EPSILON)),
+            _ => (&*self.table, &c, u[1]),
+        };
         // The uniform choice keeps the hero (lane 0), which is already uniform over the lanes.
         let lane = if radius == RadiusWavelength::HERO {
             0
         } else {
-            RadiusWavelength::choose(&c, u_lane)
+            RadiusWavelength::choose(strategy_c, u_lane)
         };
         let hero = wl.nm(lane);
-        let r_max = self.table.r_max_mm(hero);
-        let r = self.table.sample_radius(hero, u[1]);
+        // The probe's sphere reaches as far as either strategy's radii.
+        let r_max = self.wide.as_ref().map_or(self.table.r_max_mm(hero), |t| {
+            self.table.r_max_mm(hero).max(t.r_max_mm(hero))
+        });
+        let r = table.sample_radius(hero, u_radius);
         if r_max.is_nan() || r_max <= 0.0 {
             return None;
         }
@@ -251,6 +306,7 @@ impl Subsurface {
             segment: probe(frame, p_o, axis, r, r_max, u[2]),
             lanes,
             c,
+            wide,
             kappa,
         })
     }
@@ -277,9 +333,7 @@ impl Subsurface {
             (s.ng, s.ns)
         };
         let dist = (s.p - p_o).length();
-        let pdf = pdf_exit(axes, frame, p_o, s.p, ng, |ra| {
-            self.mixture(&probe.lanes, &probe.c, ra)
-        });
+        let pdf = pdf_exit(axes, frame, p_o, s.p, ng, |ra| self.density(probe, ra));
         if pdf.is_nan() || pdf <= 0.0 {
             return None;
         }
@@ -310,7 +364,7 @@ impl Subsurface {
         (p_o, frame, axes): (Vec3, &ProbeFrame, &ProbeAxes),
     ) -> Exit {
         let r = probe.segment.r_mm;
-        let pdf = axes.p_normal() * self.mixture(&probe.lanes, &probe.c, r);
+        let pdf = axes.p_normal() * self.density(probe, r);
         let weight = if pdf > 0.0 {
             self.weight(&probe.lanes, r, 1.0 / pdf)
         } else {

@@ -208,6 +208,12 @@ impl PathTracer<'_> {
         ];
         let si = &hit.si;
         let flipped = hit.ns.dot(si.ns) < 0.0;
+        // With maps, radii follow the profile of the skin the light leaves.
+        let ss = skin
+            .maps
+            .as_ref()
+            .and_then(|m| m.sampling_at(si.uv))
+            .unwrap_or(ss);
         let exit = probe::sample_exit(
             &scene.geometry,
             ss,

@@ -173,6 +173,10 @@ pub struct SkinMaps {
     pub thin_grid: Option<ProfileGrid>,
     /// How the BSSRDF combines the two ends' profiles.
     pub blend: ProfileBlend,
+    /// Per node of `grid` and of `thin_grid` (in that order), the material's BSSRDF sampling
+    /// radii from that node's profile; empty where the radii come from the grid's widest
+    /// profile (`SkinMaps::sampling_at`).
+    sampling: Vec<crate::bssrdf::Subsurface>,
     /// The material's epidermis thickness (texels without a thin epidermis), mm.
     pub epidermis_mm: f32,
 }
@@ -191,6 +195,30 @@ impl SkinMaps {
             (Some(grid), Some(thin)) if thin.is_thin(uv) => grid.corners(p),
             _ => self.grid.corners(p),
         }
+    }
+
+    /// The BSSRDF that samples radii for light leaving at the texel of `uv`: the material's
+    /// with the profile of the low corner of that texel's cell (`ProfileGrid::low_corner`), which
+    /// follows the texel's own profile and so every combined profile the rules `exit` and
+    /// `geometric` give (both vanish where the exit's does), in a defensive mixture with the
+    /// grid's widest profile ([`crate::bssrdf::WIDE_SHARE`]); `None` to sample from the grid's
+    /// widest profile (the rules `entry` and `mean`, or a grid over β_m). A radius weight
+    /// R_het / R_sample near 1 keeps strongly absorbing texels as quiet as uniform skin
+    /// (docs/physics.md §19.3).
+    #[must_use]
+    #[inline]
+    pub fn sampling_at(&self, uv: Vec2) -> Option<&crate::bssrdf::Subsurface> {
+        if self.sampling.is_empty() {
+            return None;
+        }
+        let p = self.maps.at(uv);
+        let index = match (&self.thin_grid, self.maps.thin()) {
+            (Some(grid), Some(thin)) if thin.is_thin(uv) => {
+                self.grid.tables().len() + grid.low_corner(p)?
+            }
+            _ => self.grid.low_corner(p)?,
+        };
+        self.sampling.get(index)
     }
 
     /// The epidermis thickness at the texel of `uv`, mm: the thin one where the texel is thin,
@@ -338,12 +366,29 @@ impl super::SkinMaterial {
                 }),
             });
         }
+        let per_node = matches!(blend, ProfileBlend::Exit | ProfileBlend::Geometric)
+            && grid.axes()[1].len() == 1
+            && thin_grid.as_ref().is_none_or(|t| t.axes()[1].len() == 1);
+        let sampling = match &self.subsurface {
+            Some(ss) if per_node => grid
+                .tables()
+                .iter()
+                .chain(thin_grid.iter().flat_map(ProfileGrid::tables))
+                .map(|t| crate::bssrdf::Subsurface {
+                    table: t.clone(),
+                    wide: Some(ss.table.clone()),
+                    ..ss.clone()
+                })
+                .collect(),
+            _ => Vec::new(),
+        };
         self.maps = Some(std::sync::Arc::new(SkinMaps {
             maps,
             absorption,
             grid,
             thin_grid,
             blend,
+            sampling,
             epidermis_mm: self.params.epidermis_thickness_mm() as f32,
         }));
         Ok(self)
