@@ -258,30 +258,15 @@ impl NearestSurface {
             return;
         }
         let r2 = radius_mm * radius_mm;
-        let mut stack = [0usize; 64];
-        let mut top = 1;
-        while top > 0 {
-            top -= 1;
-            let n = stack[top];
-            let node = self.nodes[n];
-            if box_distance_squared(p, node.lo, node.hi) > r2 {
-                continue;
+        // The traversal skips boxes no nearer than its cutoff; the next double above r² keeps
+        // those at exactly the radius, as the triangles at it are kept.
+        let cutoff = r2.next_up();
+        self.descend(p, cutoff, |i, _, d2| {
+            if d2 <= r2 {
+                out.push((round_down(d2.sqrt()), i as u32));
             }
-            if self.is_leaf(n) {
-                let (s, c) = (node.start as usize, node.count as usize);
-                for (i, t) in self.tris[s..s + c].iter().enumerate() {
-                    let off = closest_offset(p - t.a, t.ab, t.ac);
-                    let d2 = (p - t.a - off).length_squared();
-                    if d2 <= r2 {
-                        out.push((round_down(d2.sqrt()), (s + i) as u32));
-                    }
-                }
-                continue;
-            }
-            stack[top] = node.start as usize;
-            stack[top + 1] = node.start as usize + 1;
-            top += 2;
-        }
+            cutoff
+        });
     }
 
     /// A box [u₀, u₁] × [v₀, v₁] holding the texture coordinates of every point of triangle
