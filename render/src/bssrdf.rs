@@ -78,8 +78,9 @@ pub const ARC_SEGMENTS: usize = 8;
 /// The profile table resolved at a path's wavelengths, one entry per lane.
 type Lanes<'a> = [Option<RowsAt<'a>>; N_WAVELENGTHS];
 
-/// Share of the radii the wide profile draws where a skin samples from a narrower one
-/// ([`Subsurface::wide`]): light entering far from a strongly absorbing exit otherwise comes
+/// Share of the radii the wide profile draws where a skin samples from a narrower one (the
+/// `wide` table of [`Subsurface::sample_probe`]): light entering far from a strongly absorbing
+/// exit otherwise comes
 /// with weights up to the two profiles' ratio (700× across the split slab of
 /// `the_geometric_rule_is_reciprocal_on_the_split_slab`, whose far side reads 1.7σ from 0 with
 /// no share, 2σ with 0.1 and 3σ with 0.25). The default image's skin noise at 60 s for each
@@ -100,10 +101,6 @@ pub struct Subsurface {
     pub curvature: Option<CurvatureGain>,
     /// The azimuthal lobe (`None`: the separable form alone, [`Azimuth::Separable`]).
     pub azimuth: Option<Arc<AzimuthalLobe>>,
-    /// A wider profile that draws the share [`WIDE_SHARE`] of the radii (`None`: `table` draws
-    /// them all): a defensive mixture ([Hes95], docs/physics.md §19.3), so that no weight
-    /// exceeds 1 / [`WIDE_SHARE`] times what the wide profile alone would give.
-    pub wide: Option<Arc<ProfileTable>>,
 }
 
 /// Where a subsurface path leaves the skin toward the entry point.
@@ -131,8 +128,9 @@ pub struct ProbeSample<'a> {
     pub segment: Probe,
     lanes: Lanes<'a>,
     c: [f32; N_WAVELENGTHS],
-    /// The wide profile's lanes and lane probabilities, when it draws half the radii.
-    wide: Option<(Lanes<'a>, [f32; N_WAVELENGTHS])>,
+    /// The wide profile, its lanes and lane probabilities, when it draws the share
+    /// [`WIDE_SHARE`] of the radii.
+    wide: Option<(&'a ProfileTable, Lanes<'a>, [f32; N_WAVELENGTHS])>,
     /// Each lane's curvature κ, mm⁻¹ (0 without the curvature term).
     kappa: [f32; N_WAVELENGTHS],
 }
@@ -173,7 +171,6 @@ impl Subsurface {
             directional,
             curvature: None,
             azimuth: None,
-            wide: None,
         }
     }
 
@@ -210,14 +207,14 @@ impl Subsurface {
     }
 
     /// The planar density of radius `r_mm` under `probe`'s strategies, mm⁻²: the lanes' mixture
-    /// of the table, averaged with the wide profile's where it draws half the radii.
+    /// of the table, mixed with the wide profile's where it draws the share [`WIDE_SHARE`].
     fn density(&self, probe: &ProbeSample<'_>, r_mm: f32) -> f32 {
         let own = Self::mixture(&self.table, &probe.lanes, &probe.c, r_mm);
-        match (&self.wide, &probe.wide) {
-            (Some(wide), Some((lanes, c))) => {
+        match &probe.wide {
+            Some((wide, lanes, c)) => {
                 (1.0 - WIDE_SHARE) * own + WIDE_SHARE * Self::mixture(wide, lanes, c, r_mm)
             }
-            _ => own,
+            None => own,
         }
     }
 
@@ -245,38 +242,43 @@ impl Subsurface {
 
     /// Sample the probe segment for light that leaves at `p_o` (outward frame `frame`), from
     /// three uniforms (axis and radius wavelength, radius, azimuth), choosing probe axes by `axes`
-    /// and the radius's wavelength by `radius`. The integrator intersects the segment with the
-    /// entry point's material and hands what it found to [`Subsurface::exit_at`]; a normal probe
-    /// that found nothing goes to [`Subsurface::local_exit`] unless the material crosses
-    /// [`ProbeSample::arc_chords`] (module doc). None when the radius's wavelength has no profile.
+    /// and the radius's wavelength by `radius`; with `wide`, that wider profile draws the share
+    /// [`WIDE_SHARE`] of the radii: a defensive mixture ([Hes95], docs/physics.md §19.3), so that
+    /// no weight exceeds 1 / [`WIDE_SHARE`] times what the wide profile alone would give. The
+    /// integrator intersects the segment with the entry point's material and hands what it found
+    /// to [`Subsurface::exit_at`]; a normal probe that found nothing goes to
+    /// [`Subsurface::local_exit`] unless the material crosses [`ProbeSample::arc_chords`] (module
+    /// doc). None when the radius's wavelength has no profile.
     #[must_use]
-    pub fn sample_probe(
-        &self,
+    #[allow(clippy::too_many_arguments)] // the probe's frame, its choices and the random state
+    pub fn sample_probe<'a>(
+        &'a self,
+        wide: Option<&'a ProfileTable>,
         frame: &ProbeFrame,
         p_o: Vec3,
         axes: &ProbeAxes,
         radius: RadiusWavelength,
         wl: &SampledWavelengths,
         u: [f32; 3],
-    ) -> Option<ProbeSample<'_>> {
+    ) -> Option<ProbeSample<'a>> {
         let (axis, u_lane) = axes.choose(u[0]);
         let lanes = self.lanes(wl);
         let c = Self::lane_probabilities(wl, &lanes, radius);
-        let wide = self.wide.as_ref().map(|t| {
+        let wide = wide.map(|t| {
             let lanes: Lanes<'_> =
                 std::array::from_fn(|k| (wl.pdf()[k] > 0.0).then(|| t.at_lane(wl, k)));
             let c = Self::lane_probabilities(wl, &lanes, radius);
-            (lanes, c)
+            (t, lanes, c)
         });
         // The wide profile's share of the radii (the radius uniform split in two keeps its
         // stratification).
         let own = 1.0 - WIDE_SHARE;
-        let (table, strategy_c, u_radius) = match (&self.wide, &wide) {
-            (Some(t), Some((_, wc))) if u[1] >= own => {
-                (&**t, wc, ((u[1] - own) / WIDE_SHARE).min(ONE_MINUS_EPSILON))
+        let (table, strategy_c, u_radius) = match &wide {
+            Some((t, _, wc)) if u[1] >= own => {
+                (*t, wc, ((u[1] - own) / WIDE_SHARE).min(ONE_MINUS_EPSILON))
             }
-            (Some(_), Some(_)) => (&*self.table, &c, (u[1] / own).min(ONE_MINUS_EPSILON)),
-            _ => (&*self.table, &c, u[1]),
+            Some(_) => (&*self.table, &c, (u[1] / own).min(ONE_MINUS_EPSILON)),
+            None => (&*self.table, &c, u[1]),
         };
         // The uniform choice keeps the hero (lane 0), which is already uniform over the lanes.
         let lane = if radius == RadiusWavelength::HERO {
@@ -286,7 +288,7 @@ impl Subsurface {
         };
         let hero = wl.nm(lane);
         // The probe's sphere reaches as far as either strategy's radii.
-        let r_max = self.wide.as_ref().map_or(self.table.r_max_mm(hero), |t| {
+        let r_max = wide.as_ref().map_or(self.table.r_max_mm(hero), |(t, ..)| {
             self.table.r_max_mm(hero).max(t.r_max_mm(hero))
         });
         let r = table.sample_radius(hero, u_radius);

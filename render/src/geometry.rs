@@ -166,6 +166,12 @@ impl Geometry {
         self.triangles[triangle as usize].map(|i| self.positions[i as usize])
     }
 
+    /// The texture coordinates of triangle `triangle`'s vertices.
+    #[must_use]
+    pub fn triangle_uvs(&self, triangle: u32) -> [Vec2; 3] {
+        self.triangles[triangle as usize].map(|i| self.uvs[i as usize])
+    }
+
     /// True when something blocks the segment from `o` along unit `d` up to `tmax`.
     #[must_use]
     pub fn occluded(&self, o: Vec3, d: Vec3, tmax: f32) -> bool {

@@ -93,11 +93,47 @@ struct Row {
 
 /// Radial profiles of one material at the tabulation wavelengths (f32, for the renderer).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(from = "StoredTable")]
 pub struct ProfileTable {
     radii_mm: Vec<f32>,
     from_nm: f32,
     step_nm: f32,
     rows: Vec<Row>,
+    /// Grid steps per unit of ln r: the radii are geometric, so ln(r / r₀) times this is the
+    /// index of r's radius up to rounding.
+    #[serde(skip)]
+    steps_per_ln: f32,
+}
+
+/// What a [`ProfileTable`] stores: all but what is derived from it.
+#[derive(Deserialize)]
+struct StoredTable {
+    radii_mm: Vec<f32>,
+    from_nm: f32,
+    step_nm: f32,
+    rows: Vec<Row>,
+}
+
+impl From<StoredTable> for ProfileTable {
+    fn from(t: StoredTable) -> Self {
+        Self {
+            steps_per_ln: steps_per_ln(&t.radii_mm),
+            radii_mm: t.radii_mm,
+            from_nm: t.from_nm,
+            step_nm: t.step_nm,
+            rows: t.rows,
+        }
+    }
+}
+
+/// Grid steps per unit of ln r of geometric radii `radii_mm` (0 for fewer than two).
+fn steps_per_ln(radii_mm: &[f32]) -> f32 {
+    match radii_mm {
+        [first, .., last] if *first > 0.0 && last > first => {
+            (radii_mm.len() - 1) as f32 / (last / first).ln()
+        }
+        _ => 0.0,
+    }
 }
 
 /// A table resolved at one wavelength: its two rows, their weights and the mixed total R_tot, for
@@ -231,6 +267,7 @@ impl ProfileTable {
             })
             .collect::<Result<Vec<_>, _>>()?;
         Ok(Self {
+            steps_per_ln: steps_per_ln(&radii_mm),
             radii_mm,
             from_nm,
             step_nm,
@@ -415,7 +452,7 @@ impl ProfileTable {
     pub fn eval_each<const N: usize>(&self, at: &[Option<RowsAt<'_>>; N], r_mm: f32) -> [f32; N] {
         let r = r_mm.max(0.5 * R_MIN_MM);
         let radii = &self.radii_mm;
-        let i = radii.partition_point(|&x| x < r);
+        let i = self.radius_index(r);
         // Where r falls between two grid radii, shared by every row (beyond the grid every row
         // has ended; below its first radius the density rises linearly from 0).
         let t = (i > 0 && i < radii.len()).then(|| (r - radii[i - 1]) / (radii[i] - radii[i - 1]));
@@ -425,6 +462,26 @@ impl ProfileTable {
                 (wa * self.row_p_at(a, i, t, r) + wb * self.row_p_at(b, i, t, r)) / (2.0 * PI * r)
             })
         })
+    }
+
+    /// The index of the first grid radius ≥ `r_mm` (the grid's length when none is): guessed
+    /// from the grid's geometric spacing and corrected by comparison, so exact for any rounding.
+    #[inline]
+    fn radius_index(&self, r_mm: f32) -> usize {
+        let radii = &self.radii_mm;
+        let n = radii.len();
+        if r_mm.is_nan() {
+            return 0;
+        }
+        let guess = ((r_mm / radii[0]).ln() * self.steps_per_ln).ceil();
+        let mut i = if guess > 0.0 { (guess as usize).min(n) } else { 0 };
+        while i < n && radii[i] < r_mm {
+            i += 1;
+        }
+        while i > 0 && radii[i - 1] >= r_mm {
+            i -= 1;
+        }
+        i
     }
 
     /// Density p(r) = 2πr R(r) of one row at `r_mm`, mm⁻¹ (0 beyond the row), as
@@ -512,6 +569,29 @@ mod tests {
                     "{nm} nm, {r_mm} mm"
                 );
             }
+        }
+    }
+
+    /// The radius index guessed from the geometric spacing is the binary search's at every grid
+    /// radius, just either side of it and between, and a table read back from its stored form
+    /// guesses alike.
+    #[test]
+    fn radius_index_is_the_binary_searchs() {
+        let t = light_table();
+        let radii = t.radii_mm().to_vec();
+        let mut rs: Vec<f32> = radii.clone();
+        for &r in &radii {
+            rs.extend([r.next_down(), r.next_up(), 0.999 * r, 1.001 * r]);
+        }
+        rs.extend([0.0, 0.25 * R_MIN_MM, 2.0 * radii[radii.len() - 1]]);
+        let stored: ProfileTable = serde_json::from_str(&serde_json::to_string(&t).unwrap()).unwrap();
+        assert_eq!(stored, t);
+        for r in rs {
+            assert_eq!(
+                t.radius_index(r),
+                radii.partition_point(|&x| x < r),
+                "{r} mm"
+            );
         }
     }
 

@@ -25,6 +25,7 @@ mod lights;
 pub mod probe;
 mod subsurface;
 mod walk;
+pub mod widest;
 
 use crate::bssrdf::{ProbeAxes, RadiusWavelength};
 use crate::geometry::{SurfaceHit, offset_origin};
@@ -140,8 +141,9 @@ pub enum IntegratorKind {
 /// The state of the integrator that renders skin's body, built once per scene.
 #[derive(Debug)]
 pub enum BodyIntegrator {
-    /// The BSSRDF, with the thin-part walks of the materials whose choices ask for them.
-    Bssrdf(Option<ThinParts>),
+    /// The BSSRDF, with the thin-part walks of the materials whose choices ask for them and the
+    /// wider profile each triangle of a skin with maps mixes into its radii.
+    Bssrdf(Option<ThinParts>, widest::NearbyWidest),
     /// The volumetric walk through each skin material's meshes.
     Volumetric(Volumetric),
 }
@@ -151,8 +153,22 @@ impl BodyIntegrator {
     #[must_use]
     pub fn build(scene: &Scene, kind: IntegratorKind) -> Self {
         match kind {
-            IntegratorKind::Bssrdf => Self::Bssrdf(ThinParts::build(scene)),
+            IntegratorKind::Bssrdf => Self::Bssrdf(
+                ThinParts::build(scene),
+                widest::NearbyWidest::build(scene),
+            ),
             IntegratorKind::Volumetric => Self::Volumetric(Volumetric::build(scene)),
+        }
+    }
+
+    /// The node of the wider profile that triangle `triangle`'s BSSRDF mixes into its radii
+    /// ([`widest::NearbyWidest`]).
+    #[must_use]
+    #[inline]
+    pub fn widest_node(&self, triangle: u32) -> Option<usize> {
+        match self {
+            Self::Bssrdf(_, widest) => widest.node(triangle),
+            Self::Volumetric(_) => None,
         }
     }
 
@@ -160,7 +176,7 @@ impl BodyIntegrator {
     #[must_use]
     pub fn thin_parts(&self) -> Option<&ThinParts> {
         match self {
-            Self::Bssrdf(thin) => thin.as_ref(),
+            Self::Bssrdf(thin, _) => thin.as_ref(),
             Self::Volumetric(_) => None,
         }
     }
@@ -176,10 +192,10 @@ impl BodyIntegrator {
     ) -> Option<&SkinVolume> {
         match self {
             Self::Volumetric(v) => v.medium(si.material),
-            Self::Bssrdf(Some(thin)) if q_sss > 0.0 => {
+            Self::Bssrdf(Some(thin), _) if q_sss > 0.0 => {
                 thin.walk_at(scene, si, ng, footprint_mm, rays)
             }
-            Self::Bssrdf(_) => None,
+            Self::Bssrdf(..) => None,
         }
     }
 }

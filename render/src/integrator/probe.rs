@@ -4,7 +4,8 @@
 
 use crate::accel::{TriHit, ray};
 use crate::bssrdf::{
-    Exit, MAX_PROBE_HITS, ProbeAxes, ProbeFrame, ProbeSample, RadiusWavelength, Subsurface,
+    Exit, MAX_PROBE_HITS, ProbeAxes, ProbeFrame, ProbeSample, ProfileTable, RadiusWavelength,
+    Subsurface,
 };
 use crate::geometry::Geometry;
 use crate::spectrum::SampledWavelengths;
@@ -12,7 +13,8 @@ use glam::Vec3;
 
 /// Sample where light that leaves at `p_o` (outward frame `frame`, on material `material`)
 /// entered, from four uniforms, choosing probe axes by `axes` and the radius's wavelength by
-/// `radius`: probe `ss`'s segment through `geometry`, keep every hit on the material, pick one
+/// `radius`: probe `ss`'s segment (in a defensive mixture with `wide`'s radii where given,
+/// [`Subsurface::sample_probe`]) through `geometry`, keep every hit on the material, pick one
 /// uniformly. `flipped` tells that the entry frame faces against the mesh's vertex normals;
 /// `rays` counts probe rays. None when the probe found nothing usable (a tangent probe missing
 /// is expected and unbiased, `crate::bssrdf` module doc).
@@ -21,6 +23,7 @@ use glam::Vec3;
 pub fn sample_exit(
     geometry: &Geometry,
     ss: &Subsurface,
+    wide: Option<&ProfileTable>,
     material: u32,
     p_o: Vec3,
     frame: &ProbeFrame,
@@ -31,7 +34,7 @@ pub fn sample_exit(
     u: [f32; 4],
     rays: &mut u64,
 ) -> Option<Exit> {
-    let probe = ss.sample_probe(frame, p_o, axes, radius, wl, [u[0], u[1], u[2]])?;
+    let probe = ss.sample_probe(wide, frame, p_o, axes, radius, wl, [u[0], u[1], u[2]])?;
     let at = (p_o, frame, axes);
     let pr = probe.segment;
     *rays += 1;
@@ -177,6 +180,7 @@ mod tests {
             if let Some(e) = sample_exit(
                 &geo,
                 &ss,
+                None,
                 0,
                 Vec3::ZERO,
                 &FRAME,
@@ -228,6 +232,7 @@ mod tests {
             if let Some(e) = sample_exit(
                 geo,
                 ss,
+                None,
                 0,
                 Vec3::ZERO,
                 &FRAME,

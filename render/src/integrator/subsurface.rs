@@ -208,15 +208,19 @@ impl PathTracer<'_> {
         ];
         let si = &hit.si;
         let flipped = hit.ns.dot(si.ns) < 0.0;
-        // With maps, radii follow the profile of the skin the light leaves.
-        let ss = skin
-            .maps
-            .as_ref()
-            .and_then(|m| m.sampling_at(si.uv))
-            .unwrap_or(ss);
+        // With maps, radii follow the profile of the skin the light leaves, mixed with the
+        // widest within the probe's reach (the grid's widest where that is not known).
+        let (ss, wide) = match skin.maps.as_ref().and_then(|m| Some((m, m.sampling_at(si.uv)?))) {
+            Some((maps, own)) => {
+                let near = self.body.widest_node(si.triangle);
+                (own, Some(near.and_then(|n| maps.node_table(n)).unwrap_or(&*ss.table)))
+            }
+            None => (ss, None),
+        };
         let exit = probe::sample_exit(
             &scene.geometry,
             ss,
+            wide,
             si.material,
             si.p,
             &frame,

@@ -55,7 +55,7 @@ impl PathTracer<'_> {
             volumetric::hero_only(path.beta)
         };
         let beta_exit = beta_hero * (exit.weight * t_o);
-        let thin = matches!(self.body, BodyIntegrator::Bssrdf(_));
+        let thin = matches!(self.body, BodyIntegrator::Bssrdf(..));
         if thin && self.settings.thin_exit == ThinExit::LightSampled {
             // The walk chose to leave here (with probability T(θ) at its own direction): its
             // weight is the energy leaving, which S_ω spreads over the outgoing directions.

@@ -200,10 +200,10 @@ impl SkinMaps {
     /// The BSSRDF that samples radii for light leaving at the texel of `uv`: the material's
     /// with the profile of the low corner of that texel's cell (`ProfileGrid::low_corner`), which
     /// follows the texel's own profile and so every combined profile the rules `exit` and
-    /// `geometric` give (both vanish where the exit's does), in a defensive mixture with the
-    /// grid's widest profile ([`crate::bssrdf::WIDE_SHARE`]); `None` to sample from the grid's
-    /// widest profile (the rules `entry` and `mean`, or a grid over β_m). A radius weight
-    /// R_het / R_sample near 1 keeps strongly absorbing texels as quiet as uniform skin
+    /// `geometric` give (both vanish where the exit's does); the integrator mixes it with a wider
+    /// profile ([`SkinMaps::widest_node`], [`crate::bssrdf::WIDE_SHARE`]). `None` to sample from
+    /// the grid's widest profile (the rules `entry` and `mean`, or a grid over β_m). A radius
+    /// weight R_het / R_sample near 1 keeps strongly absorbing texels as quiet as uniform skin
     /// (docs/physics.md §19.3).
     #[must_use]
     #[inline]
@@ -219,6 +219,42 @@ impl SkinMaps {
             _ => self.grid.low_corner(p)?,
         };
         self.sampling.get(index)
+    }
+
+    /// The node (an index over `grid`'s nodes, then `thin_grid`'s) whose profile is at least as
+    /// wide as that of any skin with parameters at or above `lo` = (C_m, β_m, C_h): the low
+    /// corner of `lo`'s cell, in the thin epidermis' grid where `thin` skin is among it, in the
+    /// material's where `thick` skin is, the farther reaching of the two where both are. R(r)
+    /// falls with σa at every r (every path's weight does), so that profile bounds theirs.
+    /// `None` when the BSSRDF samples from the grid's widest profile ([`SkinMaps::sampling_at`]).
+    #[must_use]
+    pub fn widest_node(&self, lo: [f32; 3], thin: bool, thick: bool) -> Option<usize> {
+        if self.sampling.is_empty() {
+            return None;
+        }
+        let thick_node = thick.then(|| self.grid.low_corner(lo)).flatten();
+        let thin_node = match &self.thin_grid {
+            Some(g) if thin => g.low_corner(lo).map(|i| self.grid.tables().len() + i),
+            _ => None,
+        };
+        let reach = |i: usize| self.sampling[i].table.largest_radius_for_energy_mm(1.0);
+        match (thick_node, thin_node) {
+            (Some(a), Some(b)) => Some(if reach(b) > reach(a) { b } else { a }),
+            (a, b) => a.or(b),
+        }
+    }
+
+    /// Whether the BSSRDF draws radii from each texel's node ([`SkinMaps::sampling_at`]).
+    #[must_use]
+    pub fn samples_per_node(&self) -> bool {
+        !self.sampling.is_empty()
+    }
+
+    /// The profile of node `node` ([`SkinMaps::widest_node`]).
+    #[must_use]
+    #[inline]
+    pub fn node_table(&self, node: usize) -> Option<&crate::bssrdf::ProfileTable> {
+        self.sampling.get(node).map(|s| &*s.table)
     }
 
     /// The epidermis thickness at the texel of `uv`, mm: the thin one where the texel is thin,
@@ -376,7 +412,6 @@ impl super::SkinMaterial {
                 .chain(thin_grid.iter().flat_map(ProfileGrid::tables))
                 .map(|t| crate::bssrdf::Subsurface {
                     table: t.clone(),
-                    wide: Some(ss.table.clone()),
                     ..ss.clone()
                 })
                 .collect(),

@@ -126,6 +126,12 @@ impl ThinEpidermisMap {
     pub fn range(&self) -> [[f32; 2]; 3] {
         self.range
     }
+
+    /// [lo, hi] of the filtered flag ([`Self::at`]) at uv in [u₀, u₁] × [v₀, v₁].
+    #[must_use]
+    pub fn flag_range_over(&self, u: [f32; 2], v: [f32; 2]) -> [f32; 2] {
+        self.flag.range_over(u, v)[0]
+    }
 }
 
 /// What the scene gives for a skin's maps, before assembly.
