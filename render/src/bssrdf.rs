@@ -78,14 +78,26 @@ pub const ARC_SEGMENTS: usize = 8;
 /// The profile table resolved at a path's wavelengths, one entry per lane.
 type Lanes<'a> = [Option<RowsAt<'a>>; N_WAVELENGTHS];
 
-/// Share of the radii the wide profile draws where a skin samples from a narrower one (the
+/// Most of the radii the wide profile draws where a skin samples from a narrower one (the
 /// `wide` table of [`Subsurface::sample_probe`]): light entering far from a strongly absorbing
-/// exit otherwise comes
-/// with weights up to the two profiles' ratio (700× across the split slab of
-/// `the_geometric_rule_is_reciprocal_on_the_split_slab`, whose far side reads 1.7σ from 0 with
-/// no share, 2σ with 0.1 and 3σ with 0.25). The default image's skin noise at 60 s for each
-/// share: BENCHMARKS.md, "The default image: noise in 60 s".
+/// exit otherwise comes with weights up to the two profiles' ratio (700× across the split slab
+/// of `the_geometric_rule_is_reciprocal_on_the_split_slab`, whose far side reads 1.7σ from 0 with
+/// no share, 2σ with 0.1 and 3σ with 0.25). The share itself is [`wide_share`].
 pub const WIDE_SHARE: f32 = 0.5;
+
+/// The share of the radii a wide profile of luminance-weighted total `wide_total` draws beside
+/// an own profile of `own_total` (docs/physics.md §19.3): the part of the wide profile's
+/// energy the own profile lacks, 1 − R_own / R_wide, at most [`WIDE_SHARE`]. Where the two skins
+/// differ little the wide profile has little to defend against and would only spend samples
+/// at radii the own profile already covers; where they differ much it draws the most.
+#[must_use]
+pub fn wide_share(own_total: f32, wide_total: f32) -> f32 {
+    if wide_total > 0.0 && own_total >= 0.0 {
+        (1.0 - own_total / wide_total).clamp(0.0, WIDE_SHARE)
+    } else {
+        WIDE_SHARE
+    }
+}
 
 /// The largest f32 below 1: a uniform rescaled from part of [0, 1) stays below 1.
 const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;
@@ -116,6 +128,9 @@ pub struct Exit {
     pub hit: Option<SurfaceHit>,
     /// Spatial weight per wavelength, R(r) · N / pdf (dimensionless: mm⁻² / mm⁻²).
     pub weight: SampledSpectrum,
+    /// The spatial weight per unit of the profile R(r): N / pdf, times the curvature term where
+    /// the model has one, per wavelength (mm²); a skin with maps multiplies its own R(r) by it.
+    pub per_profile: SampledSpectrum,
     /// The distance r the weight's R(r) was read at, mm (the probe's radius for the local
     /// fallback).
     pub r_mm: f32,
@@ -128,9 +143,10 @@ pub struct ProbeSample<'a> {
     pub segment: Probe,
     lanes: Lanes<'a>,
     c: [f32; N_WAVELENGTHS],
-    /// The wide profile, its lanes and lane probabilities, when it draws the share
-    /// [`WIDE_SHARE`] of the radii.
+    /// The wide profile, its lanes and lane probabilities, when it draws part of the radii.
     wide: Option<(&'a ProfileTable, Lanes<'a>, [f32; N_WAVELENGTHS])>,
+    /// The share of the radii the wide profile draws ([`wide_share`]).
+    share: f32,
     /// Each lane's curvature κ, mm⁻¹ (0 without the curvature term).
     kappa: [f32; N_WAVELENGTHS],
 }
@@ -207,14 +223,14 @@ impl Subsurface {
     }
 
     /// The planar density of radius `r_mm` under `probe`'s strategies, mm⁻²: the lanes' mixture
-    /// of the table, mixed with the wide profile's where it draws the share [`WIDE_SHARE`].
+    /// of the table, mixed with the wide profile's where it draws part of the radii.
     fn density(&self, probe: &ProbeSample<'_>, r_mm: f32) -> f32 {
         let own = Self::mixture(&self.table, &probe.lanes, &probe.c, r_mm);
         match &probe.wide {
-            Some((wide, lanes, c)) => {
-                (1.0 - WIDE_SHARE) * own + WIDE_SHARE * Self::mixture(wide, lanes, c, r_mm)
+            Some((wide, lanes, c)) if probe.share > 0.0 => {
+                (1.0 - probe.share) * own + probe.share * Self::mixture(wide, lanes, c, r_mm)
             }
-            None => own,
+            _ => own,
         }
     }
 
@@ -243,8 +259,8 @@ impl Subsurface {
     /// Sample the probe segment for light that leaves at `p_o` (outward frame `frame`), from
     /// three uniforms (axis and radius wavelength, radius, azimuth), choosing probe axes by `axes`
     /// and the radius's wavelength by `radius`; with `wide`, that wider profile draws the share
-    /// [`WIDE_SHARE`] of the radii: a defensive mixture ([Hes95], docs/physics.md §19.3), so that
-    /// no weight exceeds 1 / [`WIDE_SHARE`] times what the wide profile alone would give. The
+    /// [`wide_share`] of the radii: a defensive mixture ([Hes95], docs/physics.md §19.3), so that
+    /// no weight exceeds 1 / share times what the wide profile alone would give. The
     /// integrator intersects the segment with the entry point's material and hands what it found
     /// to [`Subsurface::exit_at`]; a normal probe that found nothing goes to
     /// [`Subsurface::local_exit`] unless the material crosses [`ProbeSample::arc_chords`] (module
@@ -270,15 +286,26 @@ impl Subsurface {
             let c = Self::lane_probabilities(wl, &lanes, radius);
             (t, lanes, c)
         });
-        // The wide profile's share of the radii (the radius uniform split in two keeps its
-        // stratification).
-        let own = 1.0 - WIDE_SHARE;
-        let (table, strategy_c, u_radius) = match &wide {
-            Some((t, _, wc)) if u[1] >= own => {
-                (*t, wc, ((u[1] - own) / WIDE_SHARE).min(ONE_MINUS_EPSILON))
+        // The wide profile's share of the radii, from the luminance-weighted totals at the
+        // path's wavelengths (the radius uniform split in two keeps its stratification).
+        let share = wide.as_ref().map_or(0.0, |(_, wide_lanes, _)| {
+            let y = wl.luminance_weights();
+            let (mut own_total, mut wide_total) = (0.0, 0.0);
+            for k in 0..N_WAVELENGTHS {
+                if let (Some(y), Some(o), Some(w)) = (y[k], lanes[k], wide_lanes[k]) {
+                    own_total += y * o.total();
+                    wide_total += y * w.total();
+                }
             }
-            Some(_) => (&*self.table, &c, (u[1] / own).min(ONE_MINUS_EPSILON)),
-            None => (&*self.table, &c, u[1]),
+            wide_share(own_total, wide_total)
+        });
+        let own = 1.0 - share;
+        let (table, strategy_c, u_radius) = match &wide {
+            Some((t, _, wc)) if share > 0.0 && u[1] >= own => {
+                (*t, wc, ((u[1] - own) / share).min(ONE_MINUS_EPSILON))
+            }
+            Some(_) if share > 0.0 => (&*self.table, &c, (u[1] / own).min(ONE_MINUS_EPSILON)),
+            _ => (&*self.table, &c, u[1]),
         };
         // The uniform choice keeps the hero (lane 0), which is already uniform over the lanes.
         let lane = if radius == RadiusWavelength::HERO {
@@ -288,9 +315,10 @@ impl Subsurface {
         };
         let hero = wl.nm(lane);
         // The probe's sphere reaches as far as either strategy's radii.
-        let r_max = wide.as_ref().map_or(self.table.r_max_mm(hero), |(t, ..)| {
-            self.table.r_max_mm(hero).max(t.r_max_mm(hero))
-        });
+        let r_max = match &wide {
+            Some((t, ..)) if share > 0.0 => self.table.r_max_mm(hero).max(t.r_max_mm(hero)),
+            _ => self.table.r_max_mm(hero),
+        };
         let r = table.sample_radius(hero, u_radius);
         if r_max.is_nan() || r_max <= 0.0 {
             return None;
@@ -309,6 +337,7 @@ impl Subsurface {
             lanes,
             c,
             wide,
+            share,
             kappa,
         })
     }
@@ -339,11 +368,11 @@ impl Subsurface {
         if pdf.is_nan() || pdf <= 0.0 {
             return None;
         }
-        let mut weight = self.weight(&probe.lanes, dist, hits as f32 / pdf);
+        let mut per_profile = SampledSpectrum::splat(hits as f32 / pdf);
         if self.curvature.is_some()
             && let Some(h) = curvature::depth_below_tangent_mm(p_o, frame.n, s.p, ns)
         {
-            for (w, &k) in weight.0.iter_mut().zip(&probe.kappa) {
+            for (w, &k) in per_profile.0.iter_mut().zip(&probe.kappa) {
                 *w *= curvature::factor(k, h);
             }
         }
@@ -352,7 +381,8 @@ impl Subsurface {
             ng,
             ns,
             hit: Some(s),
-            weight,
+            weight: self.weight(&probe.lanes, dist, 1.0) * per_profile,
+            per_profile,
             r_mm: dist,
         })
     }
@@ -367,18 +397,33 @@ impl Subsurface {
     ) -> Exit {
         let r = probe.segment.r_mm;
         let pdf = axes.p_normal() * self.density(probe, r);
-        let weight = if pdf > 0.0 {
-            self.weight(&probe.lanes, r, 1.0 / pdf)
-        } else {
-            SampledSpectrum::zero()
-        };
+        let per_profile = SampledSpectrum::splat(if pdf > 0.0 { 1.0 / pdf } else { 0.0 });
         Exit {
             p: p_o,
             ng: frame.n,
             ns: frame.n,
             hit: None,
-            weight,
+            weight: self.weight(&probe.lanes, r, 1.0) * per_profile,
+            per_profile,
             r_mm: r,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The wide profile's share: none where it is the own profile, half where the own profile
+    /// holds at most half its energy, the energy the own profile lacks in between, and half
+    /// where the totals give no answer.
+    #[test]
+    fn wide_share_follows_the_energy_the_own_profile_lacks() {
+        assert_eq!(wide_share(0.4, 0.4), 0.0);
+        assert_eq!(wide_share(0.5, 0.4), 0.0);
+        assert!((wide_share(0.3, 0.4) - 0.25).abs() < 1e-6);
+        assert_eq!(wide_share(0.1, 0.4), WIDE_SHARE);
+        assert_eq!(wide_share(0.1, 0.0), WIDE_SHARE);
+        assert_eq!(wide_share(f32::NAN, 0.4), WIDE_SHARE);
     }
 }

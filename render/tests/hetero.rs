@@ -400,3 +400,97 @@ fn melanin_ita_deg_gives_the_typical_skin_that_ita() {
         );
     }
 }
+
+/// On a 240-mm sheet of C_m 0.3 skin (60 × 60 quads) with a 2-mm disc of C_m 0.02, the wider
+/// profile each triangle mixes into its radii (`NearbyWidest`) is the light skin's wherever a
+/// point of the triangle lies within the probes' reach R of the disc (the last tabulated radius of
+/// the grid's widest profile), so its weights stay bounded there; and the dark skin's own node
+/// beyond 3R plus the cells' edge, where no probe can reach light skin: the bound is local.
+#[test]
+fn the_widest_within_reach_covers_the_light_skin_it_can_reach_and_no_farther() {
+    use render::integrator::widest::NearbyWidest;
+    use render::material::Material;
+    let dir = tempfile::tempdir().unwrap();
+    let (side, n) = (240.0f32, 60usize);
+    let mut obj = String::new();
+    for j in 0..=n {
+        for i in 0..=n {
+            let (x, y) = (
+                -0.5 * side + side * i as f32 / n as f32,
+                -0.5 * side + side * j as f32 / n as f32,
+            );
+            obj += &format!(
+                "v {x} {y} 0\nvt {} {}\n",
+                (x + 0.5 * side) / side,
+                (0.5 * side - y) / side
+            );
+        }
+    }
+    obj += "vn 0 0 1\n";
+    for j in 0..n {
+        for i in 0..n {
+            let v = |a: usize, b: usize| 1 + a + (n + 1) * b;
+            let (p, q, r, s) = (v(i, j), v(i + 1, j), v(i + 1, j + 1), v(i, j + 1));
+            obj += &format!("f {p}/{p}/1 {q}/{q}/1 {r}/{r}/1\nf {p}/{p}/1 {r}/{r}/1 {s}/{s}/1\n");
+        }
+    }
+    std::fs::write(dir.path().join("sheet.obj"), obj).unwrap();
+    let (texels, disc) = (480usize, glam::Vec2::new(40.0, 0.0));
+    let values = (0..texels * texels)
+        .map(|k| {
+            let (i, j) = (k % texels, k / texels);
+            let x = -0.5 * side + (i as f32 + 0.5) * side / texels as f32;
+            let y = 0.5 * side - (j as f32 + 0.5) * side / texels as f32;
+            if glam::Vec2::new(x, y).distance(disc) <= 2.0 {
+                0.02
+            } else {
+                0.3
+            }
+        })
+        .collect();
+    std::fs::write(
+        dir.path().join("maps.exr"),
+        exr_bytes(texels, texels, vec![("melanin", values)]),
+    )
+    .unwrap();
+    let text = "[camera]\nposition_mm = [0, 0, 400]\nlook_at_mm = [0, 0, 0]\nfov_deg = 10\n\
+                [materials.skin]\ntype = \"skin\"\nmaps = \"maps.exr\"\n\
+                [[meshes]]\nfile = \"sheet.obj\"\nmaterial = \"skin\"\n";
+    let scene =
+        Scene::from_toml(text, "sheet.toml", Some(dir.path()), &SkinKnobs::default()).unwrap();
+    let Material::Skin(skin) = &scene.materials[0] else {
+        panic!("skin expected")
+    };
+    let maps = skin.maps.as_ref().unwrap();
+    let reach = skin
+        .subsurface
+        .as_ref()
+        .unwrap()
+        .table
+        .largest_radius_for_energy_mm(1.0);
+    let light = maps.grid.low_corner([0.02, 0.5, 0.0]).unwrap();
+    let dark = maps.grid.low_corner([0.3, 0.5, 0.0]).unwrap();
+    assert_ne!(light, dark);
+    let widest = NearbyWidest::build(&scene);
+    let (mut near, mut far) = (0, 0);
+    for t in 0..scene.geometry.triangle_count() as u32 {
+        let p = scene.geometry.triangle(t);
+        let distance = |q: glam::Vec3| q.truncate().distance(disc) - 2.0;
+        let nearest = p.iter().map(|&q| distance(q)).fold(f32::INFINITY, f32::min);
+        let node = widest.node(t).expect("a node per triangle");
+        if nearest < reach - 0.5 * side / n as f32 {
+            near += 1;
+            assert_eq!(
+                node, light,
+                "triangle {t}, {nearest} mm from the disc (R {reach} mm)"
+            );
+        } else if nearest > 3.0 * reach + 2.0 * side / n as f32 {
+            far += 1;
+            assert_eq!(
+                node, dark,
+                "triangle {t}, {nearest} mm from the disc (R {reach} mm)"
+            );
+        }
+    }
+    assert!(near > 4 && far > 1000, "{near} near, {far} far");
+}

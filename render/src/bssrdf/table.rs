@@ -473,8 +473,9 @@ impl ProfileTable {
         if r_mm.is_nan() {
             return 0;
         }
-        let guess = ((r_mm / radii[0]).ln() * self.steps_per_ln).ceil();
-        let mut i = if guess > 0.0 { (guess as usize).min(n) } else { 0 };
+        // Truncation (a saturating cast) lands at most one index low; the loops correct it.
+        let guess = (r_mm / radii[0]).ln() * self.steps_per_ln;
+        let mut i = (guess as usize).min(n);
         while i < n && radii[i] < r_mm {
             i += 1;
         }
@@ -584,7 +585,8 @@ mod tests {
             rs.extend([r.next_down(), r.next_up(), 0.999 * r, 1.001 * r]);
         }
         rs.extend([0.0, 0.25 * R_MIN_MM, 2.0 * radii[radii.len() - 1]]);
-        let stored: ProfileTable = serde_json::from_str(&serde_json::to_string(&t).unwrap()).unwrap();
+        let stored: ProfileTable =
+            serde_json::from_str(&serde_json::to_string(&t).unwrap()).unwrap();
         assert_eq!(stored, t);
         for r in rs {
             assert_eq!(

@@ -153,10 +153,9 @@ impl BodyIntegrator {
     #[must_use]
     pub fn build(scene: &Scene, kind: IntegratorKind) -> Self {
         match kind {
-            IntegratorKind::Bssrdf => Self::Bssrdf(
-                ThinParts::build(scene),
-                widest::NearbyWidest::build(scene),
-            ),
+            IntegratorKind::Bssrdf => {
+                Self::Bssrdf(ThinParts::build(scene), widest::NearbyWidest::build(scene))
+            }
             IntegratorKind::Volumetric => Self::Volumetric(Volumetric::build(scene)),
         }
     }

@@ -210,10 +210,17 @@ impl PathTracer<'_> {
         let flipped = hit.ns.dot(si.ns) < 0.0;
         // With maps, radii follow the profile of the skin the light leaves, mixed with the
         // widest within the probe's reach (the grid's widest where that is not known).
-        let (ss, wide) = match skin.maps.as_ref().and_then(|m| Some((m, m.sampling_at(si.uv)?))) {
+        let (ss, wide) = match skin
+            .maps
+            .as_ref()
+            .and_then(|m| Some((m, m.sampling_at(si.uv)?)))
+        {
             Some((maps, own)) => {
                 let near = self.body.widest_node(si.triangle);
-                (own, Some(near.and_then(|n| maps.node_table(n)).unwrap_or(&*ss.table)))
+                (
+                    own,
+                    Some(near.and_then(|n| maps.node_table(n)).unwrap_or(&*ss.table)),
+                )
             }
             None => (ss, None),
         };
@@ -235,7 +242,7 @@ impl PathTracer<'_> {
         if let Some(maps) = &skin.maps {
             // The profile of the skin at both ends instead of the texture's modulation.
             let uv_i = exit.hit.map_or(si.uv, |h| h.uv);
-            let weight = exit.weight * maps.reweight(&ss.table, wl, uv_i, si.uv, exit.r_mm) * t_o;
+            let weight = maps.profile(wl, uv_i, si.uv, exit.r_mm) * exit.per_profile * t_o;
             return (!weight.is_black() && weight.is_finite()).then_some((exit, weight));
         }
         let m_o = skin.texture_factor(si.uv, &scene.textures);

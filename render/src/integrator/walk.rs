@@ -65,6 +65,7 @@ impl PathTracer<'_> {
                 ns: exit.ng,
                 hit: None,
                 weight: SampledSpectrum::splat(1.0),
+                per_profile: SampledSpectrum::splat(1.0),
                 r_mm: (exit.p - hit.si.p).length(),
             };
             let (direct, lit) = self.exit_light(

@@ -83,16 +83,19 @@ impl NearbyWidest {
                 .map(|&t| {
                     let p = geometry.triangle(t);
                     let uv = geometry.triangle_uvs(t);
-                    let u = [uv[0].x.min(uv[1].x).min(uv[2].x), uv[0].x.max(uv[1].x).max(uv[2].x)];
-                    let v = [uv[0].y.min(uv[1].y).min(uv[2].y), uv[0].y.max(uv[1].y).max(uv[2].y)];
+                    let u = [
+                        uv[0].x.min(uv[1].x).min(uv[2].x),
+                        uv[0].x.max(uv[1].x).max(uv[2].x),
+                    ];
+                    let v = [
+                        uv[0].y.min(uv[1].y).min(uv[2].y),
+                        uv[0].y.max(uv[1].y).max(uv[2].y),
+                    ];
                     let range = maps.maps.range_over(u, v);
-                    let (thin, thick) = maps
-                        .maps
-                        .thin()
-                        .map_or((false, true), |th| {
-                            let [lo, hi] = th.flag_range_over(u, v);
-                            (hi >= 0.5, lo < 0.5)
-                        });
+                    let (thin, thick) = maps.maps.thin().map_or((false, true), |th| {
+                        let [lo, hi] = th.flag_range_over(u, v);
+                        (hi >= 0.5, lo < 0.5)
+                    });
                     let reach = Reach {
                         lo: std::array::from_fn(|k| range[k][0]),
                         thin,
@@ -142,7 +145,9 @@ impl Cells {
     /// Cells of edge `edge_mm` (grown until at most [`MAX_CELLS`]) over the boxes of `boxes`.
     fn new<T>(boxes: &[([Vec3; 2], T)], edge_mm: f32) -> Self {
         let lo = boxes.iter().fold(Vec3::INFINITY, |a, (b, _)| a.min(b[0]));
-        let hi = boxes.iter().fold(Vec3::NEG_INFINITY, |a, (b, _)| a.max(b[1]));
+        let hi = boxes
+            .iter()
+            .fold(Vec3::NEG_INFINITY, |a, (b, _)| a.max(b[1]));
         let mut edge_mm = edge_mm;
         let dims = loop {
             let d = ((hi - lo) / edge_mm).floor().as_ivec3() + IVec3::ONE;

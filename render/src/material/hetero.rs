@@ -6,7 +6,7 @@
 use super::maps::ChromophoreMaps;
 use crate::bssrdf::{Corners, ProfileGrid};
 use crate::media::{MediaError, SkinMedia};
-use crate::spectrum::{N_WAVELENGTHS, SampledSpectrum, SampledWavelengths, SpectrumTable};
+use crate::spectrum::{SampledSpectrum, SampledWavelengths, SpectrumTable};
 use glam::Vec2;
 use skin_optics::SkinParams;
 use std::fmt;
@@ -288,31 +288,6 @@ impl SkinMaps {
         let [at_o, at_i] = self.corners(uv_o).eval_pair(&self.corners(uv_i), wl, r_mm);
         SampledSpectrum(std::array::from_fn(|k| {
             self.blend.combine(at_i.0[k], at_o.0[k])
-        }))
-    }
-
-    /// The factor turning a BSSRDF sample drawn and weighted with `table` (the widest profile)
-    /// into one of this skin: R_het(r) / R_table(r) per lane for a path from `uv_i` (entry) to
-    /// `uv_o` (exit), 0 where the table's profile is 0.
-    #[must_use]
-    pub fn reweight(
-        &self,
-        table: &crate::bssrdf::ProfileTable,
-        wl: &SampledWavelengths,
-        uv_i: Vec2,
-        uv_o: Vec2,
-        r_mm: f32,
-    ) -> SampledSpectrum {
-        let het = self.profile(wl, uv_i, uv_o, r_mm);
-        let lanes: [_; N_WAVELENGTHS] =
-            std::array::from_fn(|k| (wl.pdf()[k] > 0.0).then(|| table.at_lane(wl, k)));
-        let base = table.eval_each(&lanes, r_mm);
-        SampledSpectrum(std::array::from_fn(|k| {
-            if base[k] > 0.0 {
-                het.0[k] / base[k]
-            } else {
-                0.0
-            }
         }))
     }
 
