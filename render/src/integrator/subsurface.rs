@@ -9,6 +9,7 @@
 use super::lights::{LightProbabilities, PrevVertex, Receiver, direct_light, light_probabilities};
 use super::{Path, PathTracer, Random, Shading, Step, dims, probe, russian_roulette};
 use crate::bssrdf::{Exit, ProbeFrame, Subsurface, texture_modulation};
+use crate::material::hetero::ExitTexel;
 use crate::material::{Material, SkinMaterial};
 use crate::sampler::PathSampler;
 use crate::sampling::cosine_hemisphere;
@@ -76,7 +77,15 @@ impl PathTracer<'_> {
         let Some(ss) = &skin.subsurface else {
             return Step::Surface;
         };
-        let found = self.subsurface_exit(skin, ss, hit, wl, (&mut *sampler, &mut *rays));
+        // The exit texel is read once for every probe at this hit.
+        let texel = skin.maps.as_ref().map(|m| m.exit_texel(hit.si.uv));
+        let found = self.subsurface_exit(
+            skin,
+            (ss, texel.as_ref()),
+            hit,
+            wl,
+            (&mut *sampler, &mut *rays),
+        );
         let outgoing = Outgoing::new(hit.wo, hit.ns);
         // Further probes at the same skin hit (splitting): each gathers the light at its own exit
         // point from its own scrambled sequence; the mean over the probes is the estimate, and
@@ -94,9 +103,13 @@ impl PathTracer<'_> {
         if probes > 1 && hit.q_sss > 0.0 {
             for k in 1..probes {
                 let mut fork = sampler.fork(k);
-                if let Some((exit, w)) =
-                    self.subsurface_exit(skin, ss, hit, wl, (&mut fork, &mut *rays))
-                {
+                if let Some((exit, w)) = self.subsurface_exit(
+                    skin,
+                    (ss, texel.as_ref()),
+                    hit,
+                    wl,
+                    (&mut fork, &mut *rays),
+                ) {
                     let (direct, _) = self.exit_light(
                         ss,
                         &exit,
@@ -187,7 +200,7 @@ impl PathTracer<'_> {
     fn subsurface_exit(
         &self,
         skin: &SkinMaterial,
-        ss: &Subsurface,
+        (ss, texel): (&Subsurface, Option<&ExitTexel<'_>>),
         hit: &Shading<'_>,
         wl: &SampledWavelengths,
         (sampler, rays): Random<'_>,
@@ -210,11 +223,7 @@ impl PathTracer<'_> {
         let flipped = hit.ns.dot(si.ns) < 0.0;
         // With maps, radii follow the profile of the skin the light leaves, mixed with the
         // widest within the probe's reach (the grid's widest where that is not known).
-        let (ss, wide) = match skin
-            .maps
-            .as_ref()
-            .and_then(|m| Some((m, m.sampling_at(si.uv)?)))
-        {
+        let (ss, wide) = match skin.maps.as_ref().zip(texel.and_then(|t| t.sampling)) {
             Some((maps, own)) => {
                 let near = self.body.widest_node(si.triangle);
                 (
@@ -239,10 +248,10 @@ impl PathTracer<'_> {
             rays,
         )?;
         let t_o = ss.directional.factors(hit.wo.dot(hit.ns), wl);
-        if let Some(maps) = &skin.maps {
+        if let (Some(maps), Some(texel)) = (&skin.maps, texel) {
             // The profile of the skin at both ends instead of the texture's modulation.
             let uv_i = exit.hit.map_or(si.uv, |h| h.uv);
-            let weight = maps.profile(wl, uv_i, si.uv, exit.r_mm) * exit.per_profile * t_o;
+            let weight = maps.profile(wl, uv_i, texel, exit.r_mm) * exit.per_profile * t_o;
             return (!weight.is_black() && weight.is_finite()).then_some((exit, weight));
         }
         let m_o = skin.texture_factor(si.uv, &scene.textures);

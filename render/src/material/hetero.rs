@@ -159,6 +159,16 @@ impl CornersAt {
     }
 }
 
+/// The texel light leaves at, as the BSSRDF reads it ([`SkinMaps::exit_texel`]).
+#[derive(Debug, Clone, Copy)]
+pub struct ExitTexel<'a> {
+    /// The profile grid's corners at the texel's parameters.
+    pub corners: Corners<'a>,
+    /// The BSSRDF that samples radii there (`None`: the material's, from the grid's widest
+    /// profile).
+    pub sampling: Option<&'a crate::bssrdf::Subsurface>,
+}
+
 /// A skin material's maps and what is built from them.
 #[derive(Debug, Clone)]
 pub struct SkinMaps {
@@ -208,17 +218,30 @@ impl SkinMaps {
     #[must_use]
     #[inline]
     pub fn sampling_at(&self, uv: Vec2) -> Option<&crate::bssrdf::Subsurface> {
-        if self.sampling.is_empty() {
-            return None;
-        }
+        self.exit_texel(uv).sampling
+    }
+
+    /// What the BSSRDF reads of the texel of `uv` where light leaves: its profile's corners
+    /// ([`SkinMaps::corners`]) and the BSSRDF that samples its radii ([`SkinMaps::sampling_at`]),
+    /// from one look-up of the maps.
+    #[must_use]
+    #[inline]
+    pub fn exit_texel(&self, uv: Vec2) -> ExitTexel<'_> {
         let p = self.maps.at(uv);
-        let index = match (&self.thin_grid, self.maps.thin()) {
-            (Some(grid), Some(thin)) if thin.is_thin(uv) => {
-                self.grid.tables().len() + grid.low_corner(p)?
-            }
-            _ => self.grid.low_corner(p)?,
+        let (grid, offset) = match (&self.thin_grid, self.maps.thin()) {
+            (Some(grid), Some(thin)) if thin.is_thin(uv) => (grid, self.grid.tables().len()),
+            _ => (&self.grid, 0),
         };
-        self.sampling.get(index)
+        let sampling = if self.sampling.is_empty() {
+            None
+        } else {
+            grid.low_corner(p)
+                .and_then(|i| self.sampling.get(offset + i))
+        };
+        ExitTexel {
+            corners: grid.corners(p),
+            sampling,
+        }
     }
 
     /// The node (an index over `grid`'s nodes, then `thin_grid`'s) whose profile is at least as
@@ -275,17 +298,17 @@ impl SkinMaps {
         self.maps.thin().map_or(d, |t| t.thickness_mm.max(d))
     }
 
-    /// R(r) per lane of a path through skin from `uv_i` (entry) to `uv_o` (exit) at distance
+    /// R(r) per lane of a path through skin from `uv_i` (entry) to the texel `exit` at distance
     /// `r_mm`, combined by the material's rule, mm⁻².
     #[must_use]
     pub fn profile(
         &self,
         wl: &SampledWavelengths,
         uv_i: Vec2,
-        uv_o: Vec2,
+        exit: &ExitTexel<'_>,
         r_mm: f32,
     ) -> SampledSpectrum {
-        let [at_o, at_i] = self.corners(uv_o).eval_pair(&self.corners(uv_i), wl, r_mm);
+        let [at_o, at_i] = exit.corners.eval_pair(&self.corners(uv_i), wl, r_mm);
         SampledSpectrum(std::array::from_fn(|k| {
             self.blend.combine(at_i.0[k], at_o.0[k])
         }))
