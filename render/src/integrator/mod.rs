@@ -271,6 +271,8 @@ struct Shading<'s> {
     take_sss: bool,
     /// Whether a light can reach the point (its light probabilities are in `Path::pick`).
     lit: bool,
+    /// The maps' texel at the hit, for a skin with maps not collapsed to its diffuse body.
+    texel: Option<crate::material::hetero::ExitTexel<'s>>,
 }
 
 /// What a branch did with the path.
@@ -377,7 +379,12 @@ impl PathTracer<'_> {
         path.travelled_mm += si.t;
         let footprint_mm = self.settings.pixel_angle_rad * path.travelled_mm;
         let collapse = material.collapses(footprint_mm, sampler.independent_1d());
-        let bsdf = material.bsdf_lod(ns, si.uv, wl, &scene.textures, collapse);
+        // A skin with maps reads the texel once for the branch choice and every probe.
+        let texel = match material {
+            Material::Skin(s) if !collapse => s.maps.as_ref().map(|m| m.exit_texel(si.uv)),
+            _ => None,
+        };
+        let bsdf = material.bsdf_lod(ns, si.uv, wl, &scene.textures, collapse, texel.as_ref());
 
         // Next-event estimation.
         let lit = path.n_lights > 0 && light_probabilities(scene, si.p, ns, &mut path.pick);
@@ -410,6 +417,7 @@ impl PathTracer<'_> {
             q_sss,
             take_sss,
             lit,
+            texel,
         };
         let step = match (volume, material) {
             // A skin rendered by the volumetric walk takes no BSSRDF exit: its body is walked.

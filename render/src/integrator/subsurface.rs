@@ -77,8 +77,9 @@ impl PathTracer<'_> {
         let Some(ss) = &skin.subsurface else {
             return Step::Surface;
         };
-        // The exit texel is read once for every probe at this hit.
-        let texel = skin.maps.as_ref().map(|m| m.exit_texel(hit.si.uv));
+        let texel = hit
+            .texel
+            .or_else(|| skin.maps.as_ref().map(|m| m.exit_texel(hit.si.uv)));
         let found = self.subsurface_exit(
             skin,
             (ss, texel.as_ref()),

@@ -167,11 +167,13 @@ impl Material {
         wl: &'a SampledWavelengths,
         textures: &[Texture],
     ) -> Bsdf<'a> {
-        self.bsdf_lod(n, uv, wl, textures, false)
+        self.bsdf_lod(n, uv, wl, textures, false, None)
     }
 
     /// [`Material::bsdf`], with skin's subsurface term collapsed to its diffuse body when
-    /// `collapsed` (the level of detail of `crate::fidelity::lod`: same totals, no BSSRDF).
+    /// `collapsed` (the level of detail of `crate::fidelity::lod`: same totals, no BSSRDF);
+    /// `texel`: the maps' texel at `uv` where the caller has read it
+    /// ([`hetero::SkinMaps::exit_texel`]).
     #[must_use]
     pub fn bsdf_lod<'a>(
         &'a self,
@@ -180,12 +182,16 @@ impl Material {
         wl: &'a SampledWavelengths,
         textures: &[Texture],
         collapsed: bool,
+        texel: Option<&hetero::ExitTexel<'_>>,
     ) -> Bsdf<'a> {
         let frame = Frame::from_normal(n);
         let lobes = match self {
             Material::Skin(s) if s.subsurface.is_some() && !collapsed => {
                 let subsurface_albedo = match &s.maps {
-                    Some(maps) => maps.totals(wl, uv).average().min(1.0),
+                    Some(maps) => texel
+                        .map_or_else(|| maps.totals(wl, uv), |t| t.corners.totals(wl))
+                        .average()
+                        .min(1.0),
                     None => {
                         let m = s.texture_factor(uv, textures);
                         (s.total_reflectance.eval(wl).average() * m).min(1.0)
