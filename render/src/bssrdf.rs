@@ -59,7 +59,7 @@ pub use grid::{Corners, ProfileGrid};
 pub use incidence::{Incidence, IncidenceGain};
 pub use sampling::{Probe, ProbeAxes, ProbeFrame, RadiusWavelength, pdf_exit, probe};
 pub use separable::{Directional, EnergySplit, texture_modulation};
-pub use table::{ProfileTable, RENDER_SHAPE_STEP_NM, RowPlace, RowsAt, TableOptions};
+pub use table::{ProfileTable, RENDER_SHAPE_STEP_NM, RowPlace, RowsAt, TableOptions, TableRadius};
 
 use crate::geometry::SurfaceHit;
 use crate::spectrum::{N_WAVELENGTHS, SampledSpectrum, SampledWavelengths};
@@ -225,24 +225,25 @@ impl Subsurface {
     /// The planar density of radius `r_mm` under `probe`'s strategies, mm⁻²: the lanes' mixture
     /// of the table, mixed with the wide profile's where it draws part of the radii.
     fn density(&self, probe: &ProbeSample<'_>, r_mm: f32) -> f32 {
-        let own = Self::mixture(&self.table, &probe.lanes, &probe.c, r_mm);
+        let radius = TableRadius::new(r_mm);
+        let own = Self::mixture(&self.table, &probe.lanes, &probe.c, radius);
         match &probe.wide {
             Some((wide, lanes, c)) if probe.share > 0.0 => {
-                (1.0 - probe.share) * own + probe.share * Self::mixture(wide, lanes, c, r_mm)
+                (1.0 - probe.share) * own + probe.share * Self::mixture(wide, lanes, c, radius)
             }
             _ => own,
         }
     }
 
-    /// Σ_j c_j pdf_area_j(r_mm): the mixture of `table`'s lanes' planar densities, mm⁻²
+    /// Σ_j c_j pdf_area_j(r): the mixture of `table`'s lanes' planar densities at `radius`, mm⁻²
     /// (spectral MIS).
     fn mixture(
         table: &ProfileTable,
         lanes: &Lanes<'_>,
         c: &[f32; N_WAVELENGTHS],
-        r_mm: f32,
+        radius: TableRadius,
     ) -> f32 {
-        let r = table.eval_each(lanes, r_mm);
+        let r = table.eval_each_at(lanes, radius);
         (0..N_WAVELENGTHS)
             .filter_map(|k| {
                 let total = lanes[k]?.total();

@@ -247,13 +247,14 @@ impl<'a> Corners<'a> {
         // Each node's R and ln R per lane (ln only of positive values: the blend is linear
         // wherever a corner's value is 0).
         let mut at = [[(0.0f32, 0.0f32); 16]; N_WAVELENGTHS];
+        let radius = super::TableRadius::new(r_mm);
         for (u, &node) in nodes[..m].iter().enumerate() {
             let table = &grid.tables[node as usize];
             let lanes: [_; N_WAVELENGTHS] = std::array::from_fn(|k| match places[k] {
                 Some(place) => Some(table.at_place(place)),
                 None => (grid.rows == 0 && wl.pdf()[k] > 0.0).then(|| table.at_lane(wl, k)),
             });
-            let r = table.eval_each(&lanes, r_mm);
+            let r = table.eval_each_at(&lanes, radius);
             for k in 0..N_WAVELENGTHS {
                 at[k][u] = (r[k], if r[k] > 0.0 { r[k].ln() } else { 0.0 });
             }

@@ -105,6 +105,28 @@ pub struct ProfileTable {
     steps_per_ln: f32,
 }
 
+/// A radius prepared for look-ups in any number of tables: r (at least half of [`R_MIN_MM`],
+/// below which every profile is flat) and ln(r / [`R_MIN_MM`]), where every table's geometric
+/// grid starts.
+#[derive(Debug, Clone, Copy)]
+pub struct TableRadius {
+    r_mm: f32,
+    ln_over_min: f32,
+}
+
+impl TableRadius {
+    /// The radius `r_mm` (mm) prepared.
+    #[must_use]
+    #[inline]
+    pub fn new(r_mm: f32) -> Self {
+        let r_mm = r_mm.max(0.5 * R_MIN_MM);
+        Self {
+            r_mm,
+            ln_over_min: (r_mm / R_MIN_MM).ln(),
+        }
+    }
+}
+
 /// What a [`ProfileTable`] stores: all but what is derived from it.
 #[derive(Deserialize)]
 struct StoredTable {
@@ -450,9 +472,20 @@ impl ProfileTable {
     /// (the profile lookups are a large share of a skin sample's time).
     #[must_use]
     pub fn eval_each<const N: usize>(&self, at: &[Option<RowsAt<'_>>; N], r_mm: f32) -> [f32; N] {
-        let r = r_mm.max(0.5 * R_MIN_MM);
+        self.eval_each_at(at, TableRadius::new(r_mm))
+    }
+
+    /// [`ProfileTable::eval_each`] at a radius prepared once for several tables.
+    #[must_use]
+    #[inline]
+    pub fn eval_each_at<const N: usize>(
+        &self,
+        at: &[Option<RowsAt<'_>>; N],
+        radius: TableRadius,
+    ) -> [f32; N] {
+        let r = radius.r_mm;
         let radii = &self.radii_mm;
-        let i = self.radius_index(r);
+        let i = self.radius_index(radius);
         // Where r falls between two grid radii, shared by every row (beyond the grid every row
         // has ended; below its first radius the density rises linearly from 0).
         let t = (i > 0 && i < radii.len()).then(|| (r - radii[i - 1]) / (radii[i] - radii[i - 1]));
@@ -464,18 +497,19 @@ impl ProfileTable {
         })
     }
 
-    /// The index of the first grid radius ≥ `r_mm` (the grid's length when none is): guessed
-    /// from the grid's geometric spacing and corrected by comparison, so exact for any rounding.
+    /// The index of the first grid radius ≥ `radius` (the grid's length when none is): guessed
+    /// from the grid's geometric spacing from [`R_MIN_MM`] and corrected by comparison, so exact
+    /// for any rounding and any grid.
     #[inline]
-    fn radius_index(&self, r_mm: f32) -> usize {
+    fn radius_index(&self, radius: TableRadius) -> usize {
         let radii = &self.radii_mm;
         let n = radii.len();
+        let r_mm = radius.r_mm;
         if r_mm.is_nan() {
             return 0;
         }
         // Truncation (a saturating cast) lands at most one index low; the loops correct it.
-        let guess = (r_mm / radii[0]).ln() * self.steps_per_ln;
-        let mut i = (guess as usize).min(n);
+        let mut i = ((radius.ln_over_min * self.steps_per_ln) as usize).min(n);
         while i < n && radii[i] < r_mm {
             i += 1;
         }
@@ -590,8 +624,8 @@ mod tests {
         assert_eq!(stored, t);
         for r in rs {
             assert_eq!(
-                t.radius_index(r),
-                radii.partition_point(|&x| x < r),
+                t.radius_index(TableRadius::new(r)),
+                radii.partition_point(|&x| x < r.max(0.5 * R_MIN_MM)),
                 "{r} mm"
             );
         }
