@@ -86,14 +86,16 @@ type Lanes<'a> = [Option<RowsAt<'a>>; N_WAVELENGTHS];
 pub const WIDE_SHARE: f32 = 0.5;
 
 /// The share of the radii a wide profile of luminance-weighted total `wide_total` draws beside
-/// an own profile of `own_total` (docs/physics.md §19.3): the part of the wide profile's
-/// energy the own profile lacks, 1 − R_own / R_wide, at most [`WIDE_SHARE`]. Where the two skins
-/// differ little the wide profile has little to defend against and would only spend samples
-/// at radii the own profile already covers; where they differ much it draws the most.
+/// an own profile of `own_total` under the geometric rule (docs/physics.md §19.3): light that
+/// entered in the wide profile's skin follows √(R_own R_wide), of energy about
+/// √(R̄_own R̄_wide), and the share is the part of it the own profile lacks,
+/// 1 − √(R̄_own / R̄_wide), at most [`WIDE_SHARE`]. Where the two skins differ little the wide
+/// profile has little to defend against and would only spend samples at radii the own profile
+/// already covers.
 #[must_use]
 pub fn wide_share(own_total: f32, wide_total: f32) -> f32 {
     if wide_total > 0.0 && own_total >= 0.0 {
-        (1.0 - own_total / wide_total).clamp(0.0, WIDE_SHARE)
+        (1.0 - (own_total / wide_total).sqrt()).clamp(0.0, WIDE_SHARE)
     } else {
         WIDE_SHARE
     }
@@ -416,13 +418,13 @@ mod tests {
     use super::*;
 
     /// The wide profile's share: none where it is the own profile, half where the own profile
-    /// holds at most half its energy, the energy the own profile lacks in between, and half
-    /// where the totals give no answer.
+    /// holds at most a quarter of its energy, the combined profile's energy the own profile lacks
+    /// in between, and half where the totals give no answer.
     #[test]
     fn wide_share_follows_the_energy_the_own_profile_lacks() {
         assert_eq!(wide_share(0.4, 0.4), 0.0);
         assert_eq!(wide_share(0.5, 0.4), 0.0);
-        assert!((wide_share(0.3, 0.4) - 0.25).abs() < 1e-6);
+        assert!((wide_share(0.36, 0.64) - 0.25).abs() < 1e-6);
         assert_eq!(wide_share(0.1, 0.4), WIDE_SHARE);
         assert_eq!(wide_share(0.1, 0.0), WIDE_SHARE);
         assert_eq!(wide_share(f32::NAN, 0.4), WIDE_SHARE);

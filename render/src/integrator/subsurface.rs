@@ -9,7 +9,7 @@
 use super::lights::{LightProbabilities, PrevVertex, Receiver, direct_light, light_probabilities};
 use super::{Path, PathTracer, Random, Shading, Step, dims, probe, russian_roulette};
 use crate::bssrdf::{Exit, ProbeFrame, Subsurface, texture_modulation};
-use crate::material::hetero::ExitTexel;
+use crate::material::hetero::{ExitTexel, ProfileBlend};
 use crate::material::{Material, SkinMaterial};
 use crate::sampler::PathSampler;
 use crate::sampling::cosine_hemisphere;
@@ -222,9 +222,11 @@ impl PathTracer<'_> {
         ];
         let si = &hit.si;
         let flipped = hit.ns.dot(si.ns) < 0.0;
-        // With maps, radii follow the profile of the skin the light leaves, mixed with the
-        // widest within the probe's reach (the grid's widest where that is not known).
+        // With maps, radii follow the profile of the skin the light leaves, mixed under the
+        // geometric rule with the widest within the probe's reach (the grid's widest where that
+        // is not known); under the exit rule the combined profile is the exit's own.
         let (ss, wide) = match skin.maps.as_ref().zip(texel.and_then(|t| t.sampling)) {
+            Some((maps, own)) if maps.blend == ProfileBlend::Exit => (own, None),
             Some((maps, own)) => {
                 let near = self.body.widest_node(si.triangle);
                 (
