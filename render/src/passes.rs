@@ -12,6 +12,7 @@ use crate::material::Material;
 use crate::scene::{Hit, Scene};
 use crate::spectrum::{linear_srgb_at_nm, xyz_to_linear_srgb};
 use glam::Vec2;
+use rayon::prelude::*;
 use skin_io::atomic;
 use std::path::Path;
 
@@ -49,66 +50,86 @@ fn reflectance_rgb(rho: impl Fn(f32) -> f32) -> [f32; 3] {
     xyz_to_linear_srgb(xyz.map(|v| (v / norm) as f32))
 }
 
+/// The passes of one pixel.
+#[derive(Debug, Clone, Copy)]
+struct Pixel {
+    albedo: [f32; 3],
+    normal: [f32; 3],
+    depth: f32,
+    skin: f32,
+}
+
+/// The passes of the primary ray from `o` along `d`.
+fn first_hit_pixel(scene: &Scene, o: glam::Vec3, d: glam::Vec3) -> Pixel {
+    let mut out = Pixel {
+        albedo: [0.0; 3],
+        normal: [0.0; 3],
+        depth: NO_DEPTH,
+        skin: 0.0,
+    };
+    match scene.intersect(o, d, 0.0, f32::INFINITY) {
+        Some(Hit::Surface(s)) => {
+            out.depth = s.t;
+            out.normal = s.ns.to_array();
+            let (rgb, is_skin) = match &scene.materials[s.material as usize] {
+                Material::Skin(crate::material::SkinMaterial {
+                    maps: Some(maps), ..
+                }) => {
+                    let at = maps.corners(s.uv);
+                    (reflectance_rgb(|nm| at.total(nm).min(1.0)), 1.0)
+                }
+                Material::Skin(m) => {
+                    let f = m.texture_factor(s.uv, &scene.textures);
+                    let t = &m.total_reflectance;
+                    (reflectance_rgb(|nm| (t.at_nm(nm) * f).min(1.0)), 1.0)
+                }
+                Material::Diffuse(m) => {
+                    let tex = m
+                        .albedo_texture
+                        .map(|t| scene.textures[t.index].lookup(s.uv));
+                    let rho = |nm| {
+                        let base = m.albedo.at_nm(nm);
+                        let t = tex.map_or(1.0, |rgb| linear_srgb_at_nm(rgb, nm));
+                        (base * t).clamp(0.0, 1.0)
+                    };
+                    (reflectance_rgb(rho), 0.0)
+                }
+            };
+            out.albedo = rgb;
+            out.skin = is_skin;
+        }
+        Some(Hit::Light { t, .. }) => out.depth = t,
+        None => {}
+    }
+    out
+}
+
 impl Passes {
-    /// Trace one primary ray per pixel of a `width × height` image of `scene`.
+    /// Trace one primary ray per pixel of a `width × height` image of `scene` (the pixels in
+    /// parallel).
     #[must_use]
     pub fn first_hit(scene: &Scene, width: usize, height: usize) -> Self {
         let n = width * height;
-        let mut p = Self {
-            width,
-            height,
-            albedo: vec![[0.0; 3]; n],
-            normal: vec![[0.0; 3]; n],
-            depth: vec![NO_DEPTH; n],
-            skin: vec![0.0; n],
-        };
         let aspect = width as f32 / height as f32;
-        for y in 0..height {
-            for x in 0..width {
-                let i = y * width + x;
+        let pixels: Vec<Pixel> = (0..n)
+            .into_par_iter()
+            .map(|i| {
                 let ndc = Vec2::new(
-                    (x as f32 + 0.5) / width as f32,
-                    (y as f32 + 0.5) / height as f32,
+                    ((i % width) as f32 + 0.5) / width as f32,
+                    ((i / width) as f32 + 0.5) / height as f32,
                 );
                 let (o, d) = scene.camera.generate_ray(ndc, aspect, Vec2::splat(0.5));
-                match scene.intersect(o, d, 0.0, f32::INFINITY) {
-                    Some(Hit::Surface(s)) => {
-                        p.depth[i] = s.t;
-                        p.normal[i] = s.ns.to_array();
-                        let (rgb, is_skin) = match &scene.materials[s.material as usize] {
-                            Material::Skin(crate::material::SkinMaterial {
-                                maps: Some(maps),
-                                ..
-                            }) => {
-                                let at = maps.corners(s.uv);
-                                (reflectance_rgb(|nm| at.total(nm).min(1.0)), 1.0)
-                            }
-                            Material::Skin(m) => {
-                                let f = m.texture_factor(s.uv, &scene.textures);
-                                let t = &m.total_reflectance;
-                                (reflectance_rgb(|nm| (t.at_nm(nm) * f).min(1.0)), 1.0)
-                            }
-                            Material::Diffuse(m) => {
-                                let tex = m
-                                    .albedo_texture
-                                    .map(|t| scene.textures[t.index].lookup(s.uv));
-                                let rho = |nm| {
-                                    let base = m.albedo.at_nm(nm);
-                                    let t = tex.map_or(1.0, |rgb| linear_srgb_at_nm(rgb, nm));
-                                    (base * t).clamp(0.0, 1.0)
-                                };
-                                (reflectance_rgb(rho), 0.0)
-                            }
-                        };
-                        p.albedo[i] = rgb;
-                        p.skin[i] = is_skin;
-                    }
-                    Some(Hit::Light { t, .. }) => p.depth[i] = t,
-                    None => {}
-                }
-            }
+                first_hit_pixel(scene, o, d)
+            })
+            .collect();
+        Self {
+            width,
+            height,
+            albedo: pixels.iter().map(|p| p.albedo).collect(),
+            normal: pixels.iter().map(|p| p.normal).collect(),
+            depth: pixels.iter().map(|p| p.depth).collect(),
+            skin: pixels.iter().map(|p| p.skin).collect(),
         }
-        p
     }
 
     /// Write `film` (linear sRGB `R`, `G`, `B`), its `variance.Y`, its per-pixel sample counts
