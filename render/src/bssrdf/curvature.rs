@@ -23,7 +23,18 @@ pub enum Curvature {
     FirstOrder,
 }
 
-/// κ(λ) of one skin, mm⁻¹: the dermis' σ_tr = √(3 σa (σa + σs (1 − g))) on the 5-nm grid.
+/// The effective attenuation σ_tr = √(3 σa (σa + σs (1 − g))) of a layer of absorption `sigma_a`
+/// and scattering `sigma_s` (mm⁻¹) at Henyey–Greenstein `g`, mm⁻¹: the gain κ of the curvature term
+/// when it is the dermis' (docs/physics.md §8.2).
+#[must_use]
+#[inline]
+pub fn sigma_tr_per_mm(sigma_a: f32, sigma_s: f32, g: f32) -> f32 {
+    (3.0 * sigma_a * (sigma_a + sigma_s * (1.0 - g)))
+        .max(0.0)
+        .sqrt()
+}
+
+/// κ(λ) of one skin, mm⁻¹: the dermis' σ_tr ([`sigma_tr_per_mm`]) on the 5-nm grid.
 #[derive(Debug, Clone)]
 pub struct CurvatureGain {
     kappa_per_mm: SpectrumTable,
@@ -38,8 +49,7 @@ impl CurvatureGain {
         Self {
             kappa_per_mm: SpectrumTable::from_fn(|nm| {
                 let nm = nm as f32;
-                let (a, s) = (d.sigma_a.at_nm(nm), d.sigma_s.at_nm(nm));
-                f64::from((3.0 * a * (a + s * (1.0 - g))).max(0.0).sqrt())
+                f64::from(sigma_tr_per_mm(d.sigma_a.at_nm(nm), d.sigma_s.at_nm(nm), g))
             }),
         }
     }

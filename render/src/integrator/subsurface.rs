@@ -8,7 +8,7 @@
 
 use super::lights::{LightProbabilities, PrevVertex, Receiver, direct_light, light_probabilities};
 use super::{Path, PathTracer, Random, Shading, Step, dims, probe, russian_roulette};
-use crate::bssrdf::{Exit, ProbeFrame, Subsurface, texture_modulation};
+use crate::bssrdf::{Exit, ProbeFrame, Subsurface, curvature, texture_modulation};
 use crate::material::hetero::{ExitTexel, ProfileBlend};
 use crate::material::{Material, SkinMaterial};
 use crate::sampler::PathSampler;
@@ -254,7 +254,12 @@ impl PathTracer<'_> {
         if let (Some(maps), Some(texel)) = (&skin.maps, texel) {
             // The profile of the skin at both ends instead of the texture's modulation.
             let uv_i = exit.hit.map_or(si.uv, |h| h.uv);
-            let weight = maps.profile(wl, uv_i, texel, exit.r_mm) * exit.per_profile * t_o;
+            // Each end's own curvature term (the probe carries none with maps); the local
+            // fallback keeps the planar weight.
+            let depth = exit
+                .hit
+                .and_then(|_| curvature::depth_below_tangent_mm(si.p, frame.n, exit.p, exit.ns));
+            let weight = maps.profile(wl, uv_i, texel, exit.r_mm, depth) * exit.per_profile * t_o;
             return (!weight.is_black() && weight.is_finite()).then_some((exit, weight));
         }
         let m_o = skin.texture_factor(si.uv, &scene.textures);

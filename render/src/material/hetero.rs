@@ -6,7 +6,7 @@
 use super::maps::ChromophoreMaps;
 use crate::bssrdf::{Corners, ProfileGrid};
 use crate::media::{MediaError, SkinMedia};
-use crate::spectrum::{SampledSpectrum, SampledWavelengths, SpectrumTable};
+use crate::spectrum::{N_WAVELENGTHS, SampledSpectrum, SampledWavelengths, SpectrumTable};
 use glam::Vec2;
 use skin_optics::SkinParams;
 use std::fmt;
@@ -123,6 +123,27 @@ impl CornerAbsorption {
             dermis: std::array::from_fn(|c| self.dermis[c].at_nm(nm)),
         }
     }
+
+    /// The dermis' σa at wavelength `nm` and parameters `p` = (C_m, β_m, C_h), mm⁻¹.
+    #[must_use]
+    #[inline]
+    pub fn dermis_sigma_a(&self, nm: f32, p: [f32; 3]) -> f32 {
+        trilinear(&std::array::from_fn(|c| self.dermis[c].at_nm(nm)), p)
+    }
+}
+
+/// The trilinear interpolation of the corner values `v` (corner c at (c & 1, c >> 1 & 1,
+/// c >> 2 & 1)) at `p`, at least 0.
+#[inline]
+fn trilinear(v: &[f32; 8], p: [f32; 3]) -> f32 {
+    let lerp = |a: f32, b: f32, t: f32| a + t * (b - a);
+    let x00 = lerp(v[0], v[1], p[0]);
+    let x10 = lerp(v[2], v[3], p[0]);
+    let x01 = lerp(v[4], v[5], p[0]);
+    let x11 = lerp(v[6], v[7], p[0]);
+    let y0 = lerp(x00, x10, p[1]);
+    let y1 = lerp(x01, x11, p[1]);
+    lerp(y0, y1, p[2]).max(0.0)
 }
 
 impl CornersAt {
@@ -130,19 +151,14 @@ impl CornersAt {
     #[must_use]
     #[inline]
     pub fn sigma_a(&self, epidermis: bool, p: [f32; 3]) -> f32 {
-        let v = if epidermis {
-            &self.epidermis
-        } else {
-            &self.dermis
-        };
-        let lerp = |a: f32, b: f32, t: f32| a + t * (b - a);
-        let x00 = lerp(v[0], v[1], p[0]);
-        let x10 = lerp(v[2], v[3], p[0]);
-        let x01 = lerp(v[4], v[5], p[0]);
-        let x11 = lerp(v[6], v[7], p[0]);
-        let y0 = lerp(x00, x10, p[1]);
-        let y1 = lerp(x01, x11, p[1]);
-        lerp(y0, y1, p[2]).max(0.0)
+        trilinear(
+            if epidermis {
+                &self.epidermis
+            } else {
+                &self.dermis
+            },
+            p,
+        )
     }
 
     /// The largest σa of each layer (epidermis, dermis) over the box `range` of parameters: a
@@ -162,6 +178,8 @@ impl CornersAt {
 /// The texel light leaves at, as the BSSRDF reads it ([`SkinMaps::exit_texel`]).
 #[derive(Debug, Clone, Copy)]
 pub struct ExitTexel<'a> {
+    /// The texel's parameters (C_m, β_m, C_h).
+    pub params: [f32; 3],
     /// The profile grid's corners at the texel's parameters.
     pub corners: Corners<'a>,
     /// The BSSRDF that samples radii there (`None`: the material's, from the grid's widest
@@ -189,6 +207,19 @@ pub struct SkinMaps {
     sampling: Vec<crate::bssrdf::Subsurface>,
     /// The material's epidermis thickness (texels without a thin epidermis), mm.
     pub epidermis_mm: f32,
+    /// The curvature term at each texel (`None`: the planar profile, `Curvature::Planar`).
+    curvature: Option<TexelCurvature>,
+}
+
+/// What the first-order curvature term needs at a texel (docs/physics.md §8.2, §19.3): its gain
+/// κ is the dermis' σ_tr, whose σa follows the texel's blood (the corners) while σs and g are the
+/// material's.
+#[derive(Debug, Clone)]
+struct TexelCurvature {
+    /// The dermis' σs, mm⁻¹.
+    dermis_sigma_s: SpectrumTable,
+    /// Henyey–Greenstein g of the layers.
+    g: f32,
 }
 
 impl SkinMaps {
@@ -239,6 +270,7 @@ impl SkinMaps {
                 .and_then(|i| self.sampling.get(offset + i))
         };
         ExitTexel {
+            params: p,
             corners: grid.corners(p),
             sampling,
         }
@@ -298,8 +330,23 @@ impl SkinMaps {
         self.maps.thin().map_or(d, |t| t.thickness_mm.max(d))
     }
 
+    /// The curvature gain κ at wavelength `nm` of skin with parameters `p` = (C_m, β_m, C_h),
+    /// mm⁻¹: the dermis' σ_tr there (`None` without the curvature term).
+    #[must_use]
+    pub fn kappa_per_mm(&self, nm: f32, p: [f32; 3]) -> Option<f32> {
+        let c = self.curvature.as_ref()?;
+        Some(crate::bssrdf::curvature::sigma_tr_per_mm(
+            self.absorption.dermis_sigma_a(nm, p),
+            c.dermis_sigma_s.at_nm(nm),
+            c.g,
+        ))
+    }
+
     /// R(r) per lane of a path through skin from `uv_i` (entry) to the texel `exit` at distance
-    /// `r_mm`, combined by the material's rule, mm⁻².
+    /// `r_mm`, combined by the material's rule, mm⁻². Where the exit lies `depth_mm` below the
+    /// entry's tangent plane (`crate::bssrdf::curvature::depth_below_tangent_mm`; `None` for
+    /// none, as for the local fallback) each end's profile carries its own skin's curvature
+    /// term 1 + κ h before the rule combines them (docs/physics.md §19.3).
     #[must_use]
     pub fn profile(
         &self,
@@ -307,8 +354,21 @@ impl SkinMaps {
         uv_i: Vec2,
         exit: &ExitTexel<'_>,
         r_mm: f32,
+        depth_mm: Option<f32>,
     ) -> SampledSpectrum {
-        let [at_o, at_i] = exit.corners.eval_pair(&self.corners(uv_i), wl, r_mm);
+        let [mut at_o, mut at_i] = exit.corners.eval_pair(&self.corners(uv_i), wl, r_mm);
+        if let Some(h) = depth_mm.filter(|_| self.curvature.is_some()) {
+            let p_i = self.maps.at(uv_i);
+            for k in 0..N_WAVELENGTHS {
+                if wl.pdf()[k] > 0.0 {
+                    let nm = wl.nm(k);
+                    for (at, p) in [(&mut at_i, p_i), (&mut at_o, exit.params)] {
+                        let kappa = self.kappa_per_mm(nm, p).unwrap_or(0.0);
+                        at.0[k] *= crate::bssrdf::curvature::factor(kappa, h);
+                    }
+                }
+            }
+        }
         SampledSpectrum(std::array::from_fn(|k| {
             self.blend.combine(at_i.0[k], at_o.0[k])
         }))
@@ -374,6 +434,15 @@ impl super::SkinMaterial {
             }
             None => None,
         };
+        // The curvature term moves from the probe (one κ for the material) to each end's texel.
+        let curvature = self
+            .subsurface
+            .as_mut()
+            .and_then(|ss| ss.curvature.take())
+            .map(|_| TexelCurvature {
+                dermis_sigma_s: self.media.dermis.sigma_s.clone(),
+                g: g as f32,
+            });
         if let Some(ss) = &mut self.subsurface {
             // Radii are drawn from the widest profile: the least absorbing node of either
             // thickness, whichever reaches farther (a sample's weight is 0 beyond its table).
@@ -423,6 +492,7 @@ impl super::SkinMaterial {
             blend,
             sampling,
             epidermis_mm: self.params.epidermis_thickness_mm() as f32,
+            curvature,
         }));
         Ok(self)
     }
