@@ -14,14 +14,21 @@
 //! the walk then sees the light, so its region means are far quieter), and `SURFACES=oily` keeps
 //! only the default surface.
 //!
-//! With `VIEW=lip` the camera stays where it is and frames the lips closely (fov 4°, 96 × 96
-//! pixels, 0.51 mm a pixel at the lips) and the regions are the lower lip's centre, the upper
-//! lip's and the chin's skin below the lip, so that hundreds of pixels fall on each. In that view
-//! `VARIANT` changes the skin (the default output of the full view stays as it was):
-//! `thick` (scene key `thin_epidermis = false`: every texel under the material's epidermis),
-//! `planar` (`Curvature::Planar`: no curvature term), `uniform` (no maps: the scalar skin of the
-//! lower lip's median texel, under the thin epidermis where that texel is thin: geometry alone),
-//! `uniform-planar` (both).
+//! With `VIEW=lip` the camera stays where it is and frames the lips closely (looking at y = 17
+//! mm, fov 4°, 96 × 96 pixels, 0.51 mm a pixel at the lips): four regions of 200–700 pixels, the
+//! lower lip's centre and the upper lip's (thin epidermis throughout), the full view's lip box
+//! seen from here (the lower lip's lower edge, where the thin epidermis gives way to the normal
+//! one, and the skin below it) and the chin. Writes OUT/hetero_head_lip_VARIANT.{csv,png}, where
+//! `VARIANT` (that view only; the full view renders the maps) changes the skin:
+//! `maps` (default), `thick` (scene key `thin_epidermis = false`: every texel under the
+//! material's epidermis), `planar` (`Curvature::Planar`: no curvature term), `uniform` (no maps:
+//! the scalar skin of the median texel of region `UNIFORM_FROM`, 0 = the lower lip by default,
+//! under the thin epidermis where that texel is thin: the geometry alone), `uniform-planar`
+//! (both), `uniform-typical-kappa` and `uniform-typical-incidence` (that scalar skin with the
+//! curvature gain κ(λ), or the oblique-incidence gain, of the maps' typical skin, the one skin
+//! the material reads them from). With SPP_VOL = 0 only the BSSRDF renders: its image at four
+//! times its size with the regions boxed, and per pixel row which pixels see thin-epidermis
+//! texels and their C_h (to place the regions).
 //!
 //!     cargo run --release -p validation --features studies --example hetero_head -- OUT [SPP_VOL] [SPP_BSSRDF]
 
@@ -304,11 +311,13 @@ fn uniform_skin(
         .with_hemoglobin(f64::from(p[2]))?
         .with_epidermis_thickness_mm(f64::from(p[3]))?;
     let mut built = SkinMaterial::build(params, skin.surface.roughness(), None, knobs)?;
-    let (own, typical) = (
+    // The maps' typical skin as a scalar material: what the maps' BSSRDF reads its one skin from.
+    let typical = SkinMaterial::build(skin.params, skin.surface.roughness(), None, knobs)?;
+    let (own, typical_ss) = (
         built.subsurface.as_mut().expect("a BSSRDF"),
-        skin.subsurface.as_ref().expect("a BSSRDF"),
+        typical.subsurface.as_ref().expect("a BSSRDF"),
     );
-    if let (Some(k_own), Some(k_typ)) = (&own.curvature, &typical.curvature) {
+    if let (Some(k_own), Some(k_typ)) = (&own.curvature, &typical_ss.curvature) {
         for nm in [450.0, 500.0, 550.0, 600.0, 650.0] {
             println!(
                 "κ at {nm} nm: this skin {:.3} mm⁻¹, the typical skin {:.3} mm⁻¹",
@@ -318,10 +327,10 @@ fn uniform_skin(
         }
     }
     match variant {
-        Variant::UniformTypicalKappa => own.curvature.clone_from(&typical.curvature),
+        Variant::UniformTypicalKappa => own.curvature.clone_from(&typical_ss.curvature),
         Variant::UniformTypicalIncidence => {
-            own.directional = typical.directional.clone();
-            built.directional = skin.directional.clone();
+            own.directional = typical_ss.directional.clone();
+            built.directional = typical.directional.clone();
         }
         _ => {}
     }
@@ -329,7 +338,8 @@ fn uniform_skin(
     Ok(p)
 }
 
-/// Prints, per row of the view, which pixels see thin-epidermis texels (`#`), and C_h in tenths.
+/// Prints, per row of the view, which pixels see thin-epidermis texels (`#`), and their C_h as
+/// the digit ⌊40 C_h⌋ (at most 9).
 fn texel_chart(scene: &Scene, view: &View) {
     let Material::Skin(skin) = &scene.materials[0] else {
         return;
@@ -510,7 +520,7 @@ fn main() -> anyhow::Result<()> {
         .collect();
     let x_hi = view.regions.len() as f64 + 0.6;
     let mut chart = LineChart::new(
-        &format!(
+        format!(
             "BSSRDF against the walk, region means ({})",
             names.join(", ")
         ),
