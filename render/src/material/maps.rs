@@ -327,7 +327,7 @@ impl ChromophoreMaps {
     /// The typical skin of the maps: each parameter's median over the texels under the
     /// material's own epidermis (C_m, β_m, C_h). The material's scalar skin takes it, so that
     /// what reads one skin per material (profile extent, level of detail, the thin-part
-    /// criterion, the curvature term) reads skin like the maps'.
+    /// criterion, the oblique-incidence gain) reads skin like the maps'.
     #[must_use]
     pub fn typical(&self) -> [f32; 3] {
         self.typical
