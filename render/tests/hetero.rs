@@ -507,7 +507,7 @@ fn the_widest_within_reach_covers_the_light_skin_it_can_reach_and_no_farther() {
 /// built as a scalar material (not through the maps). G is 6.7% here; the typical skin's κ (5.1×
 /// smaller) gives 1.3%. The render must match the closed form within 4σ + 0.5% (σ the region's
 /// standard error, 0.2%; 0.3% for the tessellated sphere, as in the scalar test, and 0.2% for the
-/// cap's edge and the f32 tables): measured +0.2% ± 0.2%, and −4.1% with the typical skin's κ at
+/// cap's edge and the f32 tables): measured +0.1% ± 0.2%, and −4.1% with the typical skin's κ at
 /// every texel, as before this term followed the texels.
 #[test]
 fn curvature_term_follows_the_texels_skin() {
