@@ -471,9 +471,13 @@ fn main() -> anyhow::Result<()> {
         }
         let (vol, vol_cpu) = render(&scene, IntegratorKind::Volumetric, view.side, spp_vol, 2)?;
         println!(
-            "## {surface} surface, {}: BSSRDF {spp_bss} spp ({bss_cpu:.1} CPU-s), walk {spp_vol} spp \
+            "## {surface} surface{}: BSSRDF {spp_bss} spp ({bss_cpu:.1} CPU-s), walk {spp_vol} spp \
              ({vol_cpu:.1} CPU-s)",
-            variant.name()
+            if lip {
+                format!(", {}", variant.name())
+            } else {
+                String::new()
+            }
         );
         println!("| region | pixels (x; y) | walk Y | BSSRDF Y | BSSRDF − walk |");
         println!("|---|---|---|---|---|");
