@@ -128,7 +128,13 @@ impl CornerAbsorption {
     #[must_use]
     #[inline]
     pub fn dermis_sigma_a(&self, nm: f32, p: [f32; 3]) -> f32 {
-        trilinear(&std::array::from_fn(|c| self.dermis[c].at_nm(nm)), p)
+        trilinear(&self.dermis_at_nm(nm), p)
+    }
+
+    /// The dermis' σa at the corners at wavelength `nm`, mm⁻¹.
+    #[inline]
+    fn dermis_at_nm(&self, nm: f32) -> [f32; 8] {
+        std::array::from_fn(|c| self.dermis[c].at_nm(nm))
     }
 }
 
@@ -231,7 +237,12 @@ impl SkinMaps {
     #[must_use]
     #[inline]
     pub fn corners(&self, uv: Vec2) -> Corners<'_> {
-        let p = self.maps.at(uv);
+        self.corners_at(uv, self.maps.at(uv))
+    }
+
+    /// [`SkinMaps::corners`] with the texel's parameters `p` already read.
+    #[inline]
+    fn corners_at(&self, uv: Vec2, p: [f32; 3]) -> Corners<'_> {
         match (&self.thin_grid, self.maps.thin()) {
             (Some(grid), Some(thin)) if thin.is_thin(uv) => grid.corners(p),
             _ => self.grid.corners(p),
@@ -334,12 +345,19 @@ impl SkinMaps {
     /// mm⁻¹: the dermis' σ_tr there (`None` without the curvature term).
     #[must_use]
     pub fn kappa_per_mm(&self, nm: f32, p: [f32; 3]) -> Option<f32> {
+        self.kappas_per_mm(nm, [p]).map(|[k]| k)
+    }
+
+    /// [`SkinMaps::kappa_per_mm`] at several parameters `ps`, the wavelength's tables read once.
+    #[must_use]
+    #[inline]
+    pub fn kappas_per_mm<const N: usize>(&self, nm: f32, ps: [[f32; 3]; N]) -> Option<[f32; N]> {
         let c = self.curvature.as_ref()?;
-        Some(crate::bssrdf::curvature::sigma_tr_per_mm(
-            self.absorption.dermis_sigma_a(nm, p),
-            c.dermis_sigma_s.at_nm(nm),
-            c.g,
-        ))
+        let dermis = self.absorption.dermis_at_nm(nm);
+        let sigma_s = c.dermis_sigma_s.at_nm(nm);
+        Some(ps.map(|p| {
+            crate::bssrdf::curvature::sigma_tr_per_mm(trilinear(&dermis, p), sigma_s, c.g)
+        }))
     }
 
     /// R(r) per lane of a path through skin from `uv_i` (entry) to the texel `exit` at distance
@@ -356,16 +374,18 @@ impl SkinMaps {
         r_mm: f32,
         depth_mm: Option<f32>,
     ) -> SampledSpectrum {
-        let [mut at_o, mut at_i] = exit.corners.eval_pair(&self.corners(uv_i), wl, r_mm);
+        let p_i = self.maps.at(uv_i);
+        let [mut at_o, mut at_i] = exit
+            .corners
+            .eval_pair(&self.corners_at(uv_i, p_i), wl, r_mm);
         if let Some(h) = depth_mm.filter(|_| self.curvature.is_some()) {
-            let p_i = self.maps.at(uv_i);
             for k in 0..N_WAVELENGTHS {
-                if wl.pdf()[k] > 0.0 {
-                    let nm = wl.nm(k);
-                    for (at, p) in [(&mut at_i, p_i), (&mut at_o, exit.params)] {
-                        let kappa = self.kappa_per_mm(nm, p).unwrap_or(0.0);
-                        at.0[k] *= crate::bssrdf::curvature::factor(kappa, h);
-                    }
+                if wl.pdf()[k] > 0.0
+                    && let Some([kappa_i, kappa_o]) =
+                        self.kappas_per_mm(wl.nm(k), [p_i, exit.params])
+                {
+                    at_i.0[k] *= crate::bssrdf::curvature::factor(kappa_i, h);
+                    at_o.0[k] *= crate::bssrdf::curvature::factor(kappa_o, h);
                 }
             }
         }
