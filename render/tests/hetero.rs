@@ -586,7 +586,7 @@ fn curvature_term_follows_the_texels_skin() {
     let wl = SampledWavelengths::fixed(nm);
     let r_tot = f64::from(maps.totals(&wl, front.uv).0[0]);
     let texel = maps.exit_texel(front.uv);
-    let planar = |r: f32| f64::from(maps.profile(&wl, front.uv, &texel, r, None).0[0]);
+    let planar = |r: f32| f64::from(maps.profile(&wl, front.uv, &texel, r, (None, None)).0[0]);
     let (n, r_max) = (20_000, 2f64.sqrt() * f64::from(radius));
     let m2: f64 = (0..n)
         .map(|i| {

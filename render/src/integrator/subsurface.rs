@@ -9,7 +9,7 @@
 use super::lights::{LightProbabilities, PrevVertex, Receiver, direct_light, light_probabilities};
 use super::{Path, PathTracer, Random, Shading, Step, dims, probe, russian_roulette};
 use crate::bssrdf::{Exit, ProbeFrame, Subsurface, curvature, texture_modulation};
-use crate::material::hetero::{ExitTexel, ProfileBlend};
+use crate::material::hetero::{ExitTexel, LaneCurvature, ProfileBlend};
 use crate::material::{Material, SkinMaterial};
 use crate::sampler::PathSampler;
 use crate::sampling::cosine_hemisphere;
@@ -60,6 +60,14 @@ impl Outgoing {
     }
 }
 
+/// What the BSSRDF reads of the skin light leaves at, once per hit for every probe: the maps'
+/// texel and its curvature gains at the path's wavelengths.
+#[derive(Clone, Copy)]
+struct ExitSkin<'t, 'm> {
+    texel: Option<&'t ExitTexel<'m>>,
+    curvature: Option<&'t LaneCurvature>,
+}
+
 impl PathTracer<'_> {
     /// The BSSRDF branch at `hit` (a skin with a BSSRDF): the first probe's exit, the light at
     /// the further probes' exits (splitting), the light at the first exit and, when the branch
@@ -80,13 +88,17 @@ impl PathTracer<'_> {
         let texel = hit
             .texel
             .or_else(|| skin.maps.as_ref().map(|m| m.exit_texel(hit.si.uv)));
-        let found = self.subsurface_exit(
-            skin,
-            (ss, texel.as_ref()),
-            hit,
-            wl,
-            (&mut *sampler, &mut *rays),
-        );
+        let curvature = skin
+            .maps
+            .as_ref()
+            .zip(texel.as_ref())
+            .and_then(|(m, t)| m.lane_curvature(wl, t));
+        let exit_skin = ExitSkin {
+            texel: texel.as_ref(),
+            curvature: curvature.as_ref(),
+        };
+        let found =
+            self.subsurface_exit(skin, (ss, exit_skin), hit, wl, (&mut *sampler, &mut *rays));
         let outgoing = Outgoing::new(hit.wo, hit.ns);
         // Further probes at the same skin hit (splitting): each gathers the light at its own exit
         // point from its own scrambled sequence; the mean over the probes is the estimate, and
@@ -104,13 +116,9 @@ impl PathTracer<'_> {
         if probes > 1 && hit.q_sss > 0.0 {
             for k in 1..probes {
                 let mut fork = sampler.fork(k);
-                if let Some((exit, w)) = self.subsurface_exit(
-                    skin,
-                    (ss, texel.as_ref()),
-                    hit,
-                    wl,
-                    (&mut fork, &mut *rays),
-                ) {
+                if let Some((exit, w)) =
+                    self.subsurface_exit(skin, (ss, exit_skin), hit, wl, (&mut fork, &mut *rays))
+                {
                     let (direct, _) = self.exit_light(
                         ss,
                         &exit,
@@ -201,7 +209,7 @@ impl PathTracer<'_> {
     fn subsurface_exit(
         &self,
         skin: &SkinMaterial,
-        (ss, texel): (&Subsurface, Option<&ExitTexel<'_>>),
+        (ss, exit_skin): (&Subsurface, ExitSkin<'_, '_>),
         hit: &Shading<'_>,
         wl: &SampledWavelengths,
         (sampler, rays): Random<'_>,
@@ -225,6 +233,7 @@ impl PathTracer<'_> {
         // With maps, radii follow the profile of the skin the light leaves, mixed under the
         // geometric rule with the widest within the probe's reach (the grid's widest where that
         // is not known); under the exit rule the combined profile is the exit's own.
+        let texel = exit_skin.texel;
         let (ss, wide) = match skin.maps.as_ref().zip(texel.and_then(|t| t.sampling)) {
             Some((maps, own)) if maps.blend == ProfileBlend::Exit => (own, None),
             Some((maps, own)) => {
@@ -259,7 +268,9 @@ impl PathTracer<'_> {
             let depth = exit
                 .hit
                 .and_then(|_| curvature::depth_below_tangent_mm(si.p, frame.n, exit.p, exit.ns));
-            let weight = maps.profile(wl, uv_i, texel, exit.r_mm, depth) * exit.per_profile * t_o;
+            let weight = maps.profile(wl, uv_i, texel, exit.r_mm, (depth, exit_skin.curvature))
+                * exit.per_profile
+                * t_o;
             return (!weight.is_black() && weight.is_finite()).then_some((exit, weight));
         }
         let m_o = skin.texture_factor(si.uv, &scene.textures);

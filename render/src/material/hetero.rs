@@ -193,6 +193,32 @@ pub struct ExitTexel<'a> {
     pub sampling: Option<&'a crate::bssrdf::Subsurface>,
 }
 
+/// The curvature gains of a skin with maps at one path's wavelengths
+/// ([`SkinMaps::lane_curvature`]).
+#[derive(Debug, Clone, Copy)]
+pub struct LaneCurvature {
+    /// The dermis' σa at the parameter corners, per lane, mm⁻¹.
+    dermis: [[f32; 8]; N_WAVELENGTHS],
+    /// The dermis' σs per lane, mm⁻¹.
+    sigma_s: [f32; N_WAVELENGTHS],
+    g: f32,
+    /// κ of the exit texel per lane, mm⁻¹.
+    pub exit: [f32; N_WAVELENGTHS],
+}
+
+impl LaneCurvature {
+    /// κ at lane `k` of skin with parameters `p` = (C_m, β_m, C_h), mm⁻¹: the dermis' σ_tr.
+    #[must_use]
+    #[inline]
+    pub fn kappa_per_mm(&self, k: usize, p: [f32; 3]) -> f32 {
+        crate::bssrdf::curvature::sigma_tr_per_mm(
+            trilinear(&self.dermis[k], p),
+            self.sigma_s[k],
+            self.g,
+        )
+    }
+}
+
 /// A skin material's maps and what is built from them.
 #[derive(Debug, Clone)]
 pub struct SkinMaps {
@@ -345,19 +371,36 @@ impl SkinMaps {
     /// mm⁻¹: the dermis' σ_tr there (`None` without the curvature term).
     #[must_use]
     pub fn kappa_per_mm(&self, nm: f32, p: [f32; 3]) -> Option<f32> {
-        self.kappas_per_mm(nm, [p]).map(|[k]| k)
+        let c = self.curvature.as_ref()?;
+        Some(crate::bssrdf::curvature::sigma_tr_per_mm(
+            self.absorption.dermis_sigma_a(nm, p),
+            c.dermis_sigma_s.at_nm(nm),
+            c.g,
+        ))
     }
 
-    /// [`SkinMaps::kappa_per_mm`] at several parameters `ps`, the wavelength's tables read once.
+    /// The curvature gains at the path's wavelengths `wl` for light leaving at the texel
+    /// `exit`, and what any entry's needs (`None` without the curvature term): read once per
+    /// hit for every probe.
     #[must_use]
-    #[inline]
-    pub fn kappas_per_mm<const N: usize>(&self, nm: f32, ps: [[f32; 3]; N]) -> Option<[f32; N]> {
+    pub fn lane_curvature(
+        &self,
+        wl: &SampledWavelengths,
+        exit: &ExitTexel<'_>,
+    ) -> Option<LaneCurvature> {
         let c = self.curvature.as_ref()?;
-        let dermis = self.absorption.dermis_at_nm(nm);
-        let sigma_s = c.dermis_sigma_s.at_nm(nm);
-        Some(ps.map(|p| {
-            crate::bssrdf::curvature::sigma_tr_per_mm(trilinear(&dermis, p), sigma_s, c.g)
-        }))
+        let dermis: [[f32; 8]; N_WAVELENGTHS] =
+            std::array::from_fn(|k| self.absorption.dermis_at_nm(wl.nm(k)));
+        let sigma_s: [f32; N_WAVELENGTHS] =
+            std::array::from_fn(|k| c.dermis_sigma_s.at_nm(wl.nm(k)));
+        let mut lanes = LaneCurvature {
+            dermis,
+            sigma_s,
+            g: c.g,
+            exit: [0.0; N_WAVELENGTHS],
+        };
+        lanes.exit = std::array::from_fn(|k| lanes.kappa_per_mm(k, exit.params));
+        Some(lanes)
     }
 
     /// R(r) per lane of a path through skin from `uv_i` (entry) to the texel `exit` at distance
@@ -372,20 +415,17 @@ impl SkinMaps {
         uv_i: Vec2,
         exit: &ExitTexel<'_>,
         r_mm: f32,
-        depth_mm: Option<f32>,
+        (depth_mm, curvature): (Option<f32>, Option<&LaneCurvature>),
     ) -> SampledSpectrum {
         let p_i = self.maps.at(uv_i);
         let [mut at_o, mut at_i] = exit
             .corners
             .eval_pair(&self.corners_at(uv_i, p_i), wl, r_mm);
-        if let Some(h) = depth_mm.filter(|_| self.curvature.is_some()) {
+        if let (Some(h), Some(c)) = (depth_mm, curvature) {
             for k in 0..N_WAVELENGTHS {
-                if wl.pdf()[k] > 0.0
-                    && let Some([kappa_i, kappa_o]) =
-                        self.kappas_per_mm(wl.nm(k), [p_i, exit.params])
-                {
-                    at_i.0[k] *= crate::bssrdf::curvature::factor(kappa_i, h);
-                    at_o.0[k] *= crate::bssrdf::curvature::factor(kappa_o, h);
+                if wl.pdf()[k] > 0.0 {
+                    at_i.0[k] *= crate::bssrdf::curvature::factor(c.kappa_per_mm(k, p_i), h);
+                    at_o.0[k] *= crate::bssrdf::curvature::factor(c.exit[k], h);
                 }
             }
         }
