@@ -226,6 +226,53 @@ pub fn grey_exr_2x2() -> Vec<u8> {
     bytes
 }
 
+/// A film against a closed form per pixel, over the pixels of a `side` × `side` image of `scene`
+/// whose centre ray meets a surface at a point where `inside` holds: (the film's summed
+/// luminance, its summed variance, the closed form summed, pixels). Each pixel's closed form is
+/// the mean of `closed(μ)` over `k` × `k` rays through the pixel, μ the cosine between the view
+/// and the shading normal where each meets the surface.
+pub fn film_against_closed_form(
+    scene: &Scene,
+    film: &Film,
+    (side, k): (usize, usize),
+    inside: impl Fn(glam::Vec3) -> bool,
+    closed: impl Fn(f32) -> f64,
+) -> (f64, f64, f64, usize) {
+    use crate::scene::Hit;
+    let (mut got, mut var, mut want, mut pixels) = (0.0, 0.0, 0.0, 0usize);
+    for py in 0..side {
+        for px in 0..side {
+            let ray = |sx: f32, sy: f32| {
+                let ndc = glam::Vec2::new(
+                    (px as f32 + sx) / side as f32,
+                    (py as f32 + sy) / side as f32,
+                );
+                let (o, d) = scene.camera.generate_ray(ndc, 1.0, glam::Vec2::ZERO);
+                (d, scene.intersect(o, d, 0.0, f32::INFINITY))
+            };
+            if !matches!(ray(0.5, 0.5).1, Some(Hit::Surface(si)) if inside(si.p)) {
+                continue;
+            }
+            let mut sum = 0.0;
+            for j in 0..k * k {
+                let (sx, sy) = (
+                    ((j % k) as f32 + 0.5) / k as f32,
+                    ((j / k) as f32 + 0.5) / k as f32,
+                );
+                let (d, Some(Hit::Surface(si))) = ray(sx, sy) else {
+                    panic!("pixel {px},{py} leaves the surface")
+                };
+                sum += closed((-d).dot(si.ns).clamp(0.0, 1.0));
+            }
+            want += sum / (k * k) as f64;
+            got += f64::from(film.xyz(px, py)[1]);
+            var += film.variance(px, py);
+            pixels += 1;
+        }
+    }
+    (got, var, want, pixels)
+}
+
 /// Heterogeneous skin on a flat slab (docs/physics.md §19.4): a 40 × 40 × 20 mm box whose
 /// texture coordinates map x ∈ [−20, 20] mm to u ∈ [0, 1] and y ∈ [20, −20] mm to v ∈ [0, 1]
 /// (every vertex, so a point's nearest surface point reads the texel above or below it), under a

@@ -648,39 +648,11 @@ fn curvature_term_on_a_sphere_renders_its_closed_form() {
             .unwrap()
             .0
     };
-    let (mut got, mut var, mut want, mut pixels) = (0.0, 0.0, 0.0, 0usize);
-    let k = 4;
-    for py in 0..side {
-        for px in 0..side {
-            let centre = Vec2::new(
-                (px as f32 + 0.5) / side as f32,
-                (py as f32 + 0.5) / side as f32,
-            );
-            let (o, d) = scene.camera.generate_ray(centre, 1.0, Vec2::ZERO);
-            if !matches!(scene.intersect(o, d, 0.0, f32::INFINITY), Some(Hit::Surface(si)) if inside(si.p))
-            {
-                continue;
-            }
-            let mut closed = 0.0;
-            for j in 0..k * k {
-                let ndc = Vec2::new(
-                    (px as f32 + ((j % k) as f32 + 0.5) / k as f32) / side as f32,
-                    (py as f32 + ((j / k) as f32 + 0.5) / k as f32) / side as f32,
-                );
-                let (o, d) = scene.camera.generate_ray(ndc, 1.0, Vec2::ZERO);
-                let Some(Hit::Surface(si)) = scene.intersect(o, d, 0.0, f32::INFINITY) else {
-                    panic!("pixel {px},{py} leaves the sphere")
-                };
-                let mu = (-d).dot(si.ns).clamp(0.0, 1.0);
-                let t = f64::from(dir.transmittance(mu));
-                closed += (1.0 - t) + f64::from(dir.factor(mu, nm)) * r_tot * (1.0 + gain);
-            }
-            want += closed / (k * k) as f64;
-            got += f64::from(film.xyz(px, py)[1]);
-            var += film.variance(px, py);
-            pixels += 1;
-        }
-    }
+    let (got, var, want, pixels) =
+        render::testing::film_against_closed_form(&scene, &film, (side, 4), inside, |mu| {
+            let t = f64::from(dir.transmittance(mu));
+            (1.0 - t) + f64::from(dir.factor(mu, nm)) * r_tot * (1.0 + gain)
+        });
     assert!(pixels > side * side / 4, "{pixels} pixels");
     let se = var.sqrt() / want;
     let rel = got / want - 1.0;
