@@ -524,10 +524,7 @@ fn main() -> anyhow::Result<()> {
         .collect();
     let x_hi = view.regions.len() as f64 + 0.6;
     let mut chart = LineChart::new(
-        format!(
-            "BSSRDF against the walk, region means ({})",
-            names.join(", ")
-        ),
+        format!("BSSRDF − walk ({})", names.join(", ")),
         "region",
         "difference (%)",
     )
