@@ -226,6 +226,51 @@ pub fn grey_exr_2x2() -> Vec<u8> {
     bytes
 }
 
+/// ∫₀^r_max 2π r³ R(r) dr of a radial profile `profile` (mm⁻² at r in mm), by the midpoint rule
+/// over 20,000 steps: the second moment that sets the curvature term's gain (docs/physics.md §8.2)
+/// once divided by R_tot.
+pub fn radial_third_moment(profile: impl Fn(f32) -> f64, r_max_mm: f64) -> f64 {
+    let n = 20_000;
+    (0..n)
+        .map(|i| {
+            let d = (i as f64 + 0.5) / n as f64 * r_max_mm;
+            profile(d as f32) * 2.0 * std::f64::consts::PI * d * d * d * r_max_mm / n as f64
+        })
+        .sum()
+}
+
+/// The radiance a skin sphere of directional term `dir` and total R_tot `r_tot` shows under a
+/// sky of radiance 1 at wavelength `nm`, as a function of the view cosine μ, with the curvature
+/// term's gain `gain` (docs/physics.md §8.2): (1 − T(μ)) + a(μ) R_tot (1 + G).
+pub fn sky_sphere_closed_form(
+    dir: &crate::bssrdf::Directional,
+    nm: f32,
+    r_tot: f64,
+    gain: f64,
+) -> impl Fn(f32) -> f64 + '_ {
+    move |mu| {
+        let t = f64::from(dir.transmittance(mu));
+        (1.0 - t) + f64::from(dir.factor(mu, nm)) * r_tot * (1.0 + gain)
+    }
+}
+
+/// A `side` × `side` render of `scene` by the BSSRDF at the single wavelength `nm`.
+pub fn render_bssrdf_at_nm(scene: &Scene, side: usize, spp: u32, seed: u64, nm: f32) -> Film {
+    use crate::integrator::{BodyIntegrator, IntegratorKind};
+    let body = BodyIntegrator::build(scene, IntegratorKind::Bssrdf);
+    let opts = RenderOptions {
+        width: side,
+        height: side,
+        spp,
+        seed,
+        wavelength_nm: Some(nm),
+        ..Default::default()
+    };
+    crate::renderer::render_with(scene, &body, &opts.validate().expect("valid options"), None)
+        .expect("the render")
+        .0
+}
+
 /// A film against a closed form per pixel, over the pixels of a `side` × `side` image of `scene`
 /// whose centre ray meets a surface at a point where `inside` holds: (the film's summed
 /// luminance, its summed variance, the closed form summed, pixels). Each pixel's closed form is

@@ -512,10 +512,7 @@ fn the_widest_within_reach_covers_the_light_skin_it_can_reach_and_no_farther() {
 #[test]
 fn curvature_term_follows_the_texels_skin() {
     use glam::{Vec2, Vec3};
-    use render::film::Film;
-    use render::integrator::BodyIntegrator;
     use render::material::Material;
-    use render::renderer::{RenderOptions, render_with};
     use render::scene::Hit;
     use render::spectrum::SampledWavelengths;
     let (radius, nm, side) = (5.0f32, 550.0f32, 16usize);
@@ -587,38 +584,14 @@ fn curvature_term_follows_the_texels_skin() {
     let r_tot = f64::from(maps.totals(&wl, front.uv).0[0]);
     let texel = maps.exit_texel(front.uv);
     let planar = |r: f32| f64::from(maps.profile(&wl, front.uv, &texel, r, (None, None)).0[0]);
-    let (n, r_max) = (20_000, 2f64.sqrt() * f64::from(radius));
-    let m2: f64 = (0..n)
-        .map(|i| {
-            let d = (i as f64 + 0.5) / n as f64 * r_max;
-            planar(d as f32) * 2.0 * std::f64::consts::PI * d * d * d * r_max / n as f64
-        })
-        .sum::<f64>()
-        / r_tot;
+    let r_max = 2f64.sqrt() * f64::from(radius);
+    let m2 = render::testing::radial_third_moment(planar, r_max) / r_tot;
     let gain = kappa_cap * m2 / (2.0 * f64::from(radius));
     let typical_gain = kappa_typical * m2 / (2.0 * f64::from(radius));
     let dir = &mapped.subsurface.as_ref().unwrap().directional;
     let inside = |p: Vec3| p.truncate().length() < 0.9 * radius;
-    let film: Film = {
-        let body = BodyIntegrator::build(&scene, IntegratorKind::Bssrdf);
-        let opts = RenderOptions {
-            width: side,
-            height: side,
-            spp: 128,
-            seed: 7,
-            wavelength_nm: Some(nm),
-            ..Default::default()
-        };
-        render_with(&scene, &body, &opts.validate().unwrap(), None)
-            .unwrap()
-            .0
-    };
-    let closed = |g: f64| {
-        move |mu: f32| {
-            let t = f64::from(dir.transmittance(mu));
-            (1.0 - t) + f64::from(dir.factor(mu, nm)) * r_tot * (1.0 + g)
-        }
-    };
+    let film = render::testing::render_bssrdf_at_nm(&scene, side, 128, 7, nm);
+    let closed = |g: f64| render::testing::sky_sphere_closed_form(dir, nm, r_tot, g);
     let (got, var, want, pixels) =
         render::testing::film_against_closed_form(&scene, &film, (side, 4), inside, closed(gain));
     let (_, _, want_typical, _) = render::testing::film_against_closed_form(

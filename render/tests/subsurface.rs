@@ -600,9 +600,6 @@ fn small_light_skin_sphere_matches_the_volumetric_walk_with_the_curvature_term()
 /// per-exit factor together, against quadrature rather than against another render.
 #[test]
 fn curvature_term_on_a_sphere_renders_its_closed_form() {
-    use render::film::Film;
-    use render::integrator::{BodyIntegrator, IntegratorKind};
-    use render::renderer::{RenderOptions, render_with};
     let (radius, nm, side) = (5.0f32, 650.0f32, 16usize);
     let scene = SceneText::camera([0.0, 0.0, 12.0 * radius], 11.0)
         .with("[environment]\nspectral_radiance = 1")
@@ -619,40 +616,19 @@ fn curvature_term_on_a_sphere_renders_its_closed_form() {
     let (table, dir) = (&ss.table, &ss.directional);
     let r_tot = f64::from(table.total(nm));
     let kappa = f64::from(ss.curvature.as_ref().unwrap().kappa_per_mm(nm));
-    let (n, r_max) = (
-        20_000,
-        f64::from(table.r_max_mm(nm)).min(2f64.sqrt() * f64::from(radius)),
-    );
-    let m2: f64 = (0..n)
-        .map(|i| {
-            let d = (i as f64 + 0.5) / n as f64 * r_max;
-            f64::from(table.eval(nm, d as f32)) * 2.0 * std::f64::consts::PI * d * d * d * r_max
-                / n as f64
-        })
-        .sum::<f64>()
-        / r_tot;
+    let r_max = f64::from(table.r_max_mm(nm)).min(2f64.sqrt() * f64::from(radius));
+    let m2 = render::testing::radial_third_moment(|r| f64::from(table.eval(nm, r)), r_max) / r_tot;
     let gain = kappa * m2 / (2.0 * f64::from(radius));
     assert!(gain > 0.05, "G = {gain}: the case must test the term");
     let inside = |p: Vec3| p.truncate().length() < 0.9 * radius;
-    let film: Film = {
-        let body = BodyIntegrator::build(&scene, IntegratorKind::Bssrdf);
-        let opts = RenderOptions {
-            width: side,
-            height: side,
-            spp: 128,
-            seed: SEED,
-            wavelength_nm: Some(nm),
-            ..Default::default()
-        };
-        render_with(&scene, &body, &opts.validate().unwrap(), None)
-            .unwrap()
-            .0
-    };
-    let (got, var, want, pixels) =
-        render::testing::film_against_closed_form(&scene, &film, (side, 4), inside, |mu| {
-            let t = f64::from(dir.transmittance(mu));
-            (1.0 - t) + f64::from(dir.factor(mu, nm)) * r_tot * (1.0 + gain)
-        });
+    let film = render::testing::render_bssrdf_at_nm(&scene, side, 128, SEED, nm);
+    let (got, var, want, pixels) = render::testing::film_against_closed_form(
+        &scene,
+        &film,
+        (side, 4),
+        inside,
+        render::testing::sky_sphere_closed_form(dir, nm, r_tot, gain),
+    );
     assert!(pixels > side * side / 4, "{pixels} pixels");
     let se = var.sqrt() / want;
     let rel = got / want - 1.0;
