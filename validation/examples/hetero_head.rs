@@ -87,6 +87,11 @@ struct Region {
     y: [usize; 2],
 }
 
+/// The region `name` over pixels x ∈ [x₀, x₁), y ∈ [y₀, y₁).
+const fn region(name: &'static str, x: [usize; 2], y: [usize; 2]) -> Region {
+    Region { name, x, y }
+}
+
 /// The view: the camera's look-at point and field of view, the image side and the regions.
 struct View {
     look_at_y_mm: f32,
@@ -100,51 +105,19 @@ struct View {
 /// thin epidermis gives way to the normal one, and the skin below it) and the chin's skin (normal
 /// epidermis).
 const LIP_REGIONS: [Region; 4] = [
-    Region {
-        name: "lower lip",
-        x: [24, 65],
-        y: [59, 67],
-    },
-    Region {
-        name: "upper lip",
-        x: [20, 60],
-        y: [42, 53],
-    },
-    Region {
-        name: "lip edge",
-        x: [28, 68],
-        y: [67, 84],
-    },
-    Region {
-        name: "chin",
-        x: [30, 62],
-        y: [84, 95],
-    },
+    region("lower lip", [24, 65], [59, 67]),
+    region("upper lip", [20, 60], [42, 53]),
+    region("lip edge", [28, 68], [67, 84]),
+    region("chin", [30, 62], [84, 95]),
 ];
 
 /// The regions: the lit cheek (the head's left, right in the image), the lower lip's centre,
 /// the right ear's lit rim (right of the image) and the forehead's centre.
 const REGIONS: [Region; 4] = [
-    Region {
-        name: "cheek",
-        x: [98, 108],
-        y: [86, 98],
-    },
-    Region {
-        name: "lip",
-        x: [74, 86],
-        y: [111, 116],
-    },
-    Region {
-        name: "ear",
-        x: [122, 127],
-        y: [74, 90],
-    },
-    Region {
-        name: "forehead",
-        x: [68, 92],
-        y: [32, 46],
-    },
+    region("cheek", [98, 108], [86, 98]),
+    region("lip", [74, 86], [111, 116]),
+    region("ear", [122, 127], [74, 90]),
+    region("forehead", [68, 92], [32, 46]),
 ];
 
 fn render(

@@ -401,48 +401,25 @@ mod tests {
         use PhotonPolicy::{Fixed, Footprint, Override};
         let (exact, mp) = (Method::Exact, Method::Multipole);
         let table = |n| Shapes::Table(Some(n));
+        let (foot, esc) = (Footprint(1.0), Shapes::Escapes);
         let cases = [
             (exact, Fixed, None, Shapes::Table(None), true),
             (exact, Fixed, None, table(50_000), false),
-            (exact, Fixed, Some(1000), Shapes::Escapes(1000), true),
-            (exact, Fixed, Some(1000), Shapes::Escapes(999), false),
+            (exact, Fixed, Some(1000), esc(1000), true),
+            (exact, Fixed, Some(1000), esc(999), false),
             (exact, Override(77_000), None, table(77_000), true),
             (exact, Override(77_000), None, table(50_000), false),
-            (mp, Footprint(1.0), None, Shapes::Table(None), true),
-            (mp, Footprint(1.0), None, table(50_000), false),
-            (exact, Footprint(1.0), None, table(50_000), true),
-            (exact, Footprint(1.0), None, table(200_000), true),
-            (exact, Footprint(1.0), None, table(60_000), false),
-            (exact, Footprint(1.0), None, Shapes::Table(None), false),
-            (
-                exact,
-                Footprint(1.0),
-                Some(5000),
-                Shapes::Escapes(5000),
-                true,
-            ),
-            (
-                exact,
-                Footprint(1.0),
-                Some(5000),
-                Shapes::Escapes(100),
-                true,
-            ),
-            (
-                exact,
-                Footprint(1.0),
-                Some(5000),
-                Shapes::Escapes(99),
-                false,
-            ),
-            (
-                exact,
-                Footprint(1.0),
-                Some(5000),
-                Shapes::Escapes(5001),
-                false,
-            ),
-            (exact, Footprint(1.0), Some(5000), table(50_000), false),
+            (mp, foot, None, Shapes::Table(None), true),
+            (mp, foot, None, table(50_000), false),
+            (exact, foot, None, table(50_000), true),
+            (exact, foot, None, table(200_000), true),
+            (exact, foot, None, table(60_000), false),
+            (exact, foot, None, Shapes::Table(None), false),
+            (exact, foot, Some(5000), esc(5000), true),
+            (exact, foot, Some(5000), esc(100), true),
+            (exact, foot, Some(5000), esc(99), false),
+            (exact, foot, Some(5000), esc(5001), false),
+            (exact, foot, Some(5000), table(50_000), false),
         ];
         for (method, policy, escapes, shapes, want) in cases {
             assert_eq!(
