@@ -342,6 +342,10 @@ pub enum MaterialDesc {
         /// Target of the profile grid's measured interpolation error, (0, 1) (default 0.02).
         #[serde(default, deserialize_with = "opt_finite")]
         map_profile_error: Option<f32>,
+        /// Target of the incidence gain grid's measured interpolation error, (0, 1) (default
+        /// 0.005; docs/physics.md §19.3).
+        #[serde(default, deserialize_with = "opt_finite")]
+        map_incidence_error: Option<f32>,
         /// Whether texels flagged in the maps' `thin_epidermis` channel (or fitted so by
         /// `fit_maps`) take the thin epidermis (default true; false: every texel keeps its
         /// chromophores under the material's epidermis).

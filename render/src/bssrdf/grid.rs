@@ -68,8 +68,7 @@ impl ProfileGrid {
             axes.iter().map(Vec::len).product::<usize>(),
             "one table per node"
         );
-        let warped =
-            std::array::from_fn(|k| axes[k].iter().map(|&v| warp(AXIS_KNEES[k], v)).collect());
+        let warped = warped_axes(&axes);
         let shared = tables.iter().all(|t| t.same_rows(&tables[0]));
         let (totals, rows) = if shared {
             let totals = tables.iter().flat_map(|t| t.row_totals()).collect();
@@ -128,41 +127,60 @@ impl ProfileGrid {
     /// coordinate clamped to its axis).
     #[must_use]
     pub fn corners(&self, p: [f32; 3]) -> Corners<'_> {
-        let locate = |k: usize, x: f32| -> (usize, f32) {
-            let axis = &self.axes[k];
-            if axis.len() == 1 {
-                return (0, 0.0);
-            }
-            let last = axis.len() - 1;
-            let i = axis.partition_point(|&a| a <= x).clamp(1, last) - 1;
-            let w = &self.warped[k];
-            let t = ((warp(AXIS_KNEES[k], x) - w[i]) / (w[i + 1] - w[i])).clamp(0.0, 1.0);
-            (i, t)
-        };
-        let at = [0, 1, 2].map(|k| locate(k, p[k]));
-        let (n0, n1) = (self.axes[0].len(), self.axes[1].len());
-        let mut nodes = [(0u32, 0.0f32); 8];
-        let mut n = 0;
-        for c in 0..8 {
-            let bits = [c & 1, (c >> 1) & 1, (c >> 2) & 1];
-            let mut w = 1.0;
-            let mut index = [0usize; 3];
-            for k in 0..3 {
-                let (i, t) = at[k];
-                w *= if bits[k] == 1 { t } else { 1.0 - t };
-                index[k] = i + bits[k];
-            }
-            if w > 0.0 {
-                nodes[n] = ((index[0] + n0 * (index[1] + n1 * index[2])) as u32, w);
-                n += 1;
-            }
-        }
+        let (nodes, n) = node_weights(&self.axes, &self.warped, p);
         Corners {
             grid: self,
             nodes,
             n,
         }
     }
+}
+
+/// The warped node values ([`warp`]) of each axis of `axes` (C_m, β_m, C_h).
+#[must_use]
+pub fn warped_axes(axes: &[Vec<f32>; 3]) -> [Vec<f32>; 3] {
+    std::array::from_fn(|k| axes[k].iter().map(|&v| warp(AXIS_KNEES[k], v)).collect())
+}
+
+/// The nodes around parameters `p` = (C_m, β_m, C_h) of a grid with node values `axes` (warped:
+/// `warped`), C_m fastest, and their multilinear weights, linear in each axis's warped coordinate
+/// (each coordinate clamped to its axis); those of weight 0 left out, the first `n` used.
+#[must_use]
+pub fn node_weights(
+    axes: &[Vec<f32>; 3],
+    warped: &[Vec<f32>; 3],
+    p: [f32; 3],
+) -> ([(u32, f32); 8], usize) {
+    let locate = |k: usize, x: f32| -> (usize, f32) {
+        let axis = &axes[k];
+        if axis.len() == 1 {
+            return (0, 0.0);
+        }
+        let last = axis.len() - 1;
+        let i = axis.partition_point(|&a| a <= x).clamp(1, last) - 1;
+        let w = &warped[k];
+        let t = ((warp(AXIS_KNEES[k], x) - w[i]) / (w[i + 1] - w[i])).clamp(0.0, 1.0);
+        (i, t)
+    };
+    let at = [0, 1, 2].map(|k| locate(k, p[k]));
+    let (n0, n1) = (axes[0].len(), axes[1].len());
+    let mut nodes = [(0u32, 0.0f32); 8];
+    let mut n = 0;
+    for c in 0..8 {
+        let bits = [c & 1, (c >> 1) & 1, (c >> 2) & 1];
+        let mut w = 1.0;
+        let mut index = [0usize; 3];
+        for k in 0..3 {
+            let (i, t) = at[k];
+            w *= if bits[k] == 1 { t } else { 1.0 - t };
+            index[k] = i + bits[k];
+        }
+        if w > 0.0 {
+            nodes[n] = ((index[0] + n0 * (index[1] + n1 * index[2])) as u32, w);
+            n += 1;
+        }
+    }
+    (nodes, n)
 }
 
 impl<'a> Corners<'a> {

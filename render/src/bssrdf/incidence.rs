@@ -35,7 +35,7 @@ pub enum Incidence {
 
 /// a(μ, λ) of one skin: rows every [`INCIDENCE_STEP_NM`] nm from 380 nm, columns at the
 /// outside cosines of the adding-doubling quadrature (ascending, the last 1).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct IncidenceGain {
     mu: Vec<f32>,
     rows: Vec<Vec<f32>>,
@@ -83,6 +83,12 @@ impl IncidenceGain {
             })
             .collect();
         Ok(Self { mu, rows })
+    }
+
+    /// The outside incidence cosines of the columns, ascending.
+    #[must_use]
+    pub fn angles(&self) -> &[f32] {
+        &self.mu
     }
 
     /// Tabulated wavelengths.

@@ -95,6 +95,20 @@ impl Directional {
         self
     }
 
+    /// [`Self::with_incidence`] with the normalisation rows `c` it computed before for `gain` on
+    /// this surface and split (a cached grid's, [`Self::normalisation_rows`]).
+    #[must_use]
+    pub fn with_normalised_incidence(mut self, gain: Arc<IncidenceGain>, c: Vec<f32>) -> Self {
+        self.incidence = Some((gain, c));
+        self
+    }
+
+    /// The normalisation c(λ) per row of the incidence gain, if any.
+    #[must_use]
+    pub fn normalisation_rows(&self) -> Option<&[f32]> {
+        self.incidence.as_ref().map(|(_, c)| c.as_slice())
+    }
+
     /// The incidence gain, if any.
     #[must_use]
     pub fn incidence(&self) -> Option<&IncidenceGain> {

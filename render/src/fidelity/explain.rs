@@ -175,7 +175,12 @@ pub struct MapChoice {
     /// Where texels have a thin epidermis: its thickness (mm), the nodes of its profile grid per
     /// axis and that grid's measured interpolation error.
     pub thin: Option<(f32, [usize; 3], f32)>,
+    /// The incidence gain's grids (the material's, then the thin epidermis') and their target.
+    pub incidence: Option<(Vec<GridChoice>, f32)>,
 }
+
+/// A parameter grid as chosen: its nodes per axis (C_m, β_m, C_h) and its measured error.
+pub type GridChoice = ([usize; 3], f32);
 
 /// Why the shapes have their photon count, in words.
 fn photon_reason(p: &PhotonChoice) -> String {
@@ -311,6 +316,21 @@ pub fn explain_table(skins: &[(&str, &SkinChoices)]) -> String {
                     nodes[1],
                     nodes[2],
                     100.0 * error,
+                );
+            }
+            if let Some((grids, target)) = &m.incidence {
+                let grids: Vec<String> = grids
+                    .iter()
+                    .map(|(n, e)| {
+                        format!("{}×{}×{} nodes, error {:.2}%", n[0], n[1], n[2], 100.0 * e)
+                    })
+                    .collect();
+                let _ = writeln!(
+                    s,
+                    "  {:<16} oblique-incidence gain per texel: {} (target {:.2}%)",
+                    "incidence",
+                    grids.join("; thin epidermis "),
+                    100.0 * target,
                 );
             }
         }

@@ -37,7 +37,7 @@ pub const MAX_NODES_PER_AXIS: usize = 33;
 pub const MAX_GRID_TABLES: usize = 33 * 33;
 
 /// Most cell centres the error is measured at per refinement step (spread over the cells).
-const MAX_PROBED_CELLS: usize = 24;
+pub(super) const MAX_PROBED_CELLS: usize = 24;
 
 /// Wavelengths of the error measure, nm.
 const ERROR_NM: [f32; 21] = [
@@ -337,7 +337,7 @@ fn refine(
 
 /// The node values of the grid over `range` with `nodes` nodes per axis: even in each axis's
 /// warped coordinate, the ends exactly `lo` and `hi`.
-fn node_axes(range: [[f32; 2]; 3], nodes: [usize; 3]) -> [Vec<f32>; 3] {
+pub(super) fn node_axes(range: [[f32; 2]; 3], nodes: [usize; 3]) -> [Vec<f32>; 3] {
     std::array::from_fn(|k| {
         let [lo, hi] = range[k];
         let n = nodes[k];
@@ -358,7 +358,7 @@ fn node_axes(range: [[f32; 2]; 3], nodes: [usize; 3]) -> [Vec<f32>; 3] {
 }
 
 /// The parameters of every node of `axes`, C_m fastest.
-fn node_points(axes: &[Vec<f32>; 3]) -> Vec<[f32; 3]> {
+pub(super) fn node_points(axes: &[Vec<f32>; 3]) -> Vec<[f32; 3]> {
     (0..axes[2].len())
         .flat_map(|c| {
             (0..axes[1].len()).flat_map(move |b| (0..axes[0].len()).map(move |a| [a, b, c]))
@@ -384,7 +384,7 @@ fn node_tables(
 
 /// The centre of every cell of the grid with node values `axes`, midway in each axis's warped
 /// coordinate (a one-node axis keeps its node).
-fn cell_centres(axes: &[Vec<f32>; 3]) -> Vec<[f32; 3]> {
+pub(super) fn cell_centres(axes: &[Vec<f32>; 3]) -> Vec<[f32; 3]> {
     let mids = |k: usize| -> Vec<f32> {
         let a = &axes[k];
         if a.len() == 1 {

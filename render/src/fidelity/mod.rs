@@ -25,6 +25,7 @@
 
 pub mod explain;
 pub mod grid;
+pub mod incidence;
 pub mod key;
 pub mod lod;
 pub mod photons;

@@ -8,7 +8,9 @@
 
 use super::lights::{LightProbabilities, PrevVertex, Receiver, direct_light, light_probabilities};
 use super::{Path, PathTracer, Random, Shading, Step, dims, probe, russian_roulette};
-use crate::bssrdf::{Exit, ProbeFrame, Subsurface, curvature, texture_modulation};
+use crate::bssrdf::{
+    Directional, Exit, GainCorners, ProbeFrame, Subsurface, curvature, texture_modulation,
+};
 use crate::material::hetero::{ExitTexel, LaneCurvature, ProfileBlend};
 use crate::material::{Material, SkinMaterial};
 use crate::sampler::PathSampler;
@@ -61,11 +63,63 @@ impl Outgoing {
 }
 
 /// What the BSSRDF reads of the skin light leaves at, once per hit for every probe: the maps'
-/// texel and its curvature gains at the path's wavelengths.
+/// texel, its curvature gains at the path's wavelengths, the angular factor T(θ_o) a(θ_o, λ)
+/// toward the viewer and, with a gain per texel, the texel's normalisation c(λ).
 #[derive(Clone, Copy)]
 struct ExitSkin<'t, 'm> {
     texel: Option<&'t ExitTexel<'m>>,
     curvature: Option<&'t LaneCurvature>,
+    t_o: SampledSpectrum,
+    c_o: Option<SampledSpectrum>,
+}
+
+/// The angular factor where light enters skin, S_ω π = T a / c: the material's, or the entry
+/// texel's gain over the normalisation the two ends' rule gives (docs/physics.md §19.3).
+#[derive(Clone, Copy)]
+pub(super) enum EntryAngle<'a> {
+    /// The material's angular factor.
+    Material(&'a Directional),
+    /// The entry texel's gain `gain` and the path's normalisation `c` per lane.
+    Texel {
+        gain: GainCorners<'a>,
+        c: SampledSpectrum,
+    },
+}
+
+impl EntryAngle<'_> {
+    /// T a s / c at each of the path's wavelengths (the texel's).
+    fn texel_factors(
+        gain: &GainCorners<'_>,
+        c: &SampledSpectrum,
+        s: f32,
+        cos_theta: f32,
+        wl: &SampledWavelengths,
+    ) -> SampledSpectrum {
+        let f = gain.factors(cos_theta, wl);
+        SampledSpectrum(std::array::from_fn(|k| {
+            if c.0[k] > 0.0 {
+                f.0[k] * s / c.0[k]
+            } else {
+                0.0
+            }
+        }))
+    }
+
+    /// T a / c at each of the path's wavelengths: the cosine-weighted continuation's weight.
+    fn cosine_sample_weights(&self, cos_theta: f32, wl: &SampledWavelengths) -> SampledSpectrum {
+        match self {
+            Self::Material(d) => d.cosine_sample_weights(cos_theta, wl),
+            Self::Texel { gain, c } => Self::texel_factors(gain, c, 1.0, cos_theta, wl),
+        }
+    }
+
+    /// S_ω = T a / (c π) at each of the path's wavelengths, sr⁻¹.
+    fn s_omegas(&self, cos_theta: f32, wl: &SampledWavelengths) -> SampledSpectrum {
+        match self {
+            Self::Material(d) => d.s_omegas(cos_theta, wl),
+            Self::Texel { gain, c } => Self::texel_factors(gain, c, FRAC_1_PI, cos_theta, wl),
+        }
+    }
 }
 
 impl PathTracer<'_> {
@@ -93,9 +147,16 @@ impl PathTracer<'_> {
             .as_ref()
             .zip(texel.as_ref())
             .and_then(|(m, t)| m.lane_curvature(wl, t));
+        let cos_o = hit.wo.dot(hit.ns);
+        let gain_o = texel.as_ref().and_then(|t| t.gain);
         let exit_skin = ExitSkin {
             texel: texel.as_ref(),
             curvature: curvature.as_ref(),
+            t_o: gain_o.map_or_else(
+                || ss.directional.factors(cos_o, wl),
+                |g| g.factors(cos_o, wl),
+            ),
+            c_o: gain_o.map(|g| g.normalisations(wl)),
         };
         let found =
             self.subsurface_exit(skin, (ss, exit_skin), hit, wl, (&mut *sampler, &mut *rays));
@@ -116,11 +177,11 @@ impl PathTracer<'_> {
         if probes > 1 && hit.q_sss > 0.0 {
             for k in 1..probes {
                 let mut fork = sampler.fork(k);
-                if let Some((exit, w)) =
+                if let Some((exit, w, angle)) =
                     self.subsurface_exit(skin, (ss, exit_skin), hit, wl, (&mut fork, &mut *rays))
                 {
                     let (direct, _) = self.exit_light(
-                        ss,
+                        (ss, angle),
                         &exit,
                         wl,
                         (&mut fork, &mut *rays),
@@ -131,7 +192,7 @@ impl PathTracer<'_> {
                 }
             }
         }
-        let Some((exit, weight)) = found else {
+        let Some((exit, weight, angle)) = found else {
             return if hit.take_sss {
                 Step::Stop
             } else {
@@ -141,7 +202,7 @@ impl PathTracer<'_> {
         let beta_exit = path.beta * weight;
         // At the exit point: next-event estimation with S_ω, then the continuation.
         let (direct, lit_exit) = self.exit_light(
-            ss,
+            (ss, angle),
             &exit,
             wl,
             (&mut *sampler, &mut *rays),
@@ -155,7 +216,7 @@ impl PathTracer<'_> {
         self.continue_from_exit(
             path,
             hit,
-            ss,
+            (ss, angle),
             &exit,
             (beta_exit, lit_exit, outgoing),
             (wl, sampler),
@@ -163,14 +224,14 @@ impl PathTracer<'_> {
     }
 
     /// The subsurface branch was taken: continue from `exit` in a cosine-weighted direction
-    /// (weight S_ω cos / (cos / π) = T / c, times `beta_exit` / q, times the azimuthal lobe toward
-    /// `outgoing`); `lit_exit` tells whether a light could reach the exit (its probabilities are
-    /// in `Path::exit_pick`).
+    /// (weight S_ω cos / (cos / π) = T a / c of the entry's `angle`, times `beta_exit` / q,
+    /// times the azimuthal lobe toward `outgoing`); `lit_exit` tells whether a light could reach
+    /// the exit (its probabilities are in `Path::exit_pick`).
     pub(super) fn continue_from_exit(
         &self,
         path: &mut Path,
         hit: &Shading<'_>,
-        ss: &Subsurface,
+        (ss, angle): (&Subsurface, EntryAngle<'_>),
         exit: &Exit,
         (beta_exit, lit_exit, outgoing): (SampledSpectrum, bool, Option<Outgoing>),
         (wl, sampler): (&SampledWavelengths, &mut PathSampler),
@@ -182,7 +243,7 @@ impl PathTracer<'_> {
         if local.z <= 0.0 || wi.dot(eng) <= 0.0 {
             return Step::Stop;
         }
-        let mut w = ss.directional.cosine_sample_weights(local.z, wl);
+        let mut w = angle.cosine_sample_weights(local.z, wl);
         if let Some(m) = outgoing.and_then(|o| o.lobe(ss, wi, ens, local.z, wl)) {
             w *= m;
         }
@@ -205,15 +266,16 @@ impl PathTracer<'_> {
     /// Sample where the light leaving skin at `hit` entered (a probe, [`probe::sample_exit`]),
     /// and the throughput factor of the path through the skin: T(θ_o) · R(r) · N / pdf ·
     /// √(m_o m_i), the texture's modulation capped so that no wavelength's R_tot · m exceeds 1
-    /// (`bssrdf::separable`). None when the probe found nothing or the factor is 0 or not finite.
-    fn subsurface_exit(
+    /// (`bssrdf::separable`), and the angular factor where the light entered. None when the
+    /// probe found nothing or the factor is 0 or not finite.
+    fn subsurface_exit<'s>(
         &self,
-        skin: &SkinMaterial,
-        (ss, exit_skin): (&Subsurface, ExitSkin<'_, '_>),
+        skin: &'s SkinMaterial,
+        (ss, exit_skin): (&'s Subsurface, ExitSkin<'_, 's>),
         hit: &Shading<'_>,
         wl: &SampledWavelengths,
         (sampler, rays): Random<'_>,
-    ) -> Option<(Exit, SampledSpectrum)> {
+    ) -> Option<(Exit, SampledSpectrum, EntryAngle<'s>)> {
         let scene = self.scene;
         let f = &hit.bsdf.frame;
         let frame = ProbeFrame {
@@ -259,19 +321,31 @@ impl PathTracer<'_> {
             u,
             rays,
         )?;
-        let t_o = ss.directional.factors(hit.wo.dot(hit.ns), wl);
+        let t_o = exit_skin.t_o;
         if let (Some(maps), Some(texel)) = (&skin.maps, texel) {
             // The profile of the skin at both ends instead of the texture's modulation.
-            let uv_i = exit.hit.map_or(si.uv, |h| h.uv);
+            let entry = maps.entry_texel(exit.hit.map_or(si.uv, |h| h.uv));
             // Each end's own curvature term (the probe carries none with maps); the local
             // fallback keeps the planar weight.
             let depth = exit
                 .hit
                 .and_then(|_| curvature::depth_below_tangent_mm(si.p, frame.n, exit.p, exit.ns));
-            let weight = maps.profile(wl, uv_i, texel, exit.r_mm, (depth, exit_skin.curvature))
+            let weight = maps.profile(wl, &entry, texel, exit.r_mm, (depth, exit_skin.curvature))
                 * exit.per_profile
                 * t_o;
-            return (!weight.is_black() && weight.is_finite()).then_some((exit, weight));
+            let angle = match (entry.gain, exit_skin.c_o) {
+                (Some(gain), Some(c_o)) => {
+                    let c_i = gain.normalisations(wl);
+                    EntryAngle::Texel {
+                        gain,
+                        c: SampledSpectrum(std::array::from_fn(|k| {
+                            maps.blend.combine(c_i.0[k], c_o.0[k])
+                        })),
+                    }
+                }
+                _ => EntryAngle::Material(&ss.directional),
+            };
+            return (!weight.is_black() && weight.is_finite()).then_some((exit, weight, angle));
         }
         let m_o = skin.texture_factor(si.uv, &scene.textures);
         let m_i = exit
@@ -282,16 +356,20 @@ impl PathTracer<'_> {
             m.min(1.0 / ss.table.at_lane(wl, k).total().max(1e-6))
         }));
         let weight = exit.weight * cap * t_o;
-        (!weight.is_black() && weight.is_finite()).then_some((exit, weight))
+        (!weight.is_black() && weight.is_finite()).then_some((
+            exit,
+            weight,
+            EntryAngle::Material(&ss.directional),
+        ))
     }
 
-    /// Next-event estimation at a subsurface exit point with S_ω (MIS against the cosine-weighted
-    /// continuation): the mean of `settings.exit_light_samples` light samples sharing the exit
-    /// (splitting), and whether any light can reach the point (`pick` gets its light
-    /// probabilities).
+    /// Next-event estimation at a subsurface exit point with S_ω of the entry's `angle` (MIS
+    /// against the cosine-weighted continuation): the mean of `settings.exit_light_samples`
+    /// light samples sharing the exit (splitting), and whether any light can reach the point
+    /// (`pick` gets its light probabilities).
     pub(super) fn exit_light(
         &self,
-        ss: &Subsurface,
+        (ss, angle): (&Subsurface, EntryAngle<'_>),
         exit: &Exit,
         wl: &SampledWavelengths,
         (sampler, rays): (&mut PathSampler, &mut u64),
@@ -334,7 +412,7 @@ impl PathTracer<'_> {
                 (&mut *sampler, &mut *rays),
                 |wi| {
                     let c = wi.dot(ens);
-                    let mut f = ss.directional.s_omegas(c, wl) * c.max(0.0);
+                    let mut f = angle.s_omegas(c, wl) * c.max(0.0);
                     if let Some(m) = outgoing.and_then(|o| o.lobe(ss, wi, ens, c, wl)) {
                         f *= m;
                     }

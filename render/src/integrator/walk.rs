@@ -5,6 +5,7 @@
 //! the energy leaving there, and the exit is shaded as a BSSRDF exit: light sampled with S_ω, the
 //! path continued cosine-weighted.
 
+use super::subsurface::EntryAngle;
 use super::{BodyIntegrator, Path, PathTracer, Random, Shading, Step, ThinExit, russian_roulette};
 use crate::bssrdf::Exit;
 use crate::material::Material;
@@ -68,8 +69,9 @@ impl PathTracer<'_> {
                 per_profile: SampledSpectrum::splat(1.0),
                 r_mm: (exit.p - hit.si.p).length(),
             };
+            let angle = EntryAngle::Material(&ss.directional);
             let (direct, lit) = self.exit_light(
-                ss,
+                (ss, angle),
                 &at,
                 wl,
                 (&mut *sampler, &mut *rays),
@@ -80,7 +82,7 @@ impl PathTracer<'_> {
             return self.continue_from_exit(
                 path,
                 hit,
-                ss,
+                (ss, angle),
                 &at,
                 (beta_exit, lit, None),
                 (wl, sampler),

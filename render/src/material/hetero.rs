@@ -4,7 +4,7 @@
 //! that combines the profiles of the two ends of a path.
 
 use super::maps::ChromophoreMaps;
-use crate::bssrdf::{Corners, ProfileGrid};
+use crate::bssrdf::{Corners, GainCorners, IncidenceGrid, ProfileGrid};
 use crate::media::{MediaError, SkinMedia};
 use crate::spectrum::{N_WAVELENGTHS, SampledSpectrum, SampledWavelengths, SpectrumTable};
 use glam::Vec2;
@@ -191,6 +191,19 @@ pub struct ExitTexel<'a> {
     /// The BSSRDF that samples radii there (`None`: the material's, from the grid's widest
     /// profile).
     pub sampling: Option<&'a crate::bssrdf::Subsurface>,
+    /// The incidence gain's corners at the texel (`None`: the material's angular factor).
+    pub gain: Option<GainCorners<'a>>,
+}
+
+/// The texel light enters at, as the BSSRDF reads it ([`SkinMaps::entry_texel`]).
+#[derive(Debug, Clone, Copy)]
+pub struct EntryTexel<'a> {
+    /// The texel's parameters (C_m, β_m, C_h).
+    pub params: [f32; 3],
+    /// The profile grid's corners at the texel's parameters.
+    pub corners: Corners<'a>,
+    /// The incidence gain's corners at the texel (`None`: the material's angular factor).
+    pub gain: Option<GainCorners<'a>>,
 }
 
 /// The curvature gains of a skin with maps at one path's wavelengths
@@ -241,6 +254,9 @@ pub struct SkinMaps {
     pub epidermis_mm: f32,
     /// The curvature term at each texel (`None`: the planar profile, `Curvature::Planar`).
     curvature: Option<TexelCurvature>,
+    /// The angular factor's incidence gain at each texel: over the maps' box, and over the thin
+    /// epidermis' where texels have it (`None` without the gain, `Incidence::Normal`).
+    pub incidence: Option<(IncidenceGrid, Option<IncidenceGrid>)>,
 }
 
 /// What the first-order curvature term needs at a texel (docs/physics.md §8.2, §19.3): its gain
@@ -266,11 +282,45 @@ impl SkinMaps {
         self.corners_at(uv, self.maps.at(uv))
     }
 
+    /// Whether the texel of `uv` reads the thin epidermis' grids.
+    #[inline]
+    fn reads_thin(&self, uv: Vec2) -> bool {
+        self.thin_grid.is_some() && self.maps.thin().is_some_and(|t| t.is_thin(uv))
+    }
+
+    /// The incidence gain's corners at parameters `p` of a texel under the thin epidermis
+    /// (`thin`) or the material's.
+    #[inline]
+    fn gain_at(&self, thin: bool, p: [f32; 3]) -> Option<GainCorners<'_>> {
+        let (thick_grid, thin_grid) = self.incidence.as_ref()?;
+        Some(match thin_grid {
+            Some(g) if thin => g.corners(p),
+            _ => thick_grid.corners(p),
+        })
+    }
+
+    /// What the BSSRDF reads of the texel of `uv` where light enters: its parameters, its
+    /// profile's corners and its incidence gain's, from one look-up of the maps.
+    #[must_use]
+    #[inline]
+    pub fn entry_texel(&self, uv: Vec2) -> EntryTexel<'_> {
+        let p = self.maps.at(uv);
+        let thin = self.reads_thin(uv);
+        EntryTexel {
+            params: p,
+            corners: match &self.thin_grid {
+                Some(grid) if thin => grid.corners(p),
+                _ => self.grid.corners(p),
+            },
+            gain: self.gain_at(thin, p),
+        }
+    }
+
     /// [`SkinMaps::corners`] with the texel's parameters `p` already read.
     #[inline]
     fn corners_at(&self, uv: Vec2, p: [f32; 3]) -> Corners<'_> {
-        match (&self.thin_grid, self.maps.thin()) {
-            (Some(grid), Some(thin)) if thin.is_thin(uv) => grid.corners(p),
+        match &self.thin_grid {
+            Some(grid) if self.reads_thin(uv) => grid.corners(p),
             _ => self.grid.corners(p),
         }
     }
@@ -296,8 +346,9 @@ impl SkinMaps {
     #[inline]
     pub fn exit_texel(&self, uv: Vec2) -> ExitTexel<'_> {
         let p = self.maps.at(uv);
-        let (grid, offset) = match (&self.thin_grid, self.maps.thin()) {
-            (Some(grid), Some(thin)) if thin.is_thin(uv) => (grid, self.grid.tables().len()),
+        let thin = self.reads_thin(uv);
+        let (grid, offset) = match &self.thin_grid {
+            Some(grid) if thin => (grid, self.grid.tables().len()),
             _ => (&self.grid, 0),
         };
         let sampling = if self.sampling.is_empty() {
@@ -310,6 +361,7 @@ impl SkinMaps {
             params: p,
             corners: grid.corners(p),
             sampling,
+            gain: self.gain_at(thin, p),
         }
     }
 
@@ -403,7 +455,7 @@ impl SkinMaps {
         Some(lanes)
     }
 
-    /// R(r) per lane of a path through skin from `uv_i` (entry) to the texel `exit` at distance
+    /// R(r) per lane of a path through skin from the texel `entry` to the texel `exit` at distance
     /// `r_mm`, combined by the material's rule, mm⁻². Where the exit lies `depth_mm` below the
     /// entry's tangent plane (`crate::bssrdf::curvature::depth_below_tangent_mm`; `None` for
     /// none, as for the local fallback) each end's profile carries its own skin's curvature
@@ -412,15 +464,13 @@ impl SkinMaps {
     pub fn profile(
         &self,
         wl: &SampledWavelengths,
-        uv_i: Vec2,
+        entry: &EntryTexel<'_>,
         exit: &ExitTexel<'_>,
         r_mm: f32,
         (depth_mm, curvature): (Option<f32>, Option<&LaneCurvature>),
     ) -> SampledSpectrum {
-        let p_i = self.maps.at(uv_i);
-        let [mut at_o, mut at_i] = exit
-            .corners
-            .eval_pair(&self.corners_at(uv_i, p_i), wl, r_mm);
+        let p_i = entry.params;
+        let [mut at_o, mut at_i] = exit.corners.eval_pair(&entry.corners, wl, r_mm);
         if let (Some(h), Some(c)) = (depth_mm, curvature) {
             for k in 0..N_WAVELENGTHS {
                 if wl.pdf()[k] > 0.0 {
@@ -446,13 +496,15 @@ impl super::SkinMaterial {
     /// grid over the maps' parameter box (error target `grid_error`,
     /// `crate::fidelity::grid::DEFAULT_GRID_ERROR` by default) and the rule `blend`. The BSSRDF
     /// samples radii from the grid's widest profile (least melanin and blood) and weights each
-    /// sample by the combined profile of its two ends (§19.3).
+    /// sample by the combined profile of its two ends (§19.3). Where the material has the
+    /// incidence gain, each texel's comes from a grid of its own (error target
+    /// `incidence_error`, `crate::fidelity::incidence::DEFAULT_INCIDENCE_ERROR` by default).
     pub fn with_maps(
         mut self,
         maps: ChromophoreMaps,
         blend: ProfileBlend,
         knobs: &super::SkinKnobs,
-        grid_error: f32,
+        (grid_error, incidence_error): (f32, f32),
     ) -> Result<Self, super::SkinBuildError> {
         let g = self.media.phase_g;
         let absorption = CornerAbsorption::new(&self.params, g)?;
@@ -494,6 +546,39 @@ impl super::SkinMaterial {
             }
             None => None,
         };
+        let incidence = match self.directional.incidence() {
+            Some(_) => {
+                let settings = crate::fidelity::incidence::IncidenceSettings {
+                    params: &self.params,
+                    phase_g: g,
+                    surface: self.media.surface,
+                    directional: &self.directional,
+                    fidelity: &fidelity,
+                    target: incidence_error,
+                };
+                let thick = crate::fidelity::incidence::incidence_grid(&settings, maps.range())
+                    .map_err(super::SkinBuildError::Profiles)?;
+                let thin = match maps.thin().filter(|_| thin_grid.is_some()) {
+                    Some(thin) => {
+                        let params = self
+                            .params
+                            .with_epidermis_thickness_mm(f64::from(thin.thickness_mm))
+                            .map_err(|e| super::SkinBuildError::Profiles(e.into()))?;
+                        let settings = crate::fidelity::incidence::IncidenceSettings {
+                            params: &params,
+                            ..settings
+                        };
+                        Some(
+                            crate::fidelity::incidence::incidence_grid(&settings, thin.range())
+                                .map_err(super::SkinBuildError::Profiles)?,
+                        )
+                    }
+                    None => None,
+                };
+                Some((thick, thin))
+            }
+            None => None,
+        };
         // The curvature term moves from the probe (one κ for the material) to each end's texel.
         let curvature = self
             .subsurface
@@ -527,6 +612,13 @@ impl super::SkinMaterial {
                         g.max_error,
                     )
                 }),
+                incidence: incidence.as_ref().map(|(thick, thin)| {
+                    let of = |g: &IncidenceGrid| (g.axes().clone().map(|a| a.len()), g.max_error);
+                    (
+                        std::iter::once(thick).chain(thin).map(of).collect(),
+                        incidence_error,
+                    )
+                }),
             });
         }
         let per_node = matches!(blend, ProfileBlend::Exit | ProfileBlend::Geometric)
@@ -553,6 +645,7 @@ impl super::SkinMaterial {
             sampling,
             epidermis_mm: self.params.epidermis_thickness_mm() as f32,
             curvature,
+            incidence,
         }));
         Ok(self)
     }

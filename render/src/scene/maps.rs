@@ -34,6 +34,7 @@ pub(super) struct MapKeys<'a> {
     pub edit_mask: &'a Option<String>,
     pub profile_blend: &'a Option<String>,
     pub map_profile_error: &'a Option<f32>,
+    pub map_incidence_error: &'a Option<f32>,
     /// `thin_epidermis` (whether flagged texels take it) and `thin_epidermis_mm`.
     pub thin_epidermis: (&'a Option<bool>, &'a Option<f64>),
 }
@@ -52,10 +53,16 @@ impl Loader<'_> {
             || keys.melanin_ita_deg.is_some();
         let Some(maps) = maps else {
             let thin = keys.thin_epidermis.0.is_some() || keys.thin_epidermis.1.is_some();
-            if edited || keys.profile_blend.is_some() || keys.map_profile_error.is_some() || thin {
+            if edited
+                || keys.profile_blend.is_some()
+                || keys.map_profile_error.is_some()
+                || keys.map_incidence_error.is_some()
+                || thin
+            {
                 return Err(self.err(
                     key,
                     "the edits, melanin_ita_deg, profile_blend, map_profile_error, \
+                     map_incidence_error, \
                      thin_epidermis and thin_epidermis_mm need a map (maps, fit_maps, melanin_map, eumelanin_map, \
                      hemoglobin_map or edit_mask)",
                 ));
@@ -68,17 +75,24 @@ impl Loader<'_> {
                 .map_err(|e| self.err(format!("{key}.profile_blend"), e.to_string()))?,
             None => ProfileBlend::default(),
         };
-        let target = match *keys.map_profile_error {
-            Some(e) if e > 0.0 && e < 1.0 => e,
-            Some(e) => {
-                return Err(self.err(
-                    format!("{key}.map_profile_error"),
-                    format!("{e} outside (0, 1)"),
-                ));
-            }
-            None => DEFAULT_GRID_ERROR,
+        let target = |name: &str, value: &Option<f32>, default: f32| match *value {
+            Some(e) if e > 0.0 && e < 1.0 => Ok(e),
+            Some(e) => Err(self.err(format!("{key}.{name}"), format!("{e} outside (0, 1)"))),
+            None => Ok(default),
         };
-        skin.with_maps(maps, blend, knobs, target)
+        let targets = (
+            target(
+                "map_profile_error",
+                keys.map_profile_error,
+                DEFAULT_GRID_ERROR,
+            )?,
+            target(
+                "map_incidence_error",
+                keys.map_incidence_error,
+                crate::fidelity::incidence::DEFAULT_INCIDENCE_ERROR,
+            )?,
+        );
+        skin.with_maps(maps, blend, knobs, targets)
             .map_err(|e: SkinBuildError| self.err(key, e.to_string()))
     }
 

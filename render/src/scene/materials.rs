@@ -77,6 +77,7 @@ impl Loader<'_> {
                     edit_mask,
                     profile_blend,
                     map_profile_error,
+                    map_incidence_error,
                     thin_epidermis,
                     thin_epidermis_mm,
                 } => {
@@ -103,6 +104,7 @@ impl Loader<'_> {
                         edit_mask,
                         profile_blend,
                         map_profile_error,
+                        map_incidence_error,
                         thin_epidermis: (thin_epidermis, thin_epidermis_mm),
                     };
                     let maps = self.chromophore_maps(&key, &params, &map_keys)?;
