@@ -58,7 +58,7 @@ pub use azimuth::{Azimuth, AzimuthOptions, AzimuthalLobe};
 pub use curvature::{Curvature, CurvatureGain};
 pub use grid::{Corners, ProfileGrid};
 pub use incidence::{Incidence, IncidenceGain};
-pub use incidence_grid::{GainCorners, IncidenceGrid};
+pub use incidence_grid::{AngularFactor, GainCorners, IncidenceGrid};
 pub use sampling::{Probe, ProbeAxes, ProbeFrame, RadiusWavelength, pdf_exit, probe};
 pub use separable::{Directional, EnergySplit, texture_modulation};
 pub use table::{ProfileTable, RENDER_SHAPE_STEP_NM, RowPlace, RowsAt, TableOptions, TableRadius};

@@ -162,3 +162,44 @@ impl GainCorners<'_> {
         SampledSpectrum(c)
     }
 }
+
+/// The separable BSSRDF's angular factor at one point (docs/physics.md §8.1, §19.3): the
+/// material's, or the texel's of a skin with maps.
+#[derive(Debug, Clone, Copy)]
+pub enum AngularFactor<'a> {
+    /// The material's, from its one skin.
+    Material(&'a Directional),
+    /// The texel's, from the incidence gain's grid.
+    Texel(GainCorners<'a>),
+}
+
+impl AngularFactor<'_> {
+    /// T(cos θ) a(cos θ, λ) at each of the path's wavelengths.
+    #[must_use]
+    pub fn factors(&self, cos_theta: f32, wl: &SampledWavelengths) -> SampledSpectrum {
+        match self {
+            Self::Material(d) => d.factors(cos_theta, wl),
+            Self::Texel(g) => g.factors(cos_theta, wl),
+        }
+    }
+
+    /// c = ∫₀¹ T(μ) 2μ dμ of the surface alone, without the gain ([`Directional::normalisation`]).
+    #[must_use]
+    pub fn normalisation(&self) -> f32 {
+        match self {
+            Self::Material(d) => d.normalisation(),
+            Self::Texel(g) => g.grid.nodes[g.nodes[0].0 as usize].normalisation(),
+        }
+    }
+
+    /// c(λ) at each of the path's wavelengths.
+    #[must_use]
+    pub fn normalisations(&self, wl: &SampledWavelengths) -> SampledSpectrum {
+        match self {
+            Self::Material(d) => {
+                SampledSpectrum(std::array::from_fn(|k| d.normalisation_lane(wl, k)))
+            }
+            Self::Texel(g) => g.normalisations(wl),
+        }
+    }
+}

@@ -299,6 +299,13 @@ impl SkinMaps {
         })
     }
 
+    /// The incidence gain's corners at the texel of `uv` (`None` without a gain per texel).
+    #[must_use]
+    pub fn gain(&self, uv: Vec2) -> Option<GainCorners<'_>> {
+        self.incidence.as_ref()?;
+        self.gain_at(self.reads_thin(uv), self.maps.at(uv))
+    }
+
     /// What the BSSRDF reads of the texel of `uv` where light enters: its parameters, its
     /// profile's corners and its incidence gain's, from one look-up of the maps.
     #[must_use]

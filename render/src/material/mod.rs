@@ -31,7 +31,7 @@
 //! spatial detail (brows, lips, pores) without replacing the model's spectral colour; the product
 //! is clamped at 1.
 
-use crate::bssrdf::Directional;
+use crate::bssrdf::AngularFactor;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths, SpectrumTable, linear_srgb_at_nm};
 use crate::texture::Texture;
 use brdf::Frame;
@@ -98,8 +98,9 @@ enum Lobes<'a> {
         surface: Surface<'a>,
         /// R_d(λ) m(uv).
         body: SampledSpectrum,
-        /// T(θ) a(θ, λ) / c(λ) on both sides (the BSSRDF's angular factor).
-        directional: &'a Directional,
+        /// T(θ) a(θ, λ) / c(λ) on both sides (the BSSRDF's angular factor, the texel's with
+        /// maps).
+        directional: AngularFactor<'a>,
         wl: &'a SampledWavelengths,
         /// π c(λ) per lane.
         pi_c: SampledSpectrum,
@@ -204,14 +205,16 @@ impl Material {
             }
             Material::Skin(s) => {
                 let rd = s.body_totals(uv, wl, textures);
+                let directional = match s.maps.as_ref().and_then(|m| m.gain(uv)) {
+                    Some(g) => AngularFactor::Texel(g),
+                    None => AngularFactor::Material(&s.directional),
+                };
                 Lobes::Skin {
                     surface: Surface::of(s),
                     body: rd,
-                    directional: &s.directional,
+                    directional,
                     wl,
-                    pi_c: SampledSpectrum(std::array::from_fn(|k| {
-                        PI * s.directional.normalisation_lane(wl, k)
-                    })),
+                    pi_c: directional.normalisations(wl) * PI,
                     outgoing: Cell::new(None),
                 }
             }
