@@ -21,7 +21,8 @@
 //! one, and the skin below it) and the chin. Writes OUT/hetero_head_lip_VARIANT.{csv,png}, where
 //! `VARIANT` (that view only; the full view renders the maps) changes the skin:
 //! `maps` (default), `thick` (scene key `thin_epidermis = false`: every texel under the
-//! material's epidermis), `planar` (`Curvature::Planar`: no curvature term), `uniform` (no maps:
+//! material's epidermis), `fine` (the grids refined to `map_profile_error = 0.005` and
+//! `map_incidence_error = 0.002`), `planar` (`Curvature::Planar`: no curvature term), `uniform` (no maps:
 //! the scalar skin of the median texel of region `UNIFORM_FROM`, 0 = the lower lip by default,
 //! under the thin epidermis where that texel is thin: the geometry alone), `uniform-planar`
 //! (both), `uniform-typical-kappa` and `uniform-typical-incidence` (that scalar skin with the
@@ -177,6 +178,8 @@ enum Variant {
     Maps,
     /// The maps with `thin_epidermis = false`.
     Thick,
+    /// The maps with finer grids: `map_profile_error = 0.005`, `map_incidence_error = 0.002`.
+    Fine,
     /// The maps without the curvature term.
     Planar,
     /// The lower lip's median texel as a scalar skin.
@@ -195,13 +198,14 @@ impl Variant {
         Ok(match std::env::var("VARIANT").as_deref() {
             Err(_) | Ok("maps") => Self::Maps,
             Ok("thick") => Self::Thick,
+            Ok("fine") => Self::Fine,
             Ok("planar") => Self::Planar,
             Ok("uniform") => Self::Uniform,
             Ok("uniform-planar") => Self::UniformPlanar,
             Ok("uniform-typical-kappa") => Self::UniformTypicalKappa,
             Ok("uniform-typical-incidence") => Self::UniformTypicalIncidence,
             Ok(v) => anyhow::bail!(
-                "VARIANT '{v}' unknown (valid: maps, thick, planar, uniform, uniform-planar, \
+                "VARIANT '{v}' unknown (valid: maps, thick, fine, planar, uniform, uniform-planar, \
                  uniform-typical-kappa, uniform-typical-incidence)"
             ),
         })
@@ -211,6 +215,7 @@ impl Variant {
         match self {
             Self::Maps => "maps",
             Self::Thick => "thick",
+            Self::Fine => "fine",
             Self::Planar => "planar",
             Self::Uniform => "uniform",
             Self::UniformPlanar => "uniform-planar",
@@ -397,12 +402,15 @@ fn main() -> anyhow::Result<()> {
     };
     for &(surface, key) in surfaces {
         let mut text = HEAD.replace("{surface}", key);
-        if variant == Variant::Thick {
-            text = text.replace(
-                "fit_maps = \"auto-rgb\"",
-                "fit_maps = \"auto-rgb\"\nthin_epidermis = false",
-            );
-        }
+        let extra = match variant {
+            Variant::Thick => "\nthin_epidermis = false",
+            Variant::Fine => "\nmap_profile_error = 0.005\nmap_incidence_error = 0.002",
+            _ => "",
+        };
+        text = text.replace(
+            "fit_maps = \"auto-rgb\"",
+            &format!("fit_maps = \"auto-rgb\"{extra}"),
+        );
         if sky {
             let lights = text.find("[[lights]]").expect("the quad light");
             text.truncate(lights);
