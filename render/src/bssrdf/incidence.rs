@@ -38,7 +38,8 @@ pub enum Incidence {
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct IncidenceGain {
     mu: Vec<f32>,
-    rows: Vec<Vec<f32>>,
+    /// The rows one after the other, `mu.len()` values each.
+    rows: Vec<f32>,
 }
 
 impl IncidenceGain {
@@ -71,7 +72,7 @@ impl IncidenceGain {
         let mu = solved[0].iter().map(|r| r.mu_outside as f32).collect();
         let rows = solved
             .iter()
-            .map(|angles| {
+            .flat_map(|angles| {
                 let normal = angles.last().map_or(0.0, |r| r.per_entering());
                 angles
                     .iter()
@@ -79,10 +80,21 @@ impl IncidenceGain {
                         let a = r.per_entering() / normal;
                         if a.is_finite() { a as f32 } else { 1.0 }
                     })
-                    .collect()
+                    .collect::<Vec<f32>>()
             })
             .collect();
         Ok(Self { mu, rows })
+    }
+
+    /// Whether the table is whole: at least one angle, ascending, and every row complete and
+    /// finite (a table read back from the disk cache is checked with it).
+    #[must_use]
+    pub fn is_whole(&self) -> bool {
+        !self.mu.is_empty()
+            && self.mu.windows(2).all(|w| w[0] < w[1])
+            && !self.rows.is_empty()
+            && self.rows.len() % self.mu.len() == 0
+            && self.rows.iter().all(|a| a.is_finite())
     }
 
     /// The outside incidence cosines of the columns, ascending.
@@ -94,7 +106,7 @@ impl IncidenceGain {
     /// Tabulated wavelengths.
     #[must_use]
     pub fn wavelengths(&self) -> usize {
-        self.rows.len()
+        self.rows.len() / self.mu.len().max(1)
     }
 
     /// The wavelength of row `i`, nm.
@@ -134,7 +146,8 @@ impl IncidenceGain {
     /// a of row `i` at the column `c` (linear between the quadrature's angles).
     #[must_use]
     pub fn row_gain_at(&self, i: usize, c: Column) -> f32 {
-        let row = &self.rows[i.min(self.rows.len() - 1)];
+        let n = self.mu.len();
+        let row = &self.rows[n * i.min(self.wavelengths() - 1)..];
         row[c.k0] + c.t * (row[c.k1] - row[c.k0])
     }
 
@@ -148,10 +161,10 @@ impl IncidenceGain {
     /// The row index and weight of the next row for wavelength `nm` (linear in λ).
     #[must_use]
     pub fn rows_at(&self, nm: f32) -> (usize, f32) {
-        if self.rows.len() < 2 {
+        if self.wavelengths() < 2 {
             return (0, 0.0);
         }
-        let at = GridPosition::on_grid(nm, INCIDENCE_STEP_NM as f32, self.rows.len());
+        let at = GridPosition::on_grid(nm, INCIDENCE_STEP_NM as f32, self.wavelengths());
         (at.index(), at.weight())
     }
 
@@ -165,7 +178,7 @@ impl IncidenceGain {
     #[must_use]
     pub fn gain_at(&self, c: Column, nm: f32) -> f32 {
         let (i, t) = self.rows_at(nm);
-        if self.rows.len() < 2 {
+        if self.wavelengths() < 2 {
             return self.row_gain_at(0, c);
         }
         let (a, b) = (self.row_gain_at(i, c), self.row_gain_at(i + 1, c));
@@ -191,7 +204,7 @@ impl IncidenceGain {
     #[must_use]
     #[inline]
     pub fn on_10nm_grid(&self) -> bool {
-        self.rows.len() == GRID_10NM_NODES && INCIDENCE_STEP_NM as f32 == GRID_10NM_STEP_NM
+        self.wavelengths() == GRID_10NM_NODES && INCIDENCE_STEP_NM as f32 == GRID_10NM_STEP_NM
     }
 }
 

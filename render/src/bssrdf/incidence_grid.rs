@@ -67,7 +67,8 @@ impl IncidenceGrid {
     }
 
     /// [`Self::new`] with each node's normalisation rows `c` (as [`Self::nodes`] gave them
-    /// for the same surface and split), or `None` if their count or length is not the gains'.
+    /// for the same surface and split), or `None` if their count or length is not the gains', a
+    /// gain is not whole or the gains' angles differ.
     #[must_use]
     pub fn with_rows(
         axes: [Vec<f32>; 3],
@@ -78,7 +79,10 @@ impl IncidenceGrid {
         let count: usize = axes.iter().map(Vec::len).product();
         if axes.iter().any(Vec::is_empty)
             || gains.len() != count
-            || gains.iter().any(|(g, c)| c.len() != g.wavelengths())
+            || gains
+                .iter()
+                .any(|(g, c)| !g.is_whole() || c.len() != g.wavelengths())
+            || gains.windows(2).any(|w| w[0].0.angles() != w[1].0.angles())
         {
             return None;
         }

@@ -27,7 +27,7 @@ pub const MAX_INCIDENCE_NODES_PER_AXIS: usize = 17;
 
 /// Version of what [`incidence_grid`] computes from its inputs: bump it whenever the same inputs
 /// would give another grid.
-const INCIDENCE_GRID_VERSION: u32 = 1;
+const INCIDENCE_GRID_VERSION: u32 = 2;
 
 /// What a node's gain is built from besides its parameters.
 #[derive(Debug, Clone, Copy)]
