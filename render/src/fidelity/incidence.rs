@@ -15,6 +15,7 @@ use serde::{Deserialize, Serialize};
 use skin_io::cache;
 use skin_optics::SkinParams;
 use std::collections::HashMap;
+use std::path::Path;
 use std::sync::{Arc, Mutex};
 
 /// Default target of the gain grid's interpolation error: the largest relative error of a(μ, λ)
@@ -53,6 +54,20 @@ struct Stored {
     /// Each node's gain and normalisation rows.
     gains: Vec<(IncidenceGain, Vec<f32>)>,
     max_error: f32,
+}
+
+impl Stored {
+    fn of(grid: &IncidenceGrid) -> Self {
+        Self {
+            axes: grid.axes().clone(),
+            gains: grid
+                .nodes()
+                .iter()
+                .filter_map(|d| Some((d.incidence()?.clone(), d.normalisation_rows()?.to_vec())))
+                .collect(),
+            max_error: grid.max_error,
+        }
+    }
 }
 
 /// Gains built so far, keyed by their parameters' bits.
@@ -146,29 +161,50 @@ pub fn incidence_grid(
     range: [[f32; 2]; 3],
 ) -> Result<IncidenceGrid, MultipoleError> {
     let (dir, max_bytes) = cache_folder(settings.fidelity)?;
+    incidence_grid_in(settings, range, dir.as_deref(), max_bytes)
+}
+
+/// [`incidence_grid`] kept in the cache folder `dir` (`None`: built in memory), the folder bounded
+/// to `max_bytes`. An entry whose axes the refinement could not have chosen over `range`, or
+/// whose gains are not whole, is built again.
+pub fn incidence_grid_in(
+    settings: &IncidenceSettings<'_>,
+    range: [[f32; 2]; 3],
+    dir: Option<&Path>,
+    max_bytes: u64,
+) -> Result<IncidenceGrid, MultipoleError> {
     let key = settings.key(range)?;
-    let (stored, _) = cache::load_or_build(dir.as_deref(), max_bytes, &key, || {
-        let grid = refine(settings, range)?;
-        let gains = grid
-            .nodes()
-            .iter()
-            .filter_map(|d| Some((d.incidence()?.clone(), d.normalisation_rows()?.to_vec())))
-            .collect();
-        Ok::<_, MultipoleError>(Stored {
-            axes: grid.axes().clone(),
-            gains,
-            max_error: grid.max_error,
-        })
+    let (stored, _) = cache::load_or_build(dir, max_bytes, &key, || {
+        refine(settings, range).map(|g| Stored::of(&g))
     })?;
+    let counts = stored.axes.clone().map(|a| a.len());
+    let chosen = counts.iter().zip(range).all(|(&n, [lo, hi])| {
+        if hi > lo {
+            (2..=MAX_INCIDENCE_NODES_PER_AXIS).contains(&n) && (n - 1).is_power_of_two()
+        } else {
+            n == 1
+        }
+    }) && node_axes(range, counts) == stored.axes;
     let gains = stored
         .gains
         .into_iter()
         .map(|(g, c)| (Arc::new(g), c))
         .collect();
-    match IncidenceGrid::with_rows(stored.axes, settings.directional, gains, stored.max_error) {
+    let grid = chosen
+        .then(|| {
+            IncidenceGrid::with_rows(stored.axes, settings.directional, gains, stored.max_error)
+        })
+        .flatten();
+    match grid {
         Some(grid) => Ok(grid),
-        // An entry that passed the checksum but not the shape: build again without it.
-        None => refine(settings, range),
+        None => {
+            let grid = refine(settings, range)?;
+            if let Some(dir) = dir {
+                // A folder that cannot be written leaves the grid built in memory.
+                let _ = cache::store(dir, max_bytes, &key, &Stored::of(&grid));
+            }
+            Ok(grid)
+        }
     }
 }
 
@@ -207,5 +243,64 @@ fn refine(
             return Ok(grid);
         }
         nodes = nodes.map(|n| if n > 1 { 2 * n - 1 } else { 1 });
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bssrdf::EnergySplit;
+    use skin_optics::Preset;
+
+    /// A grid is read back from the cache as it was stored: a valid entry under the key is
+    /// returned as it stands (its recorded error shows it was read, not built), an entry whose axes
+    /// the refinement could not have chosen is built again, and a grid read back equals the built
+    /// one bit for bit.
+    #[test]
+    fn a_cached_grid_is_read_back_and_a_foreign_one_built_again() {
+        let params = SkinParams::preset(Preset::Light);
+        let lobe = brdf::TorranceSparrow::new(0.3, 0.25, 1.4).unwrap();
+        let directional = Directional::new(lobe, EnergySplit::Fresnel);
+        let fidelity = FidelityKnobs::default();
+        let settings = IncidenceSettings {
+            params: &params,
+            phase_g: multipole::DEFAULT_G,
+            surface: multipole::Surface::Fresnel,
+            directional: &directional,
+            fidelity: &fidelity,
+            target: 0.05,
+        };
+        let range = [[0.02, 0.1], [0.5, 0.5], [0.01, 0.01]];
+        let dir = tempfile::tempdir().unwrap();
+        let max = cache::DEFAULT_MAX_BYTES;
+        let built = incidence_grid_in(&settings, range, Some(dir.path()), max).unwrap();
+        let rows = |g: &IncidenceGrid| -> Vec<Vec<f32>> {
+            g.nodes()
+                .iter()
+                .map(|d| d.normalisation_rows().unwrap().to_vec())
+                .collect()
+        };
+        let key = settings.key(range).unwrap();
+        let mut marked = Stored::of(&built);
+        marked.max_error = 0.0123;
+        cache::store(dir.path(), max, &key, &marked).unwrap();
+        let read = incidence_grid_in(&settings, range, Some(dir.path()), max).unwrap();
+        assert_eq!(read.max_error, 0.0123);
+        assert_eq!(read.axes(), built.axes());
+        assert_eq!(rows(&read), rows(&built));
+        let gains = |g: &IncidenceGrid| -> Vec<IncidenceGain> {
+            g.nodes()
+                .iter()
+                .map(|d| d.incidence().unwrap().clone())
+                .collect()
+        };
+        assert_eq!(gains(&read), gains(&built));
+        let mut foreign = Stored::of(&built);
+        foreign.axes[0] = vec![0.02, 0.05, 0.1];
+        foreign.max_error = 0.0456;
+        cache::store(dir.path(), max, &key, &foreign).unwrap();
+        let rebuilt = incidence_grid_in(&settings, range, Some(dir.path()), max).unwrap();
+        assert_eq!(rebuilt.max_error, built.max_error);
+        assert_eq!(rebuilt.axes(), built.axes());
     }
 }
