@@ -93,7 +93,7 @@ impl IncidenceGain {
         !self.mu.is_empty()
             && self.mu.windows(2).all(|w| w[0] < w[1])
             && !self.rows.is_empty()
-            && self.rows.len() % self.mu.len() == 0
+            && self.rows.len().is_multiple_of(self.mu.len())
             && self.rows.iter().all(|a| a.is_finite())
     }
 
