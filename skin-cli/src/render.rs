@@ -9,6 +9,7 @@ use ::render::material::SkinKnobs;
 use ::render::renderer::{Progress, RenderOptions, SettingError, render_with};
 use ::render::scene::Scene;
 use ::render::volumetric::majorant::Majorant;
+use ::render::volumetric::walk::Absorption;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use skin_optics::echo::Num;
@@ -137,6 +138,12 @@ pub struct RenderArgs {
     /// everywhere); both are unbiased, local is faster.
     #[arg(long, value_name = "KIND", value_enum, default_value_t = MajorantArg::Local)]
     pub majorant: MajorantArg,
+    /// Absorption at the volumetric walk's collisions in skin with chromophore maps: implicit
+    /// (every collision weighs σs/σt at its own texel) or excess (the weight keeps the local
+    /// majorant cell's least σa, the excess over it ends the walk; the texel is read at few
+    /// collisions); both are unbiased.
+    #[arg(long, value_name = "RULE", value_enum, default_value_t = AbsorptionArg::Implicit)]
+    pub walk_absorption: AbsorptionArg,
     /// Render one wavelength, nm, in [380, 780]: the EXR holds the spectral radiance there as a
     /// grey (R = G = B), in the scene's emission units.
     #[arg(long, value_name = "NM", value_parser = Checked(parse_wavelength), allow_hyphen_values = true)]
@@ -159,6 +166,15 @@ pub enum MajorantArg {
     Local,
     /// The maps' darkest texel everywhere.
     Global,
+}
+
+/// The volumetric walk's absorption rule with maps (`--walk-absorption`).
+#[derive(clap::ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum AbsorptionArg {
+    /// σs/σt(x) in the weight at every collision.
+    Implicit,
+    /// The cell's least σa in the weight, the excess by analog absorption.
+    Excess,
 }
 
 fn parse_wavelength(s: &str) -> Result<f32, String> {
@@ -241,8 +257,13 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
             MajorantArg::Local => Majorant::Local,
             MajorantArg::Global => Majorant::Global,
         };
+        let absorption = match args.walk_absorption {
+            AbsorptionArg::Implicit => Absorption::Implicit,
+            AbsorptionArg::Excess => Absorption::Excess,
+        };
         for medium in walk.media.iter_mut().flatten() {
             medium.majorant = majorant;
+            medium.absorption = absorption;
         }
     }
     let load = t0.elapsed();

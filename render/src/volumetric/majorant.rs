@@ -86,6 +86,9 @@ struct Cell {
     range: ParamBox,
     epidermis: bool,
     dermis: bool,
+    /// The epidermis thickness under every texel the cell's points can read (the thin one or the
+    /// material's), mm; `None` where it varies or the cell lies off the grid.
+    epidermis_mm: Option<f32>,
     /// Every triangle not listed lies farther than this from the centre, mm.
     reach_mm: f64,
     /// (distance of the triangle from the centre in mm, rounded down; triangle), nearest first.
@@ -118,6 +121,12 @@ pub struct CellMajorant {
     pub sigma_t: f32,
     /// Each layer's largest σa in the cell (epidermis, dermis; 0 where the layer is absent), mm⁻¹.
     pub sigma_a: (f32, f32),
+    /// Each layer's smallest σa in the cell (epidermis, dermis), lowered by the interpolation's
+    /// rounding: no point of the cell absorbs less, mm⁻¹.
+    pub least_sigma_a: (f32, f32),
+    /// The epidermis thickness under every texel the cell's points can read, mm (`None`: it
+    /// varies, the nearest texel tells).
+    pub epidermis_mm: Option<f32>,
 }
 
 impl MajorantGrid {
@@ -134,6 +143,7 @@ impl MajorantGrid {
             range: maps.maps.range(),
             epidermis: false,
             dermis: true,
+            epidermis_mm: None,
             reach_mm: 0.0,
             list: Box::new([]),
         };
@@ -206,10 +216,35 @@ impl MajorantGrid {
         let mut list = Vec::new();
         nearest.triangles_within(c, reach_mm, &mut list);
         list.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let range = list.iter().fold(EMPTY, |acc, &(_, t)| {
-            let (u, v) = nearest.uv_box_within(t, c, reach_mm);
-            union(acc, maps.range_over(u, v))
-        });
+        let boxes: Vec<_> = list
+            .iter()
+            .map(|&(_, t)| nearest.uv_box_within(t, c, reach_mm))
+            .collect();
+        let range = boxes
+            .iter()
+            .fold(EMPTY, |acc, &(u, v)| union(acc, maps.range_over(u, v)));
+        // The filtered flag over the same boxes: below ½ throughout, no point reads a thin
+        // texel; at least ½ throughout, every point does.
+        let epidermis_mm = match maps.thin() {
+            None => Some(self.maps.epidermis_mm),
+            Some(thin) => {
+                let flag = boxes
+                    .iter()
+                    .fold([f32::INFINITY, f32::NEG_INFINITY], |f, &(u, v)| {
+                        let g = thin.flag_range_over(u, v);
+                        [f[0].min(g[0]), f[1].max(g[1])]
+                    });
+                // A filtered value may pass its texels' range by the weights' rounding.
+                let slack = 4.0 * f32::EPSILON;
+                if flag[1] * (1.0 + slack) < 0.5 {
+                    Some(self.maps.epidermis_mm)
+                } else if flag[0] * (1.0 - slack) >= 0.5 {
+                    Some(thin.thickness_mm)
+                } else {
+                    None
+                }
+            }
+        };
         // With a thin epidermis in the maps, d_epi is the deepest boundary and the dermis may
         // begin at the thin one.
         let shallowest = maps.thin().map_or(self.d_epi_mm, |t| {
@@ -219,6 +254,7 @@ impl MajorantGrid {
             range,
             epidermis: dist - r <= self.d_epi_mm,
             dermis: dist + r > shallowest,
+            epidermis_mm: if boxes.is_empty() { None } else { epidermis_mm },
             reach_mm,
             list: list.into_boxed_slice(),
         }
@@ -302,6 +338,7 @@ impl MajorantGrid {
         let cell = self.get(nearest, key);
         // σa at a point is the corners' trilinear interpolation in f32, which may pass the
         // largest corner by its rounding.
+        let least = smallest(corners, cell.range);
         let (e, d) = corners.largest(cell.range);
         let (e, d) = (
             e * (1.0 + 4.0 * f32::EPSILON),
@@ -326,6 +363,12 @@ impl MajorantGrid {
             // The sums' rounding likewise.
             sigma_t: sigma_t * (1.0 + 4.0 * f32::EPSILON),
             sigma_a,
+            // The interpolation's rounding is a few ulps of the largest corner it mixes.
+            least_sigma_a: (
+                (least.0 - 8.0 * f32::EPSILON * e).max(0.0),
+                (least.1 - 8.0 * f32::EPSILON * d).max(0.0),
+            ),
+            epidermis_mm: cell.epidermis_mm,
         }
     }
 
@@ -357,6 +400,18 @@ impl MajorantGrid {
         let c = self.get(nearest, key_of(x, self.cell_mm));
         (c.range, c.epidermis, c.dermis)
     }
+}
+
+/// The smallest σa of each layer (epidermis, dermis) over the parameter box `range`: like the
+/// largest, a multilinear function's smallest value over a box is at one of its corners.
+fn smallest(corners: &CornersAt, range: ParamBox) -> (f32, f32) {
+    let mut out = (f32::INFINITY, f32::INFINITY);
+    for c in 0..8 {
+        let p = std::array::from_fn(|k| range[k][(c >> k) & 1]);
+        out.0 = out.0.min(corners.sigma_a(true, p));
+        out.1 = out.1.min(corners.sigma_a(false, p));
+    }
+    (out.0.max(0.0), out.1.max(0.0))
 }
 
 fn key_of(p: DVec3, cell_mm: f64) -> [i32; 3] {

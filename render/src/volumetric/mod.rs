@@ -57,6 +57,8 @@ pub struct SkinVolume {
     /// The majorant of delta tracking with maps ([`majorant`]; the guided walk keeps the global
     /// one).
     pub majorant: majorant::Majorant,
+    /// How a real collision with maps accounts for absorption ([`walk::Absorption`]).
+    pub absorption: walk::Absorption,
 }
 
 impl SkinVolume {
@@ -90,6 +92,7 @@ impl SkinVolume {
             epidermis_region: SurfaceDistance::new(triangles, d_epi_mm),
             maps: None,
             majorant: majorant::Majorant::default(),
+            absorption: walk::Absorption::default(),
         }
     }
 
@@ -114,6 +117,13 @@ impl SkinVolume {
     #[must_use]
     pub fn with_majorant(mut self, majorant: majorant::Majorant) -> Self {
         self.majorant = majorant;
+        self
+    }
+
+    /// The same medium with real collisions accounting for absorption by `absorption`.
+    #[must_use]
+    pub fn with_absorption(mut self, absorption: walk::Absorption) -> Self {
+        self.absorption = absorption;
         self
     }
 

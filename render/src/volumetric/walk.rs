@@ -41,6 +41,7 @@ use crate::geometry::{Geometry, SurfaceHit};
 use glam::{DVec3, Vec3};
 use multipole::exact::montecarlo::scatter_direction;
 use rand::{Rng, RngCore};
+use std::fmt;
 
 /// Most real collisions per walk (a bound on the cost; a walk reaching it is dropped, a bias
 /// below 1e-6 of the energy for skin — BENCHMARKS.md).
@@ -51,6 +52,30 @@ pub const MAX_COLLISIONS: u32 = 1_000_000;
 /// fall below it after about twenty collisions, and ending most of their tails costs less than the
 /// variance it adds (BENCHMARKS.md, "Volumetric reference").
 pub const ROULETTE_BELOW: f64 = 0.1;
+
+/// How a real collision in skin with chromophore maps accounts for absorption (docs/physics.md
+/// §19.1). Both are unbiased; they differ in variance and in how often σa(x), and so the
+/// nearest surface point, is read.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Absorption {
+    /// Every real collision keeps σs/σt(x) in the weight (implicit capture): σa is read at each.
+    #[default]
+    Implicit,
+    /// With the local majorant, the weight keeps σs/(σs + σa,min) of the cell's least σa and the
+    /// excess σa(x) − σa,min ends the walk (analog absorption): σa is read only at collisions
+    /// that are not scattering at that least rate. Elsewhere (global majorant, guided walk), as
+    /// [`Absorption::Implicit`].
+    Excess,
+}
+
+impl fmt::Display for Absorption {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Self::Implicit => "implicit",
+            Self::Excess => "excess",
+        })
+    }
+}
 
 /// Most BVH hits one surface query passes over (behind the walk, or its own face) before the
 /// light is counted lost.
@@ -237,7 +262,13 @@ pub fn walk<R: RngCore>(
         let layer = if !one_layer
             && in_epidermis(region, &mut anchor, x, d_epi)
             && maps.as_ref().is_none_or(|m| {
-                !m.has_thin() || in_epidermis(region, &mut anchor, x, f64::from(m.epidermis_mm(x)))
+                // A cell whose texels are all thin or all not names the thickness unread.
+                !m.has_thin() || {
+                    let d = cell
+                        .and_then(|c| c.epidermis_mm)
+                        .unwrap_or_else(|| m.epidermis_mm(x));
+                    in_epidermis(region, &mut anchor, x, f64::from(d))
+                }
             }) {
             Layer::Epidermis
         } else {
@@ -259,12 +290,33 @@ pub fn walk<R: RngCore>(
                 continue;
             }
         }
-        let sa = maps
-            .as_ref()
-            .map_or(sa, |m| m.sigma_a(layer == Layer::Epidermis, x));
-        if xi >= sa + ss {
-            continue; // null collision
-        }
+        let excess = local
+            .zip(cell.as_ref())
+            .filter(|_| vol.absorption == Absorption::Excess);
+        let sa = if let Some((m, c)) = excess {
+            let least = match layer {
+                Layer::Epidermis => c.least_sigma_a.0,
+                Layer::Dermis => c.least_sigma_a.1,
+            };
+            if xi >= least + ss {
+                // Beyond scattering at the cell's least σa: absorbed with probability
+                // (σa(x) − σa,min)/σ̄, else null.
+                if xi < m.sigma_a(layer == Layer::Epidermis, x) + ss {
+                    out.collisions += 1;
+                    return out;
+                }
+                continue;
+            }
+            least
+        } else {
+            let sa = maps
+                .as_ref()
+                .map_or(sa, |m| m.sigma_a(layer == Layer::Epidermis, x));
+            if xi >= sa + ss {
+                continue; // null collision
+            }
+            sa
+        };
         out.collisions += 1;
         if let Some(guide) = &guide {
             w *= guide.weight(&segment);
