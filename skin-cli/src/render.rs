@@ -138,11 +138,11 @@ pub struct RenderArgs {
     /// everywhere); both are unbiased, local is faster.
     #[arg(long, value_name = "KIND", value_enum, default_value_t = MajorantArg::Local)]
     pub majorant: MajorantArg,
-    /// Absorption at the volumetric walk's collisions in skin with chromophore maps: implicit
-    /// (every collision weighs σs/σt at its own texel) or excess (the weight keeps the local
-    /// majorant cell's least σa, the excess over it ends the walk; the texel is read at few
-    /// collisions); both are unbiased.
-    #[arg(long, value_name = "RULE", value_enum, default_value_t = AbsorptionArg::Implicit)]
+    /// Absorption at the volumetric walk's collisions in skin with chromophore maps: excess (a
+    /// collision weighs σs/σt at the local majorant cell's least σa, and the excess over it is
+    /// ratio-tracked; the texel is read at few collisions) or implicit (every collision weighs
+    /// σs/σt at its own texel); both are unbiased, excess is faster.
+    #[arg(long, value_name = "RULE", value_enum, default_value_t = AbsorptionArg::Excess)]
     pub walk_absorption: AbsorptionArg,
     /// Render one wavelength, nm, in [380, 780]: the EXR holds the spectral radiance there as a
     /// grey (R = G = B), in the scene's emission units.
@@ -173,7 +173,7 @@ pub enum MajorantArg {
 pub enum AbsorptionArg {
     /// σs/σt(x) in the weight at every collision.
     Implicit,
-    /// The cell's least σa in the weight, the excess by analog absorption.
+    /// The cell's least σa in the weight, the excess ratio-tracked.
     Excess,
 }
 

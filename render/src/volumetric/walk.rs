@@ -59,12 +59,13 @@ pub const ROULETTE_BELOW: f64 = 0.1;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Absorption {
     /// Every real collision keeps σs/σt(x) in the weight (implicit capture): σa is read at each.
-    #[default]
     Implicit,
-    /// With the local majorant, the weight keeps σs/(σs + σa,min) of the cell's least σa and the
-    /// excess σa(x) − σa,min ends the walk (analog absorption): σa is read only at collisions
-    /// that are not scattering at that least rate. Elsewhere (global majorant, guided walk), as
+    /// With the local majorant, a collision with ξσ̄ < σs + σa,min (the cell's least σa) is real
+    /// and keeps σs/(σs + σa,min); one in the band up to σs + the cell's largest σa is null with
+    /// weight (σa,max − σa(x))/(σa,max − σa,min) (ratio tracking of the excess over σa,min):
+    /// σa is read only in that band. Elsewhere (global majorant, guided walk), as
     /// [`Absorption::Implicit`].
+    #[default]
     Excess,
 }
 
@@ -294,15 +295,17 @@ pub fn walk<R: RngCore>(
             .zip(cell.as_ref())
             .filter(|_| vol.absorption == Absorption::Excess);
         let sa = if let Some((m, c)) = excess {
-            let least = match layer {
-                Layer::Epidermis => c.least_sigma_a.0,
-                Layer::Dermis => c.least_sigma_a.1,
+            let (least, largest) = match layer {
+                Layer::Epidermis => (c.least_sigma_a.0, c.sigma_a.0),
+                Layer::Dermis => (c.least_sigma_a.1, c.sigma_a.1),
             };
+            let least = least.min(largest);
             if xi >= least + ss {
-                // Beyond scattering at the cell's least σa: absorbed with probability
-                // (σa(x) − σa,min)/σ̄, else null.
-                if xi < m.sigma_a(layer == Layer::Epidermis, x) + ss {
-                    out.collisions += 1;
+                // Between the cell's least and largest σt: null, weighted by the share of that
+                // band σt(x) leaves free (ratio tracking of the excess σa(x) − σa,min).
+                let sa = m.sigma_a(layer == Layer::Epidermis, x);
+                w *= f64::from(((largest - sa) / (largest - least)).clamp(0.0, 1.0));
+                if w == 0.0 {
                     return out;
                 }
                 continue;
