@@ -122,6 +122,13 @@ impl MapAbsorption<'_> {
         self.medium.grid.exit(cell, x, d)
     }
 
+    /// The distance from `x` to the nearest face of `cell`, mm ([`MajorantGrid::inside_mm`]).
+    #[must_use]
+    #[inline]
+    pub fn inside_mm(&self, cell: &CellMajorant, x: DVec3) -> f64 {
+        MajorantGrid::inside_mm(cell, x)
+    }
+
     /// The local majorant's cell `key` (from [`MapAbsorption::exit`]).
     #[must_use]
     pub fn cell(&self, key: [i32; 3], sigma_s: (f32, f32)) -> CellMajorant {

@@ -223,22 +223,27 @@ impl MajorantGrid {
         let range = boxes
             .iter()
             .fold(EMPTY, |acc, &(u, v)| union(acc, maps.range_over(u, v)));
+        let epidermis = dist - r <= self.d_epi_mm;
         // The filtered flag over the same boxes: below ½ throughout, no point reads a thin
-        // texel; at least ½ throughout, every point does.
+        // texel; at least ½ throughout, every point does. A cell without epidermis never asks.
         let epidermis_mm = match maps.thin() {
+            _ if boxes.is_empty() || !epidermis => None,
             None => Some(self.maps.epidermis_mm),
             Some(thin) => {
-                let flag = boxes
-                    .iter()
-                    .fold([f32::INFINITY, f32::NEG_INFINITY], |f, &(u, v)| {
-                        let g = thin.flag_range_over(u, v);
-                        [f[0].min(g[0]), f[1].max(g[1])]
-                    });
                 // A filtered value may pass its texels' range by the weights' rounding.
                 let slack = 4.0 * f32::EPSILON;
-                if flag[1] * (1.0 + slack) < 0.5 {
+                let (mut below, mut above) = (true, true);
+                for &(u, v) in &boxes {
+                    let [lo, hi] = thin.flag_range_over(u, v);
+                    below &= hi * (1.0 + slack) < 0.5;
+                    above &= lo * (1.0 - slack) >= 0.5;
+                    if !below && !above {
+                        break;
+                    }
+                }
+                if below {
                     Some(self.maps.epidermis_mm)
-                } else if flag[0] * (1.0 - slack) >= 0.5 {
+                } else if above {
                     Some(thin.thickness_mm)
                 } else {
                     None
@@ -252,9 +257,9 @@ impl MajorantGrid {
         });
         Cell {
             range,
-            epidermis: dist - r <= self.d_epi_mm,
+            epidermis,
             dermis: dist + r > shallowest,
-            epidermis_mm: if boxes.is_empty() { None } else { epidermis_mm },
+            epidermis_mm,
             reach_mm,
             list: list.into_boxed_slice(),
         }
@@ -370,6 +375,14 @@ impl MajorantGrid {
             ),
             epidermis_mm: cell.epidermis_mm,
         }
+    }
+
+    /// The distance from `x` to the nearest face of `cell`, mm (negative outside): no flight
+    /// shorter than it leaves the cell, whatever its direction.
+    #[must_use]
+    #[inline]
+    pub fn inside_mm(cell: &CellMajorant, x: DVec3) -> f64 {
+        (x - cell.lo).min(cell.hi - x).min_element()
     }
 
     /// The distance from `x` (in `cell`) along unit `d` to the next cell, mm, and its key.

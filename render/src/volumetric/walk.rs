@@ -201,7 +201,11 @@ pub fn walk<R: RngCore>(
         // over the whole flight, and kept across the cells it passes: a surface lying on a
         // cell's face (a slab's top on the grid's plane) is then met from the side it was
         // found from, not missed from a point within rounding of it.
-        let exit = local.zip(cell.as_ref()).map(|(m, c)| m.exit(c, x, d));
+        // A flight shorter than the distance to the cell's nearest face stays in the cell.
+        let exit = local
+            .zip(cell.as_ref())
+            .filter(|(m, c)| s >= m.inside_mm(c, x))
+            .map(|(m, c)| m.exit(c, x, d));
         let flight = exit.map_or(s, |(t, _)| s.min(t));
         if ahead.is_none() {
             let f = Flight { x, d, s, on_face };
