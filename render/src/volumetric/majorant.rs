@@ -109,6 +109,10 @@ pub struct MajorantGrid {
     maps: Arc<SkinMaps>,
     /// Cells off the grid: deeper than the shell, the dermis over the maps' whole box.
     deep: Cell,
+    /// Per triangle (numbered as the surface's nearest-point search numbers them), the
+    /// parameters and the thin-epidermis flag over its whole texture box, each found once: a
+    /// cell's ball holds most of its triangles whole.
+    whole: Box<[(OnceLock<ParamBox>, OnceLock<[f32; 2]>)]>,
 }
 
 /// One cell of the grid at one wavelength, for the walk.
@@ -185,6 +189,7 @@ impl MajorantGrid {
             .flatten()
             .fold(0.0f64, |m, p| m.max(f64::from(p.abs().max_element())));
         Self {
+            whole: (0..triangles.len()).map(|_| Default::default()).collect(),
             cell_mm,
             half_diagonal_mm: half_diagonal + 1e-9 * (1.0 + extent + reach),
             d_epi_mm,
@@ -216,13 +221,21 @@ impl MajorantGrid {
         let mut list = Vec::new();
         nearest.triangles_within(c, reach_mm, &mut list);
         list.sort_by(|a, b| a.0.total_cmp(&b.0));
+        // (triangle, its box within reach, whether that is its whole box)
         let boxes: Vec<_> = list
             .iter()
-            .map(|&(_, t)| nearest.uv_box_within(t, c, reach_mm))
+            .map(|&(_, t)| {
+                let b = nearest.uv_box_within(t, c, reach_mm);
+                (t as usize, b, b == nearest.uv_box(t))
+            })
             .collect();
-        let range = boxes
-            .iter()
-            .fold(EMPTY, |acc, &(u, v)| union(acc, maps.range_over(u, v)));
+        let range = boxes.iter().fold(EMPTY, |acc, &(t, (u, v), whole)| {
+            let range = match self.whole.get(t) {
+                Some(once) if whole => *once.0.get_or_init(|| maps.range_over(u, v)),
+                _ => maps.range_over(u, v),
+            };
+            union(acc, range)
+        });
         let epidermis = dist - r <= self.d_epi_mm;
         // The filtered flag over the same boxes: below ½ throughout, no point reads a thin
         // texel; at least ½ throughout, every point does. A cell without epidermis never asks.
@@ -233,8 +246,11 @@ impl MajorantGrid {
                 // A filtered value may pass its texels' range by the weights' rounding.
                 let slack = 4.0 * f32::EPSILON;
                 let (mut below, mut above) = (true, true);
-                for &(u, v) in &boxes {
-                    let [lo, hi] = thin.flag_range_over(u, v);
+                for &(t, (u, v), whole) in &boxes {
+                    let [lo, hi] = match self.whole.get(t) {
+                        Some(once) if whole => *once.1.get_or_init(|| thin.flag_range_over(u, v)),
+                        _ => thin.flag_range_over(u, v),
+                    };
                     below &= hi * (1.0 + slack) < 0.5;
                     above &= lo * (1.0 - slack) >= 0.5;
                     if !below && !above {

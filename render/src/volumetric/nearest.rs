@@ -269,6 +269,16 @@ impl NearestSurface {
         });
     }
 
+    /// The box [u₀, u₁] × [v₀, v₁] of triangle `index`'s texture coordinates (numbered as
+    /// [`NearestSurface::triangles_within`] numbers them).
+    #[must_use]
+    pub fn uv_box(&self, index: u32) -> ([f32; 2], [f32; 2]) {
+        let t = &self.tris[index as usize];
+        let lo = t.uv[0].min(t.uv[1]).min(t.uv[2]);
+        let hi = t.uv[0].max(t.uv[1]).max(t.uv[2]);
+        ([lo.x, hi.x], [lo.y, hi.y])
+    }
+
     /// A box [u₀, u₁] × [v₀, v₁] holding the texture coordinates of every point of triangle
     /// `index` (as [`NearestSurface::triangles_within`] numbers them) within `radius_mm` of `p`:
     /// that part lies in the disc where the ball cuts the triangle's plane, whose image under the
@@ -277,9 +287,7 @@ impl NearestSurface {
     #[must_use]
     pub fn uv_box_within(&self, index: u32, p: DVec3, radius_mm: f64) -> ([f32; 2], [f32; 2]) {
         let t = &self.tris[index as usize];
-        let lo = t.uv[0].min(t.uv[1]).min(t.uv[2]);
-        let hi = t.uv[0].max(t.uv[1]).max(t.uv[2]);
-        let whole = ([lo.x, hi.x], [lo.y, hi.y]);
+        let whole = self.uv_box(index);
         let n = t.ab.cross(t.ac);
         let (d00, d01, d11) = (t.ab.dot(t.ab), t.ab.dot(t.ac), t.ac.dot(t.ac));
         let det = d00 * d11 - d01 * d01;
