@@ -73,6 +73,10 @@ const MAX_CELLS: f64 = 2.0e6;
 /// A box of parameters (C_m, β_m, C_h), [lo, hi] each.
 type ParamBox = [[f32; 2]; 3];
 
+/// A triangle's parameter box and thin-epidermis flag range over its whole texture box, each
+/// found on first use.
+type WholeBox = (OnceLock<ParamBox>, OnceLock<[f32; 2]>);
+
 const EMPTY: ParamBox = [[f32::INFINITY, f32::NEG_INFINITY]; 3];
 
 fn union(a: ParamBox, b: ParamBox) -> ParamBox {
@@ -112,7 +116,7 @@ pub struct MajorantGrid {
     /// Per triangle (numbered as the surface's nearest-point search numbers them), the
     /// parameters and the thin-epidermis flag over its whole texture box, each found once: a
     /// cell's ball holds most of its triangles whole.
-    whole: Box<[(OnceLock<ParamBox>, OnceLock<[f32; 2]>)]>,
+    whole: Box<[WholeBox]>,
 }
 
 /// One cell of the grid at one wavelength, for the walk.
