@@ -2,7 +2,8 @@
 //! the majorant σ̄ = max(σt_epidermis, σt_dermis) at the hero wavelength (with chromophore maps,
 //! by default each cell's own σ̄, [`super::majorant`], §19.1), so the layer boundary
 //! (a distance from the surface, not a plane) is crossed exactly without ever being intersected;
-//! at a real collision the weight keeps σs/σt (implicit capture) and the direction turns by
+//! at a real collision the weight keeps σs/σt (implicit capture; with maps by default of the
+//! cell's least σa, the band above it ratio-tracked, [`Absorption`]) and the direction turns by
 //! Henyey–Greenstein — both from `multipole::exact::montecarlo`, the photon physics of the layered Monte
 //! Carlo; under isotropic scattering part of the steps are drawn towards the surface instead, with
 //! exact MIS weights ([`super::guide`], §15.6); below weight `SkinVolume::roulette_below`
