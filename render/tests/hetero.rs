@@ -155,6 +155,24 @@ fn the_geometric_rule_is_reciprocal_on_the_split_slab() {
     );
 }
 
+/// Uniforms in [0, 1] from a xorshift32 stream seeded with `state`.
+fn uniforms(mut state: u32) -> impl FnMut() -> f64 {
+    move || {
+        state ^= state << 13;
+        state ^= state >> 17;
+        state ^= state << 5;
+        f64::from(state) / f64::from(u32::MAX)
+    }
+}
+
+/// A grid's coarsest refinement (`nodes` on its first axis, its error) errs beyond `target` and
+/// the refined grid's error (`refined`) is within it: the measure decides the resolution.
+fn assert_refined((nodes, coarse): (usize, f32), refined: f32, target: f32) {
+    assert_eq!(nodes, 2);
+    assert!(coarse > target, "coarse {coarse}");
+    assert!(refined <= target, "refined {refined}");
+}
+
 /// The grid over C_m ∈ [0.02, 0.3] (β_m 0.5, C_h 0.01; 9 nodes) meets its 2% error target at the
 /// cells' centres, and at random parameters inside the box its error against directly built
 /// tables stays within 1.25 × the measured bound (linear interpolation errs most near a cell's
@@ -179,18 +197,14 @@ fn profile_grid_error_stays_within_its_measured_bound() {
     };
     let range = [[0.02, 0.3], [0.5, 0.5], [0.01, 0.01]];
     let coarse = profile_grid(&settings(f32::MAX), range).unwrap();
-    assert_eq!(coarse.axes()[0].len(), 2);
     let grid = profile_grid(&settings(0.02), range).unwrap();
-    assert!(coarse.max_error > 0.02, "coarse {}", coarse.max_error);
-    assert!(grid.max_error <= 0.02, "refined {}", grid.max_error);
+    assert_refined(
+        (coarse.axes()[0].len(), coarse.max_error),
+        grid.max_error,
+        0.02,
+    );
     assert_eq!(grid.axes()[1], vec![0.5]);
-    let mut state = 0x2545_f491u32;
-    let mut next = || {
-        state ^= state << 13;
-        state ^= state >> 17;
-        state ^= state << 5;
-        f64::from(state) / f64::from(u32::MAX)
-    };
+    let mut next = uniforms(0x2545_f491);
     for _ in 0..8 {
         let p = [(0.02 + 0.28 * next()) as f32, 0.5, 0.01];
         let q = params
@@ -245,17 +259,13 @@ fn incidence_grid_error_stays_within_its_measured_bound() {
     };
     let range = [[0.02, 0.3], [0.5, 0.5], [0.005, 0.12]];
     let coarse = incidence_grid(&settings(f32::MAX), range).unwrap();
-    assert_eq!(coarse.axes()[0].len(), 2);
     let grid = incidence_grid(&settings(0.005), range).unwrap();
-    assert!(coarse.max_error > 0.005, "coarse {}", coarse.max_error);
-    assert!(grid.max_error <= 0.005, "refined {}", grid.max_error);
-    let mut state = 0x9e37_79b9u32;
-    let mut next = || {
-        state ^= state << 13;
-        state ^= state >> 17;
-        state ^= state << 5;
-        f64::from(state) / f64::from(u32::MAX)
-    };
+    assert_refined(
+        (coarse.axes()[0].len(), coarse.max_error),
+        grid.max_error,
+        0.005,
+    );
+    let mut next = uniforms(0x9e37_79b9);
     for _ in 0..6 {
         let p = [
             (0.02 + 0.28 * next()) as f32,

@@ -121,49 +121,67 @@ fn every_texel_lies_under_its_cells_majorant() {
     assert!(light_cells > 50, "{light_cells} light points checked");
 }
 
+/// The walk's mean radiance at 550 nm on each side of the split slab of `dir` (half-width `half`
+/// mm, `cols` columns; ≥ 1 mm from the split) at 384 spp with seed `seed`, each skin volume set
+/// by `set`.
+fn side_means(
+    dir: &std::path::Path,
+    (half, cols): (f32, usize),
+    seed: u64,
+    set: impl Fn(&mut render::volumetric::SkinVolume),
+) -> [(f64, f64); 2] {
+    let scene = slab(dir, half, cols);
+    let BodyIntegrator::Volumetric(mut walked) =
+        BodyIntegrator::build(&scene, IntegratorKind::Volumetric)
+    else {
+        unreachable!("the volumetric integrator");
+    };
+    walked.media.iter_mut().flatten().for_each(set);
+    let body = BodyIntegrator::Volumetric(walked);
+    let opts = RenderOptions {
+        width: cols,
+        height: 2,
+        spp: 384,
+        seed,
+        wavelength_nm: Some(550.0),
+        ..Default::default()
+    };
+    let film = render_with(&scene, &body, &opts.validate().unwrap(), None)
+        .unwrap()
+        .0;
+    let cols = columns(&film);
+    [
+        region(&cols, half, -half, -1.0),
+        region(&cols, half, 1.0, half),
+    ]
+}
+
+/// Each side's means of two renders (`names`) agree within 3σ of their difference.
+fn assert_sides_agree(names: [&str; 2], a: [(f64, f64); 2], b: [(f64, f64); 2]) {
+    for (side, ((x, xs), (y, ys))) in a.into_iter().zip(b).enumerate() {
+        eprintln!(
+            "side {side}: {} {x:.5} ± {xs:.5}, {} {y:.5} ± {ys:.5}",
+            names[0], names[1]
+        );
+        assert!(
+            (x - y).abs() <= 3.0 * xs.hypot(ys),
+            "side {side}: {} {x} ± {xs} vs {} {y} ± {ys}",
+            names[0],
+            names[1]
+        );
+    }
+}
+
 /// The walk at 550 nm on the split slab with the local and with the global majorant: the mean
 /// radiance of each side (≥ 1 mm from the split) agrees within 3σ of the two renders' difference
 /// (independent seeds; both are unbiased, nothing but noise may separate them).
 #[test]
 fn local_and_global_majorants_agree() {
     let dir = tempfile::tempdir().unwrap();
-    let (half, cols) = (3.0, 6);
-    let scene = slab(dir.path(), half, cols);
-    let mut means = Vec::new();
-    for (majorant, seed) in [(Majorant::Local, 33), (Majorant::Global, 34)] {
-        let BodyIntegrator::Volumetric(mut walked) =
-            BodyIntegrator::build(&scene, IntegratorKind::Volumetric)
-        else {
-            unreachable!("the volumetric integrator");
-        };
-        for m in walked.media.iter_mut().flatten() {
-            m.majorant = majorant;
-        }
-        let body = BodyIntegrator::Volumetric(walked);
-        let opts = RenderOptions {
-            width: cols,
-            height: 2,
-            spp: 384,
-            seed,
-            wavelength_nm: Some(550.0),
-            ..Default::default()
-        };
-        let film = render_with(&scene, &body, &opts.validate().unwrap(), None)
-            .unwrap()
-            .0;
-        let cols = columns(&film);
-        means.push([
-            region(&cols, half, -half, -1.0),
-            region(&cols, half, 1.0, half),
-        ]);
-    }
-    for (side, (&(l, ls), &(g, gs))) in means[0].iter().zip(&means[1]).enumerate() {
-        eprintln!("side {side}: local {l:.5} ± {ls:.5}, global {g:.5} ± {gs:.5}");
-        assert!(
-            (l - g).abs() <= 3.0 * ls.hypot(gs),
-            "side {side}: local {l} ± {ls} vs global {g} ± {gs}"
-        );
-    }
+    let shape = (3.0, 6);
+    let local = side_means(dir.path(), shape, 33, |m| m.majorant = Majorant::Local);
+    let global = side_means(dir.path(), shape, 34, |m| m.majorant = Majorant::Global);
+    assert_sides_agree(["local", "global"], local, global);
 }
 
 /// The split speckle's slab with the left half's epidermis thin (0.05 mm; the material's is
@@ -237,41 +255,10 @@ fn cells_bound_the_texels_thickness_and_least_absorption() {
 #[test]
 fn excess_and_implicit_absorption_agree() {
     let dir = tempfile::tempdir().unwrap();
-    let (half, cols) = (3.0, 6);
-    let scene = slab(dir.path(), half, cols);
-    let mut means = Vec::new();
-    for (absorption, seed) in [(Absorption::Implicit, 35), (Absorption::Excess, 36)] {
-        let BodyIntegrator::Volumetric(mut walked) =
-            BodyIntegrator::build(&scene, IntegratorKind::Volumetric)
-        else {
-            unreachable!("the volumetric integrator");
-        };
-        for m in walked.media.iter_mut().flatten() {
-            m.absorption = absorption;
-        }
-        let body = BodyIntegrator::Volumetric(walked);
-        let opts = RenderOptions {
-            width: cols,
-            height: 2,
-            spp: 384,
-            seed,
-            wavelength_nm: Some(550.0),
-            ..Default::default()
-        };
-        let film = render_with(&scene, &body, &opts.validate().unwrap(), None)
-            .unwrap()
-            .0;
-        let cols = columns(&film);
-        means.push([
-            region(&cols, half, -half, -1.0),
-            region(&cols, half, 1.0, half),
-        ]);
-    }
-    for (side, (&(i, is), &(e, es))) in means[0].iter().zip(&means[1]).enumerate() {
-        eprintln!("side {side}: implicit {i:.5} ± {is:.5}, excess {e:.5} ± {es:.5}");
-        assert!(
-            (i - e).abs() <= 3.0 * is.hypot(es),
-            "side {side}: implicit {i} ± {is} vs excess {e} ± {es}"
-        );
-    }
+    let shape = (3.0, 6);
+    let implicit = side_means(dir.path(), shape, 35, |m| {
+        m.absorption = Absorption::Implicit
+    });
+    let excess = side_means(dir.path(), shape, 36, |m| m.absorption = Absorption::Excess);
+    assert_sides_agree(["implicit", "excess"], implicit, excess);
 }

@@ -536,18 +536,21 @@ impl super::SkinMaterial {
         };
         let grid = crate::fidelity::grid::profile_grid(&settings, maps.range())
             .map_err(super::SkinBuildError::Profiles)?;
-        let thin_grid = match maps.thin() {
-            Some(thin) => {
-                let params = self
-                    .params
+        // The skin under the thin epidermis, with the box of the texels that read it.
+        let thin_skin = match maps.thin() {
+            Some(thin) => Some((
+                self.params
                     .with_epidermis_thickness_mm(f64::from(thin.thickness_mm))
-                    .map_err(|e| super::SkinBuildError::Profiles(e.into()))?;
-                let settings = crate::fidelity::grid::GridSettings {
-                    params: &params,
-                    ..settings
-                };
+                    .map_err(|e| super::SkinBuildError::Profiles(e.into()))?,
+                thin.range(),
+            )),
+            None => None,
+        };
+        let thin_grid = match &thin_skin {
+            Some((params, range)) => {
+                let settings = crate::fidelity::grid::GridSettings { params, ..settings };
                 Some(
-                    crate::fidelity::grid::profile_grid(&settings, thin.range())
+                    crate::fidelity::grid::profile_grid(&settings, *range)
                         .map_err(super::SkinBuildError::Profiles)?,
                 )
             }
@@ -565,18 +568,12 @@ impl super::SkinMaterial {
                 };
                 let thick = crate::fidelity::incidence::incidence_grid(&settings, maps.range())
                     .map_err(super::SkinBuildError::Profiles)?;
-                let thin = match maps.thin().filter(|_| thin_grid.is_some()) {
-                    Some(thin) => {
-                        let params = self
-                            .params
-                            .with_epidermis_thickness_mm(f64::from(thin.thickness_mm))
-                            .map_err(|e| super::SkinBuildError::Profiles(e.into()))?;
-                        let settings = crate::fidelity::incidence::IncidenceSettings {
-                            params: &params,
-                            ..settings
-                        };
+                let thin = match &thin_skin {
+                    Some((params, range)) => {
+                        let settings =
+                            crate::fidelity::incidence::IncidenceSettings { params, ..settings };
                         Some(
-                            crate::fidelity::incidence::incidence_grid(&settings, thin.range())
+                            crate::fidelity::incidence::incidence_grid(&settings, *range)
                                 .map_err(super::SkinBuildError::Profiles)?,
                         )
                     }
