@@ -165,12 +165,33 @@ fn uniforms(mut state: u32) -> impl FnMut() -> f64 {
     }
 }
 
-/// A grid's coarsest refinement (`nodes` on its first axis, its error) errs beyond `target` and
-/// the refined grid's error (`refined`) is within it: the measure decides the resolution.
-fn assert_refined((nodes, coarse): (usize, f32), refined: f32, target: f32) {
+/// The grid `build` gives for the error target `target`, once its coarsest refinement
+/// (`build(f32::MAX)`, two nodes on the first axis) is found to err beyond the target and the
+/// refined grid within it (`measure`: a grid's nodes on the first axis and its measured error):
+/// the measure decides the resolution.
+fn refined_grid<G>(
+    target: f32,
+    build: impl Fn(f32) -> G,
+    measure: impl Fn(&G) -> (usize, f32),
+) -> G {
+    let (nodes, coarse) = measure(&build(f32::MAX));
     assert_eq!(nodes, 2);
     assert!(coarse > target, "coarse {coarse}");
+    let grid = build(target);
+    let (_, refined) = measure(&grid);
     assert!(refined <= target, "refined {refined}");
+    grid
+}
+
+/// Light skin with C_m and C_h of `p` = (C_m, β_m, C_h) and its layers at the default g.
+fn light_skin_at(p: [f32; 3]) -> (SkinParams, render::media::SkinMedia) {
+    let q = SkinParams::preset(Preset::Light)
+        .with_melanin(f64::from(p[0]))
+        .unwrap()
+        .with_hemoglobin(f64::from(p[2]))
+        .unwrap();
+    let media = render::media::SkinMedia::new(&q, multipole::DEFAULT_G).unwrap();
+    (q, media)
 }
 
 /// The grid over C_m ∈ [0.02, 0.3] (β_m 0.5, C_h 0.01; 9 nodes) meets its 2% error target at the
@@ -196,23 +217,16 @@ fn profile_grid_error_stays_within_its_measured_bound() {
         target,
     };
     let range = [[0.02, 0.3], [0.5, 0.5], [0.01, 0.01]];
-    let coarse = profile_grid(&settings(f32::MAX), range).unwrap();
-    let grid = profile_grid(&settings(0.02), range).unwrap();
-    assert_refined(
-        (coarse.axes()[0].len(), coarse.max_error),
-        grid.max_error,
+    let grid = refined_grid(
         0.02,
+        |t| profile_grid(&settings(t), range).unwrap(),
+        |g| (g.axes()[0].len(), g.max_error),
     );
     assert_eq!(grid.axes()[1], vec![0.5]);
     let mut next = uniforms(0x2545_f491);
     for _ in 0..8 {
         let p = [(0.02 + 0.28 * next()) as f32, 0.5, 0.01];
-        let q = params
-            .with_melanin(f64::from(p[0]))
-            .unwrap()
-            .with_hemoglobin(f64::from(p[2]))
-            .unwrap();
-        let media = render::media::SkinMedia::new(&q, multipole::DEFAULT_G).unwrap();
+        let (q, media) = light_skin_at(p);
         let (direct, _) = render::fidelity::tables::skin_table(
             &q,
             &media,
@@ -258,12 +272,10 @@ fn incidence_grid_error_stays_within_its_measured_bound() {
         target,
     };
     let range = [[0.02, 0.3], [0.5, 0.5], [0.005, 0.12]];
-    let coarse = incidence_grid(&settings(f32::MAX), range).unwrap();
-    let grid = incidence_grid(&settings(0.005), range).unwrap();
-    assert_refined(
-        (coarse.axes()[0].len(), coarse.max_error),
-        grid.max_error,
+    let grid = refined_grid(
         0.005,
+        |t| incidence_grid(&settings(t), range).unwrap(),
+        |g| (g.axes()[0].len(), g.max_error),
     );
     let mut next = uniforms(0x9e37_79b9);
     for _ in 0..6 {
@@ -272,12 +284,7 @@ fn incidence_grid_error_stays_within_its_measured_bound() {
             0.5,
             (0.005 + 0.115 * next()) as f32,
         ];
-        let q = params
-            .with_melanin(f64::from(p[0]))
-            .unwrap()
-            .with_hemoglobin(f64::from(p[2]))
-            .unwrap();
-        let media = render::media::SkinMedia::new(&q, multipole::DEFAULT_G).unwrap();
+        let (_, media) = light_skin_at(p);
         let gain = IncidenceGain::build(media.every_10nm(), multipole::DEFAULT_G).unwrap();
         let angles = gain.angles().to_vec();
         let direct = directional

@@ -156,8 +156,16 @@ fn side_means(
     ]
 }
 
-/// Each side's means of two renders (`names`) agree within 3σ of their difference.
-fn assert_sides_agree(names: [&str; 2], a: [(f64, f64); 2], b: [(f64, f64); 2]) {
+/// The walk at 550 nm on the split slab under two settings of its skin volumes (`set(m, k)` for
+/// setting k, named `names[k]`, rendered with seed `seeds[k]`): the mean radiance of each side
+/// (≥ 1 mm from the split) agrees within 3σ of the two renders' difference.
+fn assert_settings_agree(
+    names: [&str; 2],
+    seeds: [u64; 2],
+    set: impl Fn(&mut render::volumetric::SkinVolume, usize),
+) {
+    let dir = tempfile::tempdir().unwrap();
+    let [a, b] = [0, 1].map(|k| side_means(dir.path(), (3.0, 6), seeds[k], |m| set(m, k)));
     for (side, ((x, xs), (y, ys))) in a.into_iter().zip(b).enumerate() {
         eprintln!(
             "side {side}: {} {x:.5} ± {xs:.5}, {} {y:.5} ± {ys:.5}",
@@ -177,11 +185,10 @@ fn assert_sides_agree(names: [&str; 2], a: [(f64, f64); 2], b: [(f64, f64); 2]) 
 /// (independent seeds; both are unbiased, nothing but noise may separate them).
 #[test]
 fn local_and_global_majorants_agree() {
-    let dir = tempfile::tempdir().unwrap();
-    let shape = (3.0, 6);
-    let local = side_means(dir.path(), shape, 33, |m| m.majorant = Majorant::Local);
-    let global = side_means(dir.path(), shape, 34, |m| m.majorant = Majorant::Global);
-    assert_sides_agree(["local", "global"], local, global);
+    let majorants = [Majorant::Local, Majorant::Global];
+    assert_settings_agree(["local", "global"], [33, 34], |m, k| {
+        m.majorant = majorants[k];
+    });
 }
 
 /// The split speckle's slab with the left half's epidermis thin (0.05 mm; the material's is
@@ -254,11 +261,8 @@ fn cells_bound_the_texels_thickness_and_least_absorption() {
 /// both rules are unbiased, nothing but noise may separate them).
 #[test]
 fn excess_and_implicit_absorption_agree() {
-    let dir = tempfile::tempdir().unwrap();
-    let shape = (3.0, 6);
-    let implicit = side_means(dir.path(), shape, 35, |m| {
-        m.absorption = Absorption::Implicit
+    let rules = [Absorption::Implicit, Absorption::Excess];
+    assert_settings_agree(["implicit", "excess"], [35, 36], |m, k| {
+        m.absorption = rules[k];
     });
-    let excess = side_means(dir.path(), shape, 36, |m| m.absorption = Absorption::Excess);
-    assert_sides_agree(["implicit", "excess"], implicit, excess);
 }

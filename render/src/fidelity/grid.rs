@@ -12,7 +12,7 @@
 use super::FidelityKnobs;
 use super::PhotonPolicy;
 use super::key::grid_key;
-use super::tables::{Shapes, cache_folder, first_table_key, may_choose, node_table};
+use super::tables::{Shapes, first_table_key, in_cache_folder, may_choose, node_table};
 use crate::bssrdf::grid::{AXIS_KNEES, unwarp, warp};
 use crate::bssrdf::{Corners, ProfileGrid, ProfileTable};
 use crate::media::SkinMedia;
@@ -251,8 +251,9 @@ pub fn profile_grid_traced(
     settings: &GridSettings<'_>,
     range: [[f32; 2]; 3],
 ) -> Result<(ProfileGrid, GridLoad), MultipoleError> {
-    let (dir, max_bytes) = cache_folder(settings.fidelity)?;
-    profile_grid_in(settings, range, dir.as_deref(), max_bytes)
+    in_cache_folder(settings.fidelity, |dir, max_bytes| {
+        profile_grid_in(settings, range, dir, max_bytes)
+    })
 }
 
 /// [`profile_grid_traced`] with the record kept in `dir` (`None`: no record), the folder

@@ -5,7 +5,7 @@
 
 use super::FidelityKnobs;
 use super::grid::{MAX_PROBED_CELLS, cell_centres, node_axes, node_points};
-use super::tables::cache_folder;
+use super::tables::in_cache_folder;
 use crate::bssrdf::{Directional, IncidenceGain, IncidenceGrid};
 use crate::media::SkinMedia;
 use multipole::MultipoleError;
@@ -160,8 +160,9 @@ pub fn incidence_grid(
     settings: &IncidenceSettings<'_>,
     range: [[f32; 2]; 3],
 ) -> Result<IncidenceGrid, MultipoleError> {
-    let (dir, max_bytes) = cache_folder(settings.fidelity)?;
-    incidence_grid_in(settings, range, dir.as_deref(), max_bytes)
+    in_cache_folder(settings.fidelity, |dir, max_bytes| {
+        incidence_grid_in(settings, range, dir, max_bytes)
+    })
 }
 
 /// [`incidence_grid`] kept in the cache folder `dir` (`None`: built in memory), the folder bounded

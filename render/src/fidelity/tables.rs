@@ -258,6 +258,16 @@ pub(super) fn cache_folder(
     Ok((dir, max_bytes))
 }
 
+/// `build` given the cache folder of skin tables under `knobs` and its size limit
+/// ([`cache_folder`]): what builds through the disk cache in a folder it is handed.
+pub(super) fn in_cache_folder<T>(
+    knobs: &FidelityKnobs,
+    build: impl FnOnce(Option<&std::path::Path>, u64) -> Result<T, MultipoleError>,
+) -> Result<T, MultipoleError> {
+    let (dir, max_bytes) = cache_folder(knobs)?;
+    build(dir.as_deref(), max_bytes)
+}
+
 /// The shapes of the first tables [`skin_table`] asks for: the fixed ones, the override, or the
 /// cheapest table a footprint's choice is read from.
 fn first_shapes(method: Method, photons: PhotonPolicy, shape_escapes: Option<u64>) -> Shapes {
