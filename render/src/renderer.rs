@@ -13,7 +13,7 @@ use crate::adaptive::{Accumulator, ErrorEstimate, MIN_SPP};
 use crate::error::RenderError;
 pub use crate::error::SettingError;
 use crate::film::Film;
-use crate::integrator::{BodyIntegrator, IntegratorKind, PathSettings, PathTracer};
+use crate::integrator::{BodyIntegrator, ExitLights, IntegratorKind, PathSettings, PathTracer};
 use crate::sampler::{PathSampler, SamplerKind};
 use crate::scene::Scene;
 use crate::spectrum::{LAMBDA_MAX_NM, LAMBDA_MIN_NM, SampledWavelengths};
@@ -36,6 +36,8 @@ pub const MAX_THREADS: usize = 1024;
 pub const MAX_DEPTH: u32 = 1024;
 /// Most light samples per subsurface exit point, and most probes per skin hit, accepted.
 pub const MAX_EXIT_LIGHT_SAMPLES: u32 = 64;
+/// Largest light-splitting budget accepted at an exit point (`ExitLights::Split`).
+pub const MAX_SPLIT_BUDGET: f32 = 1e6;
 
 /// What to render and how long, as requested; [`RenderOptions::validate`] checks it once and
 /// gives the [`RenderSettings`] that [`render`] takes.
@@ -139,12 +141,22 @@ impl RenderOptions {
         {
             return Err(bad("threads", t.to_string(), "[1, 1024]"));
         }
-        if !(1..=MAX_EXIT_LIGHT_SAMPLES).contains(&self.path.exit_light_samples) {
-            return Err(bad(
-                "path.exit_light_samples",
-                self.path.exit_light_samples.to_string(),
-                "[1, 64]",
-            ));
+        match self.path.exit_lights {
+            ExitLights::Choose { samples, .. } if !(1..=MAX_EXIT_LIGHT_SAMPLES).contains(&samples) => {
+                return Err(bad(
+                    "path.exit_lights.samples",
+                    samples.to_string(),
+                    "[1, 64]",
+                ));
+            }
+            ExitLights::Split { budget } if !(1.0..=MAX_SPLIT_BUDGET).contains(&budget) => {
+                return Err(bad(
+                    "path.exit_lights.budget",
+                    budget.to_string(),
+                    "[1, 1e6]",
+                ));
+            }
+            _ => {}
         }
         if !(1..=MAX_EXIT_LIGHT_SAMPLES).contains(&self.path.subsurface_probes) {
             return Err(bad(

@@ -10,7 +10,7 @@
 
 use cpu_time::ProcessTime;
 use render::bssrdf::{ProbeAxes, RadiusWavelength};
-use render::integrator::PathSettings;
+use render::integrator::{ExitLights, PathSettings};
 use render::noise::relative_noise_where;
 use render::passes::Passes;
 use render::renderer::{RenderOptions, render};
@@ -33,18 +33,22 @@ pub struct Variant {
 /// The steps in the order they were added, each on top of the one before (the first is the
 /// renderer before any of them), then two other normal-probe probabilities on top of the fourth,
 /// then the splitting candidates on top of the seventh, then the radius wavelength's choice on
-/// top of the tenth (two probes per skin hit): the seventeenth (by luminance, uniform share 0.1)
+/// top of the tenth (two probes per skin hit), then four light-splitting budgets at the exit
+/// points on top of the seventeenth (by luminance, uniform share 0.1): the twenty-fifth (budget 8)
 /// is today's default.
 #[must_use]
 pub fn variants() -> Vec<Variant> {
+    let chosen = |samples, stratified| ExitLights::Choose {
+        samples,
+        stratified,
+    };
     let before = PathSettings {
         sampler: SamplerKind::Independent,
         wavelengths: WavelengthSampling::Uniform,
         probe_axes: ProbeAxes::PBRT,
-        exit_light_samples: 1,
+        exit_lights: chosen(1, false),
         split_subsurface: false,
         subsurface_probes: 1,
-        stratified_exit_lights: false,
         radius_wavelength: RadiusWavelength::HERO,
         ..PathSettings::default()
     };
@@ -65,7 +69,7 @@ pub fn variants() -> Vec<Variant> {
         ..split
     };
     let two_lights = PathSettings {
-        exit_light_samples: 2,
+        exit_lights: chosen(2, false),
         ..normal
     };
     let pair = PathSettings {
@@ -113,14 +117,14 @@ pub fn variants() -> Vec<Variant> {
             "2 probes, 1 light sample each",
             PathSettings {
                 subsurface_probes: 2,
-                exit_light_samples: 1,
+                exit_lights: chosen(1, false),
                 ..pair
             },
         ),
         (
             "4 light samples per exit",
             PathSettings {
-                exit_light_samples: 4,
+                exit_lights: chosen(4, false),
                 ..pair
             },
         ),
@@ -135,7 +139,7 @@ pub fn variants() -> Vec<Variant> {
             "2 probes, stratified exit light choice",
             PathSettings {
                 subsurface_probes: 2,
-                stratified_exit_lights: true,
+                exit_lights: chosen(2, true),
                 ..pair
             },
         ),
@@ -143,7 +147,7 @@ pub fn variants() -> Vec<Variant> {
             "3 probes, 2 stratified light samples",
             PathSettings {
                 subsurface_probes: 3,
-                stratified_exit_lights: true,
+                exit_lights: chosen(2, true),
                 ..pair
             },
         ),
@@ -175,12 +179,32 @@ pub fn variants() -> Vec<Variant> {
         (
             "luminance radius, stratified exit light choice",
             PathSettings {
-                stratified_exit_lights: true,
+                exit_lights: chosen(2, true),
                 ..share(0.1)
             },
         ),
     ]
     .into_iter()
+    .chain(
+        [
+            ("luminance radius, lights split (budget 4)", 4.0),
+            ("+ lights split at each exit (budget 8)", 8.0),
+            ("luminance radius, lights split (budget 16)", 16.0),
+            (
+                "luminance radius, every light at each exit",
+                render::renderer::MAX_SPLIT_BUDGET,
+            ),
+        ]
+        .map(|(name, budget)| {
+            (
+                name,
+                PathSettings {
+                    exit_lights: ExitLights::Split { budget },
+                    ..share(0.1)
+                },
+            )
+        }),
+    )
     .map(|(name, path)| Variant { name, path })
     .collect()
 }

@@ -6,7 +6,7 @@ use crate::geometry::offset_origin;
 use crate::sampler::PathSampler;
 use crate::scene::Scene;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use smallvec::SmallVec;
 
 /// Lights whose probabilities a path keeps without allocating (a scene with more spills to the
@@ -58,7 +58,6 @@ pub(super) fn direct_light(
     (sampler, rays): (&mut PathSampler, &mut u64),
     scatter: impl Fn(Vec3) -> (SampledSpectrum, f32),
 ) -> SampledSpectrum {
-    let Receiver { p, ng, ns } = at;
     let n_lights = pick.len();
     // Pick a light by its selection probability (inverse CDF over a handful of lights).
     let mut k = 0;
@@ -67,8 +66,65 @@ pub(super) fn direct_light(
         k += 1;
         cdf += pick[k];
     }
-    let pick_pdf = pick[k];
     let u = sampler.get_2d();
+    light_estimate(scene, at, wl, (k, pick[k]), (u, rays), scatter)
+}
+
+/// Uniforms of the first [`SPLIT_STRATIFIED`] lights under splitting come from the sampler's
+/// region (two dimensions each); further lights draw independent numbers.
+pub(super) const SPLIT_STRATIFIED: usize = 4;
+
+/// Each light's expected number of samples under splitting with `budget` ≥ 1, written over its
+/// selection probability in `probs`: min(1, budget · p). A light holding at least 1/`budget` of
+/// the selection weight is sampled at every point; a weaker one with that probability.
+pub(super) fn split_rates(probs: &mut LightProbabilities, budget: f32) {
+    for p in probs.iter_mut() {
+        *p = (budget * *p).min(1.0);
+    }
+}
+
+/// Next-event estimation at `at` by splitting (docs/physics.md §8, "The light at an exit point"):
+/// light k is sampled with probability `rates[k]` (from [`split_rates`]) and its estimate divided
+/// by it, so the sum over lights is unbiased with no light-choice variance among the lights whose
+/// rate is 1. Light k < [`SPLIT_STRATIFIED`] reads its two uniforms at offset `first_dim` + 2k of
+/// the sampler's region; the rate's coin is independent.
+pub(super) fn split_direct_light(
+    scene: &Scene,
+    at: Receiver,
+    wl: &SampledWavelengths,
+    (rates, first_dim): (&[f32], u32),
+    (sampler, rays): (&mut PathSampler, &mut u64),
+    scatter: impl Fn(Vec3) -> (SampledSpectrum, f32),
+) -> SampledSpectrum {
+    let mut sum = SampledSpectrum::zero();
+    for (k, &rate) in rates.iter().enumerate() {
+        if rate <= 0.0 || (rate < 1.0 && sampler.independent_1d() >= rate) {
+            continue;
+        }
+        let u = if k < SPLIT_STRATIFIED {
+            sampler.seek(first_dim + 2 * k as u32);
+            sampler.get_2d()
+        } else {
+            Vec2::new(sampler.independent_1d(), sampler.independent_1d())
+        };
+        sum += light_estimate(scene, at, wl, (k, rate), (u, &mut *rays), &scatter);
+    }
+    sum
+}
+
+/// One sample of light `k` (the environment after the scene's lights) from the uniforms `u`,
+/// taken with strategy weight `chosen` (its selection probability, or its expected number of
+/// samples): f · L_i · w / (chosen · pdf), the power heuristic w against the scattering density
+/// of `scatter`; one shadow ray, counted in `rays`.
+fn light_estimate(
+    scene: &Scene,
+    at: Receiver,
+    wl: &SampledWavelengths,
+    (k, chosen): (usize, f32),
+    (u, rays): (Vec2, &mut u64),
+    scatter: impl Fn(Vec3) -> (SampledSpectrum, f32),
+) -> SampledSpectrum {
+    let Receiver { p, ng, ns } = at;
     let sample = if k < scene.lights.len() {
         scene.lights[k].sample(p, u, wl)
     } else {
@@ -77,7 +133,7 @@ pub(super) fn direct_light(
     let Some(ls) = sample else {
         return SampledSpectrum::zero();
     };
-    if pick_pdf <= 0.0 || ls.pdf <= 0.0 || ls.wi.dot(ng) <= 0.0 || ls.li.is_black() {
+    if chosen <= 0.0 || ls.pdf <= 0.0 || ls.wi.dot(ng) <= 0.0 || ls.li.is_black() {
         return SampledSpectrum::zero();
     }
     let (f, scatter_pdf) = scatter(ls.wi);
@@ -94,7 +150,7 @@ pub(super) fn direct_light(
     if scene.geometry.occluded(origin, ls.wi, tmax) {
         return SampledSpectrum::zero();
     }
-    let light_pdf = pick_pdf * ls.pdf;
+    let light_pdf = chosen * ls.pdf;
     let w = if ls.is_delta {
         1.0
     } else {
@@ -107,7 +163,8 @@ pub(super) fn direct_light(
 pub(super) struct PrevVertex {
     pub ns: Vec3,
     pub bsdf_pdf: f32,
-    /// Light selection probabilities there (environment last).
+    /// Each light's strategy weight there, environment last: its selection probability, or
+    /// its expected number of samples under splitting ([`split_rates`]).
     pub pick: LightProbabilities,
     pub p: Vec3,
 }

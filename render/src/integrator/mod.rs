@@ -2,7 +2,8 @@
 //! sampling (power heuristic, [Veach 1997]), Russian roulette after a few bounces.
 //!
 //! One light (or the environment) is picked per shading point with probability proportional to a
-//! rough estimate of the irradiance it delivers there, and sampled; BSDF-sampled
+//! rough estimate of the irradiance it delivers there, and sampled; at a subsurface exit point
+//! every light that holds a share of that estimate is sampled instead ([`ExitLights`]). BSDF-sampled
 //! rays that reach an area light or the environment add its emission with the MIS weight of the
 //! same strategy pair. Delta lights (point, spot, distant) are only reached by light sampling.
 //!
@@ -40,7 +41,8 @@ use lights::{LightProbabilities, PrevVertex, Receiver, direct_light, light_proba
 /// Where each decision of a bounce reads its uniforms in the bounce's region of
 /// [`PathSampler`] (sets of four dimensions: light choice and position at the hit with the
 /// subsurface decision; the probe, or the BSDF sample and roulette; light at the exit point (two
-/// sets: up to two light samples stratified); the continuation from the exit point and roulette).
+/// sets: two dimensions for each of the first four lights under splitting, or up to two light
+/// samples stratified by choice); the continuation from the exit point and roulette).
 mod dims {
     pub const SUBSURFACE_CHOICE: u32 = 3;
     pub const PROBE: u32 = 4;
@@ -65,9 +67,8 @@ pub struct PathSettings {
     pub wavelengths: WavelengthSampling,
     /// How subsurface probe axes are chosen (default [`ProbeAxes::DEFAULT`]).
     pub probe_axes: ProbeAxes,
-    /// Light samples (next-event estimates, averaged) at each subsurface exit point, ≥ 1
-    /// (default 2: BENCHMARKS.md, "Image noise").
-    pub exit_light_samples: u32,
+    /// How the light at a subsurface exit point is sampled (default [`ExitLights::DEFAULT`]).
+    pub exit_lights: ExitLights,
     /// Gather the light at a subsurface exit point at every skin hit, not only when the
     /// subsurface branch is chosen for the continuation.
     pub split_subsurface: bool,
@@ -75,15 +76,47 @@ pub struct PathSettings {
     /// gathered, ≥ 1; only the first continues the path (only with `split_subsurface`; default 2:
     /// BENCHMARKS.md, "Image noise").
     pub subsurface_probes: u32,
-    /// Stratify the light choice of the light samples at one exit point (u₀ + j/n) instead of
-    /// drawing each from its own uniform.
-    pub stratified_exit_lights: bool,
     /// How the wavelength whose profile draws a probe's radius is chosen (default
     /// [`RadiusWavelength::RENDER`]: mostly by the lanes' luminance).
     pub radius_wavelength: RadiusWavelength,
     /// How light leaves a thin part walked under the BSSRDF integrator (default
     /// [`ThinExit::LightSampled`]; the volumetric reference always refracts).
     pub thin_exit: ThinExit,
+}
+
+/// How the light at a subsurface exit point is sampled by next-event estimation (docs/physics.md
+/// §8, "The light at an exit point").
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ExitLights {
+    /// `samples` estimates, each choosing one light by its selection probability, averaged; with
+    /// `stratified` the j-th of n chooses at u₀ + j/n instead of from its own uniform.
+    Choose {
+        /// Estimates per exit point, in [1, 64].
+        samples: u32,
+        /// Stratify the choices of one exit point.
+        stratified: bool,
+    },
+    /// Every light whose selection probability p is at least 1/`budget` sampled once, each
+    /// weaker one with probability `budget` · p (and its estimate divided by it): no
+    /// light-choice variance among the lights that matter, such as a fill light in the key
+    /// light's shadow.
+    Split {
+        /// The inverse of the least share sampled at every exit point, in [1, 10⁶].
+        budget: f32,
+    },
+}
+
+impl ExitLights {
+    /// What renders use: splitting with budget 8 (of budgets 4, 8, 16 and ∞ and two chosen
+    /// samples, the least noise at equal CPU time on the default scene: BENCHMARKS.md, "Image
+    /// noise").
+    pub const DEFAULT: Self = Self::Split { budget: 8.0 };
+}
+
+impl Default for ExitLights {
+    fn default() -> Self {
+        Self::DEFAULT
+    }
 }
 
 /// How the path leaves a thin part of skin after its volumetric walk (docs/physics.md §16.6).
@@ -108,10 +141,9 @@ impl Default for PathSettings {
             sampler: SamplerKind::default(),
             wavelengths: WavelengthSampling::default(),
             probe_axes: ProbeAxes::DEFAULT,
-            exit_light_samples: 2,
+            exit_lights: ExitLights::DEFAULT,
             split_subsurface: true,
             subsurface_probes: 2,
-            stratified_exit_lights: false,
             radius_wavelength: RadiusWavelength::RENDER,
             thin_exit: ThinExit::LightSampled,
         }

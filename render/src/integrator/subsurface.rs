@@ -6,8 +6,11 @@
 //! branch is chosen (weight 1/q). Both are unbiased; splitting removes the variance of skipping
 //! the exit's light whenever the surface branch is taken.
 
-use super::lights::{LightProbabilities, PrevVertex, Receiver, direct_light, light_probabilities};
-use super::{Path, PathTracer, Random, Shading, Step, dims, probe, russian_roulette};
+use super::lights::{
+    LightProbabilities, PrevVertex, Receiver, direct_light, light_probabilities, split_direct_light,
+    split_rates,
+};
+use super::{ExitLights, Path, PathTracer, Random, Shading, Step, dims, probe, russian_roulette};
 use crate::bssrdf::{
     Directional, Exit, GainCorners, ProbeFrame, Subsurface, curvature, texture_modulation,
 };
@@ -364,9 +367,8 @@ impl PathTracer<'_> {
     }
 
     /// Next-event estimation at a subsurface exit point with S_ω of the entry's `angle` (MIS
-    /// against the cosine-weighted continuation): the mean of `settings.exit_light_samples`
-    /// light samples sharing the exit (splitting), and whether any light can reach the point
-    /// (`pick` gets its light probabilities).
+    /// against the cosine-weighted continuation) by `settings.exit_lights`, and whether any
+    /// light can reach the point (`pick` gets each light's strategy weight there).
     pub(super) fn exit_light(
         &self,
         (ss, angle): (&Subsurface, EntryAngle<'_>),
@@ -384,10 +386,40 @@ impl PathTracer<'_> {
         if !lit {
             return (SampledSpectrum::zero(), false);
         }
-        let n = self.settings.exit_light_samples.max(1);
+        let at = Receiver {
+            p: exit.p,
+            ng: eng,
+            ns: ens,
+        };
+        let scatter = |wi: Vec3| {
+            let c = wi.dot(ens);
+            let mut f = angle.s_omegas(c, wl) * c.max(0.0);
+            if let Some(m) = outgoing.and_then(|o| o.lobe(ss, wi, ens, c, wl)) {
+                f *= m;
+            }
+            (f, c.max(0.0) * FRAC_1_PI)
+        };
+        let (samples, stratified) = match self.settings.exit_lights {
+            ExitLights::Split { budget } => {
+                split_rates(pick, budget);
+                let direct = split_direct_light(
+                    scene,
+                    at,
+                    wl,
+                    (pick, dims::EXIT_LIGHT),
+                    (sampler, rays),
+                    scatter,
+                );
+                return (direct, true);
+            }
+            ExitLights::Choose {
+                samples,
+                stratified,
+            } => (samples.max(1), stratified),
+        };
         let mut direct = SampledSpectrum::zero();
         let mut u_first = 0.0;
-        for j in 0..n {
+        for j in 0..samples {
             sampler.seek(dims::EXIT_LIGHT + 4 * j.min(1));
             let drawn = sampler.get_1d();
             // Stratified light choice: the j-th sample picks at u₀ + j/n (mod 1), each uniform, so
@@ -395,31 +427,20 @@ impl PathTracer<'_> {
             let u_pick = if j == 0 {
                 u_first = drawn;
                 drawn
-            } else if self.settings.stratified_exit_lights {
-                (u_first + j as f32 / n as f32).fract()
+            } else if stratified {
+                (u_first + j as f32 / samples as f32).fract()
             } else {
                 drawn
             };
             direct += direct_light(
                 scene,
-                Receiver {
-                    p: exit.p,
-                    ng: eng,
-                    ns: ens,
-                },
+                at,
                 wl,
                 (pick, u_pick),
                 (&mut *sampler, &mut *rays),
-                |wi| {
-                    let c = wi.dot(ens);
-                    let mut f = angle.s_omegas(c, wl) * c.max(0.0);
-                    if let Some(m) = outgoing.and_then(|o| o.lobe(ss, wi, ens, c, wl)) {
-                        f *= m;
-                    }
-                    (f, c.max(0.0) * FRAC_1_PI)
-                },
+                scatter,
             );
         }
-        (direct / n as f32, true)
+        (direct / samples as f32, true)
     }
 }
