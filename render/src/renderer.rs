@@ -142,7 +142,9 @@ impl RenderOptions {
             return Err(bad("threads", t.to_string(), "[1, 1024]"));
         }
         match self.path.exit_lights {
-            ExitLights::Choose { samples, .. } if !(1..=MAX_EXIT_LIGHT_SAMPLES).contains(&samples) => {
+            ExitLights::Choose { samples, .. }
+                if !(1..=MAX_EXIT_LIGHT_SAMPLES).contains(&samples) =>
+            {
                 return Err(bad(
                     "path.exit_lights.samples",
                     samples.to_string(),

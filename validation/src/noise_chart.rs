@@ -410,7 +410,9 @@ fn write_csv(path: &Path, rows: &[(&'static str, Point)]) -> anyhow::Result<()> 
     for (name, p) in rows {
         writeln!(
             s,
-            "{name},{},{:.3},{:.3},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6}",
+            "\"{}\",{},{:.3},{:.3},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6}",
+            // Quoted (RFC 4180): the names hold commas.
+            name.replace('"', "\"\""),
             p.spp,
             p.cpu_s,
             p.wall_s,

@@ -7,8 +7,8 @@
 //! the exit's light whenever the surface branch is taken.
 
 use super::lights::{
-    LightProbabilities, PrevVertex, Receiver, direct_light, light_probabilities, split_direct_light,
-    split_rates,
+    LightProbabilities, PrevVertex, Receiver, direct_light, light_probabilities,
+    split_direct_light, split_rates,
 };
 use super::{ExitLights, Path, PathTracer, Random, Shading, Step, dims, probe, russian_roulette};
 use crate::bssrdf::{
