@@ -277,6 +277,36 @@ fn split_exit_lights_estimate_the_chosen_lights_mean() {
     }
 }
 
+/// Exit-light settings outside their ranges are typed errors naming the key: a split budget below
+/// 1, above 10⁶, infinite or NaN, and zero or more than 64 chosen samples.
+#[test]
+fn bad_exit_light_settings_are_errors_naming_the_key() {
+    use render::integrator::{ExitLights, PathSettings};
+    use render::renderer::RenderOptions;
+    let check = |exit_lights, key: &str| {
+        let options = RenderOptions {
+            path: PathSettings {
+                exit_lights,
+                ..PathSettings::default()
+            },
+            ..Default::default()
+        };
+        assert_eq!(options.validate().unwrap_err().name, key, "{exit_lights:?}");
+    };
+    for budget in [0.5, 2e6, f32::INFINITY, f32::NAN] {
+        check(ExitLights::Split { budget }, "path.exit_lights.budget");
+    }
+    for samples in [0, 65] {
+        check(
+            ExitLights::Choose {
+                samples,
+                stratified: false,
+            },
+            "path.exit_lights.samples",
+        );
+    }
+}
+
 /// A bloodless, melanin-free light-skin sphere of `radius_mm` inside a uniform white environment
 /// of luminance 1, seen from 8 radii with a 10° field of view (the image lies inside the sphere's
 /// disc: exit angles from 0° at the centre to 79° at the corners), at full fidelity, with the
